@@ -1,0 +1,88 @@
+// The GPU backend interface: the small surface every compute API implements (src/vk, src/gl).
+// Plain buffers, named kernels from the embedded registry, explicit barriers and per-dispatch
+// timestamps. Pipelines (src/core/*_pipeline.cpp) are written once against this interface.
+#pragma once
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace sffd {
+
+// Arithmetic variant of a kernel (see shaders/common/prelude.glsl).
+struct KernelVariant {
+  bool strict = false;   // every operation precise, fixed order: bit-identical across APIs
+  bool f64 = false;      // double-precision arithmetic and storage
+  bool operator==(const KernelVariant&) const = default;
+};
+
+struct DeviceLimits {
+  uint64_t maxStorageBufferRange = 128u << 20;   // bytes one storage binding may cover
+  uint64_t storageOffsetAlignment = 256;         // alignment of a storage binding's offset
+  uint32_t maxWorkGroupCount[3] = {65535, 65535, 65535};
+  bool float64 = false;                          // kernels in the f64 variant can run
+  bool timestamps = false;                       // per-dispatch GPU times are measured
+};
+
+struct DeviceInfo {
+  std::string api;       // "vulkan" or "gl"
+  std::string provider;  // how it was reached: "vulkan", "egl", "osmesa", "glfw"
+  std::string name;      // device name as the driver reports it
+  std::string driver;    // driver / API version string
+  std::string type;      // "discrete", "integrated", "virtual", "cpu", "other"
+  DeviceLimits limits;
+};
+
+using BufferId = uint32_t;
+
+// A storage buffer range bound at a binding slot of the kernel (slot numbers from shaders/common/layout.h).
+struct BufferBinding {
+  uint32_t slot = 0;
+  BufferId buffer = 0;
+  uint64_t offset = 0;
+  uint64_t size = 0;   // 0: from offset to the end of the buffer
+};
+
+struct Dispatch {
+  std::string_view kernel;                  // name in the kernel registry (the .comp file's stem)
+  KernelVariant variant;
+  const void* params = nullptr;             // the kernel's parameter block (binding SFFD_BINDING_PARAMS)
+  size_t paramsSize = 0;
+  std::vector<BufferBinding> buffers;
+  uint32_t groups[3] = {1, 1, 1};
+  std::string_view label;                   // names the timing record; defaults to the kernel name
+};
+
+struct DispatchTiming {
+  std::string label;
+  double gpuMs = -1;   // from timestamp queries; -1 when the device has none
+};
+
+class Backend {
+ public:
+  virtual ~Backend() = default;
+  virtual const DeviceInfo& info() const = 0;
+
+  virtual BufferId createBuffer(uint64_t bytes) = 0;
+  virtual void destroyBuffer(BufferId buffer) = 0;
+  virtual void upload(BufferId buffer, uint64_t offset, const void* data, uint64_t bytes) = 0;
+  // Waits for all work that writes the buffer, then copies it out.
+  virtual void download(BufferId buffer, uint64_t offset, void* data, uint64_t bytes) = 0;
+
+  // Records (or issues) one dispatch; compiles the kernel variant on first use.
+  virtual void dispatch(const Dispatch& d) = 0;
+  // Makes the writes of earlier dispatches visible to later dispatches and transfers.
+  virtual void barrier() = 0;
+  // Submits everything recorded and waits for it.
+  virtual void finish() = 0;
+  // Timings of the dispatches finished since the last call, in dispatch order.
+  virtual std::vector<DispatchTiming> takeTimings() = 0;
+};
+
+// Splits a 1-D job of `threads` threads into a grid within the device's group-count limits
+// (SFFD_LOCAL_SIZE threads a group; kernels rebuild the index with sffdThreadIndex()).
+void gridFor(uint64_t threads, const DeviceLimits& limits, uint32_t groups[3]);
+
+}  // namespace sffd

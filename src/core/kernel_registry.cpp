@@ -1,0 +1,35 @@
+#include "kernel_registry.h"
+
+#include <algorithm>
+
+#include "shader_layout.h"
+
+namespace sffd {
+
+const EmbeddedKernel* findKernel(std::string_view name) {
+  for (const EmbeddedKernel& k : embeddedKernels())
+    if (name == k.name) return &k;
+  return nullptr;
+}
+
+std::string glslForVariant(const EmbeddedKernel& kernel, KernelVariant variant) {
+  std::string src = kernel.glsl;
+  size_t eol = src.find('\n');
+  std::string defines = std::string("#define SFFD_STRICT ") + (variant.strict ? "1" : "0") +
+                        "\n#define SFFD_F64 " + (variant.f64 ? "1" : "0") + "\n";
+  src.insert(eol == std::string::npos ? src.size() : eol + 1, defines);
+  return src;
+}
+
+void gridFor(uint64_t threads, const DeviceLimits& limits, uint32_t groups[3]) {
+  uint64_t need = (threads + SFFD_LOCAL_SIZE - 1) / SFFD_LOCAL_SIZE;
+  uint64_t maxX = std::min<uint64_t>(limits.maxWorkGroupCount[0], SFFD_MAX_GROUPS_X);
+  if (need == 0) need = 1;
+  uint64_t x = std::min(need, maxX);
+  uint64_t y = (need + x - 1) / x;
+  groups[0] = static_cast<uint32_t>(x);
+  groups[1] = static_cast<uint32_t>(y);
+  groups[2] = 1;
+}
+
+}  // namespace sffd

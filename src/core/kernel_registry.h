@@ -1,0 +1,30 @@
+// The kernels embedded in the binary at build time (tools/embed_kernels.cpp writes the table):
+// SPIR-V for Vulkan in each variant, and the GLSL source with its #includes inlined for OpenGL.
+// Nothing is loaded from a path at run time.
+#pragma once
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <string_view>
+
+#include "backend.h"
+
+namespace sffd {
+
+struct EmbeddedKernel {
+  const char* name;
+  const char* glsl;                 // inlined source without variant defines
+  const uint32_t* spirv[4];         // index variantIndex(): strict + 2 * f64
+  size_t spirvWords[4];
+};
+
+inline int variantIndex(KernelVariant v) { return (v.strict ? 1 : 0) + (v.f64 ? 2 : 0); }
+
+std::span<const EmbeddedKernel> embeddedKernels();
+// nullptr when no kernel has that name.
+const EmbeddedKernel* findKernel(std::string_view name);
+// GLSL source of a variant for an OpenGL driver: the variant defines follow the #version line.
+std::string glslForVariant(const EmbeddedKernel& kernel, KernelVariant variant);
+
+}  // namespace sffd
