@@ -1,0 +1,1 @@
+// placeholder: the GL driver is being written

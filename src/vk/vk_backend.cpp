@@ -1,0 +1,1 @@
+// placeholder: the Vulkan driver is being written
