@@ -1,0 +1,92 @@
+#include "backend_select.h"
+
+#include <thread>
+
+#include "error.h"
+#include "gl/gl_backend.h"
+#include "vk/vk_backend.h"
+
+namespace sffd {
+
+DeviceInfo cpuDeviceInfo() {
+  DeviceInfo info;
+  info.api = "cpu";
+  info.provider = "cpu";
+  info.name = "CPU reference (double precision)";
+  info.driver = "sffd " + std::to_string(std::thread::hardware_concurrency()) + " hardware threads";
+  info.type = "cpu";
+  info.limits.maxStorageBufferRange = ~uint64_t(0) >> 1;
+  info.limits.float64 = true;
+  return info;
+}
+
+namespace {
+
+OpenedBackend openGl(gl::Provider provider, const std::string& label, const BackendRequest& r) {
+  gl::Options o;
+  o.provider = provider;
+  o.deviceSubstring = r.device;
+  OpenedBackend b;
+  b.gpu = gl::createBackend(o);
+  b.info = b.gpu->info();
+  b.label = label == "gl" ? "gl-" + b.info.provider : label;
+  return b;
+}
+
+OpenedBackend openNamed(const std::string& name, const BackendRequest& r) {
+  if (name == "vulkan") {
+    vk::Options o;
+    o.deviceSubstring = r.device;
+    o.validation = r.validation;
+    OpenedBackend b;
+    b.gpu = vk::createBackend(o);
+    b.info = b.gpu->info();
+    b.label = "vulkan";
+    return b;
+  }
+  if (name == "gl") return openGl(gl::Provider::Auto, name, r);
+  if (name == "gl-egl") return openGl(gl::Provider::EGL, name, r);
+  if (name == "gl-osmesa") return openGl(gl::Provider::OSMesa, name, r);
+  if (name == "gl-glfw") return openGl(gl::Provider::GLFW, name, r);
+  if (name == "cpu") {
+    OpenedBackend b;
+    b.info = cpuDeviceInfo();
+    b.label = "cpu";
+    return b;
+  }
+  throw Error(ErrorKind::Input, "unknown backend '" + name + "' (auto, vulkan, gl, gl-egl, gl-osmesa, gl-glfw, cpu)");
+}
+
+}  // namespace
+
+OpenedBackend openBackend(const BackendRequest& r, std::vector<std::string>* notes) {
+  if (r.name != "auto") return openNamed(r.name, r);
+  for (const char* name : {"vulkan", "gl"}) {
+    try {
+      return openNamed(name, r);
+    } catch (const Error& e) {
+      if (e.kind() != ErrorKind::Device) throw;
+      if (notes) notes->push_back(std::string(name) + " unavailable: " + e.what());
+    }
+  }
+  if (!r.device.empty()) throw deviceError("no Vulkan or GL device matches '" + r.device + "'");
+  return openNamed("cpu", r);
+}
+
+std::vector<std::pair<std::string, DeviceInfo>> listBackends(std::vector<std::string>& problems) {
+  std::vector<std::pair<std::string, DeviceInfo>> out;
+  try {
+    for (DeviceInfo& d : vk::listDevices()) out.emplace_back("vulkan", d);
+  } catch (const Error& e) {
+    problems.push_back(std::string("vulkan: ") + e.what());
+  }
+  try {
+    for (DeviceInfo& d : gl::listDevices()) out.emplace_back("gl-" + d.provider, d);
+  } catch (const Error& e) {
+    problems.push_back(std::string("gl: ") + e.what());
+  }
+  out.emplace_back("cpu", cpuDeviceInfo());
+  return out;
+}
+
+}  // namespace sffd

@@ -1,0 +1,34 @@
+// Opening a compute backend by name (--backend auto|vulkan|gl|cpu, --device SUBSTRING) with the
+// documented fallback order for auto: Vulkan, then GL (EGL, then OSMesa), then the CPU reference.
+#pragma once
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "backend.h"
+
+namespace sffd {
+
+// A named way to run a job. `gpu` is null for the CPU reference.
+struct OpenedBackend {
+  std::string label;            // "vulkan", "gl-egl", "gl-osmesa", "gl-glfw", "cpu"
+  DeviceInfo info;
+  std::unique_ptr<Backend> gpu;
+};
+
+struct BackendRequest {
+  std::string name = "auto";    // auto, vulkan, gl, gl-egl, gl-osmesa, gl-glfw, cpu
+  std::string device;           // device-name substring
+  bool validation = false;      // Vulkan validation layer
+};
+
+DeviceInfo cpuDeviceInfo();
+
+// Opens the backend; throws a device Error (exit 3) when the one asked for is unusable. For "auto",
+// failures are skipped and `notes` receives one line per skipped backend.
+OpenedBackend openBackend(const BackendRequest& request, std::vector<std::string>* notes = nullptr);
+
+// Every backend and device that can be used here; `problems` receives one line per API that failed.
+std::vector<std::pair<std::string, DeviceInfo>> listBackends(std::vector<std::string>& problems);
+
+}  // namespace sffd

@@ -1,0 +1,25 @@
+// The lattice as the kernels read it (shaders/common/bspline.glsl): the parameter block, the frame
+// buffer (affine frame, cof(A), knot breaks) and the per-box Bezier coefficients, kept in double
+// and converted to the kernel's `real` type on upload.
+#pragma once
+#include <vector>
+
+#include "lattice.h"
+#include "shader_layout.h"
+
+namespace sffd {
+
+struct PackedLattice {
+  gpu::LatticeParams params;
+  std::vector<double> frame;    // SFFD_FRAME_* layout
+  std::vector<double> coeffs;   // 4 per coefficient (x, y, z, 0)
+};
+
+PackedLattice packLattice(const Lattice& lattice);
+
+template <class Real>
+std::vector<Real> convertReals(const std::vector<double>& v) {
+  return std::vector<Real>(v.begin(), v.end());
+}
+
+}  // namespace sffd
