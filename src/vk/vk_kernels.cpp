@@ -31,12 +31,14 @@ Kernels::Kernels(Device& device) : device_(device) {
     check(api.vkCreatePipelineLayout(dev, &pi, nullptr, &pipelineLayout_), "vkCreatePipelineLayout");
     check(api.vkCreatePipelineCache(dev, &ci, nullptr, &cache_), "vkCreatePipelineCache");
   } catch (...) {
-    this->~Kernels();
+    destroy();
     throw;
   }
 }
 
-Kernels::~Kernels() {
+Kernels::~Kernels() { destroy(); }
+
+void Kernels::destroy() {
   const Api& api = device_.api();
   VkDevice dev = device_.handle();
   for (auto& [key, pipeline] : pipelines_) api.vkDestroyPipeline(dev, pipeline, nullptr);

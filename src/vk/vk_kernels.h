@@ -27,6 +27,8 @@ class Kernels {
   VkPipeline pipeline(std::string_view kernel, KernelVariant variant);
 
  private:
+  void destroy();
+
   Device& device_;
   VkDescriptorSetLayout setLayout_ = VK_NULL_HANDLE;
   VkPipelineLayout pipelineLayout_ = VK_NULL_HANDLE;
