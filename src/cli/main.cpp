@@ -20,9 +20,10 @@ static void usage(FILE* f) {
 
 int main(int argc, char** argv) {
   try {
-    if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h")) {
-      usage(argc < 2 ? stderr : stdout);
-      return argc < 2 ? 2 : 0;
+    if (argc < 2) throw Error(ErrorKind::Input, "no command given (sffd --help lists them)");
+    if (!std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h")) {
+      usage(stdout);
+      return 0;
     }
     for (const auto& c : commands()) {
       if (c.name != std::string(argv[1])) continue;

@@ -26,7 +26,7 @@ bool forceStaging() {
 }  // namespace
 
 Device::Device(const Instance& instance, const PhysicalDevice& physical)
-    : api_(instance.api()), info_(physical.info), family_(physical.computeFamily) {
+    : api_(instance.api()), info_(physical.info), family_(physical.computeFamily), timestampBits_(physical.timestampBits) {
   api_.vkGetPhysicalDeviceProperties(physical.handle, &props_);
   api_.vkGetPhysicalDeviceMemoryProperties(physical.handle, &memory_);
 

@@ -36,6 +36,7 @@ class Device {
   VkDevice handle() const { return device_; }
   VkQueue queue() const { return queue_; }
   uint32_t queueFamily() const { return family_; }
+  uint32_t timestampBits() const { return timestampBits_; }   // valid bits of the queue's timestamps
   const VkPhysicalDeviceProperties& properties() const { return props_; }
   const DeviceInfo& info() const { return info_; }
 
@@ -54,6 +55,7 @@ class Device {
   VkDevice device_ = VK_NULL_HANDLE;
   VkQueue queue_ = VK_NULL_HANDLE;
   uint32_t family_ = 0;
+  uint32_t timestampBits_ = 0;
 };
 
 }  // namespace sffd::vk

@@ -107,11 +107,10 @@ PhysicalDevice describe(const Api& api, VkPhysicalDevice handle) {
   api.vkGetPhysicalDeviceQueueFamilyProperties(handle, &familyCount, nullptr);
   std::vector<VkQueueFamilyProperties> families(familyCount);
   api.vkGetPhysicalDeviceQueueFamilyProperties(handle, &familyCount, families.data());
-  uint32_t timestampBits = 0;
   for (uint32_t i = 0; i < familyCount; ++i)
     if (families[i].queueFlags & VK_QUEUE_COMPUTE_BIT) {
       pd.computeFamily = i;
-      timestampBits = families[i].timestampValidBits;
+      pd.timestampBits = families[i].timestampValidBits;
       break;
     }
 
@@ -120,7 +119,7 @@ PhysicalDevice describe(const Api& api, VkPhysicalDevice handle) {
   limits.storageOffsetAlignment = props.limits.minStorageBufferOffsetAlignment;
   for (int i = 0; i < 3; ++i) limits.maxWorkGroupCount[i] = props.limits.maxComputeWorkGroupCount[i];
   limits.float64 = features.shaderFloat64;
-  limits.timestamps = props.limits.timestampComputeAndGraphics && props.limits.timestampPeriod > 0 && timestampBits > 0;
+  limits.timestamps = props.limits.timestampComputeAndGraphics && props.limits.timestampPeriod > 0 && pd.timestampBits > 0;
 
   if (props.apiVersion < VK_API_VERSION_1_1)
     pd.unusable = "it supports only Vulkan " + versionString(props.apiVersion) + " (1.1 is required)";

@@ -15,6 +15,7 @@ struct PhysicalDevice {
   VkPhysicalDevice handle = VK_NULL_HANDLE;
   DeviceInfo info;
   uint32_t computeFamily = UINT32_MAX;   // first queue family with compute
+  uint32_t timestampBits = 0;            // its timestampValidBits
   std::string unusable;                  // why sffd cannot run on it; empty when it can
 };
 

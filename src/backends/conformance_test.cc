@@ -1,0 +1,158 @@
+// Conformance: the classic_ffd kernel on every GPU backend (Vulkan, GL through EGL and OSMesa)
+// against the CPU reference, in every variant (docs/CONFORMANCE.md states the tolerances).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <random>
+#include <sstream>
+
+#include "backends/backend_select.h"
+#include "buffer_compare.h"
+#include "classic_ffd.h"
+#include "error.h"
+#include "vk/vk_backend.h"
+
+using namespace sffd;
+
+namespace {
+
+// Backends that must be present: by default every one Debian 12's Mesa gives (SFFD_REQUIRE_BACKENDS overrides).
+std::vector<std::string> requiredBackends() {
+  const char* env = std::getenv("SFFD_REQUIRE_BACKENDS");
+  std::stringstream ss(env ? env : "vulkan,gl-egl,gl-osmesa");
+  std::vector<std::string> names;
+  for (std::string n; std::getline(ss, n, ',');)
+    if (!n.empty()) names.push_back(n);
+  return names;
+}
+
+OpenedBackend open(const std::string& name) {
+  BackendRequest r;
+  r.name = name;
+  r.validation = true;
+  return openBackend(r);
+}
+
+// A closed UV sphere with unit normals, partly outside the lattice box when `radius` > box.
+Mesh sphereMesh(int rings, int segments, double radius) {
+  Mesh m;
+  for (int r = 0; r <= rings; ++r)
+    for (int s = 0; s < segments; ++s) {
+      double th = M_PI * r / rings, ph = 2 * M_PI * s / segments;
+      glm::dvec3 n(std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th));
+      m.positions.push_back(radius * n + glm::dvec3(0.1, -0.05, 0.02));
+      m.normals.push_back(n);
+    }
+  for (int r = 0; r < rings; ++r)
+    for (int s = 0; s < segments; ++s) {
+      uint32_t a = r * segments + s, b = r * segments + (s + 1) % segments;
+      m.triangles.push_back({a, a + segments, b});
+      m.triangles.push_back({b, a + uint32_t(segments), b + uint32_t(segments)});
+    }
+  return m;
+}
+
+Lattice deformedLattice(OutsideMode outside) {
+  Lattice L = makeIdentityLattice({-1, -1, -1}, {1, 1, 1}, {5, 6, 4}, {2, 3, 2});
+  std::mt19937 rng(42);
+  std::uniform_real_distribution<double> u(-0.15, 0.15);
+  for (auto& p : L.controlPoints) p += glm::dvec3(u(rng), u(rng), u(rng));
+  L.outside = outside;
+  return L;
+}
+
+void expectClose(const ClassicOutput& a, const ClassicOutput& b, bool float32, const CompareTolerance& tol,
+                 const std::string& what) {
+  CompareResult p = compareBuffers(a.positions, b.positions, float32, tol);
+  CompareResult n = compareBuffers(a.normals, b.normals, float32, tol);
+  EXPECT_EQ(p.mismatched, 0u) << what << " positions: max_abs " << p.maxAbs << " max_ulp " << p.maxUlp;
+  EXPECT_EQ(n.mismatched, 0u) << what << " normals: max_abs " << n.maxAbs << " max_ulp " << n.maxUlp;
+}
+
+class ClassicConformance : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(ClassicConformance, AgreesWithCpuReferenceInEveryVariant) {
+  OpenedBackend b = open(GetParam());
+  ASSERT_TRUE(b.gpu);
+  Mesh mesh = sphereMesh(40, 64, 1.05);   // the caps stick out of the box: outside rules are exercised
+  for (OutsideMode outside : {OutsideMode::Extrapolate, OutsideMode::Keep}) {
+    PackedLattice P = packLattice(deformedLattice(outside));
+    ClassicOutput cpuDouble = classicFfdCpu(mesh, P, {false, true});
+    ClassicOutput cpuStrictFloat = classicFfdCpu(mesh, P, {true, false});
+
+    // Fast float kernels against the double reference: 64 ulp or 2e-6 of the largest value.
+    expectClose(classicFfdGpu(*b.gpu, mesh, P, {false, false}), cpuDouble, true, {false, 64, 2e-6}, "fast float");
+    // Strict float kernels: bit-identical to the C++ reference's float path.
+    expectClose(classicFfdGpu(*b.gpu, mesh, P, {true, false}), cpuStrictFloat, true, {true, 0, 0}, "strict float");
+    if (b.info.limits.float64) {
+      // Double kernels: within 1e-12 of the largest value; strict: bit-identical to the double reference.
+      expectClose(classicFfdGpu(*b.gpu, mesh, P, {false, true}), cpuDouble, false, {false, 0, 1e-12}, "fast double");
+      expectClose(classicFfdGpu(*b.gpu, mesh, P, {true, true}), cpuDouble, false, {true, 0, 0}, "strict double");
+    }
+  }
+  EXPECT_EQ(vk::validationMessageCount(), 0u);
+}
+
+TEST_P(ClassicConformance, ChunkedJobEqualsOneDispatch) {
+  OpenedBackend b = open(GetParam());
+  Mesh mesh = sphereMesh(30, 50, 0.9);
+  PackedLattice P = packLattice(deformedLattice(OutsideMode::Extrapolate));
+  ClassicOutput whole = classicFfdGpu(*b.gpu, mesh, P, {true, false});
+  setenv("SFFD_MAX_CHUNK_VERTICES", "97", 1);   // many small chunks, last one partial
+  ClassicOutput chunked = classicFfdGpu(*b.gpu, mesh, P, {true, false});
+  unsetenv("SFFD_MAX_CHUNK_VERTICES");
+  EXPECT_EQ(whole.positions, chunked.positions);
+  EXPECT_EQ(whole.normals, chunked.normals);
+}
+
+TEST_P(ClassicConformance, IdentityLatticeLeavesVerticesAndNormals) {
+  OpenedBackend b = open(GetParam());
+  Mesh mesh = sphereMesh(20, 32, 0.95);
+  PackedLattice P = packLattice(makeIdentityLattice({-1, -1, -1}, {1, 1, 1}, {5, 5, 5}, {2, 2, 2}));
+  ClassicOutput out = classicFfdGpu(*b.gpu, mesh, P, {false, false});
+  for (size_t v = 0; v < mesh.positions.size(); ++v) {
+    EXPECT_NEAR(glm::length(glm::dvec3(out.positions[4 * v], out.positions[4 * v + 1], out.positions[4 * v + 2]) - mesh.positions[v]), 0, 1e-6);
+    EXPECT_NEAR(glm::length(glm::dvec3(out.normals[4 * v], out.normals[4 * v + 1], out.normals[4 * v + 2]) - mesh.normals[v]), 0, 1e-6);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, ClassicConformance, ::testing::ValuesIn(requiredBackends()),
+                         [](const auto& info) {
+                           std::string n = info.param;
+                           for (char& c : n) if (c == '-') c = '_';
+                           return n;
+                         });
+
+TEST(CrossApi, GlAndVulkanFastKernelsAgreeWithinUlpBound) {
+  OpenedBackend vkb = open("vulkan"), glb = open("gl");
+  Mesh mesh = sphereMesh(40, 64, 1.0);
+  PackedLattice P = packLattice(deformedLattice(OutsideMode::Extrapolate));
+  expectClose(classicFfdGpu(*vkb.gpu, mesh, P, {false, false}), classicFfdGpu(*glb.gpu, mesh, P, {false, false}), true,
+              {false, 64, 1e-6}, "GL vs Vulkan fast float");
+}
+
+TEST(BackendSelect, UnknownBackendIsAUsageError) {
+  BackendRequest r;
+  r.name = "metal";
+  try {
+    openBackend(r);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Input);
+  }
+}
+
+TEST(BackendSelect, DeviceSubstringThatMatchesNothingIsADeviceError) {
+  BackendRequest r;
+  r.name = "vulkan";
+  r.device = "no-such-gpu-xyz";
+  try {
+    openBackend(r);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Device);
+  }
+}
+
+}  // namespace

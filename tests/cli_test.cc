@@ -1,0 +1,221 @@
+// End-to-end tests of the sffd command line: the PyGeM oracle through every backend, the contract's
+// errors and exit statuses, and outputs that appear whole or not at all.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <sys/wait.h>
+
+#include <nlohmann/json.hpp>
+
+#include "mesh.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+const std::string kData = SFFD_SHARED_DATA;
+const std::string kSffd = SFFD_BINARY;
+
+struct RunResult {
+  int status = -1;
+  std::string out, err;
+};
+
+// Runs sffd with the given arguments (shell-quoted by the caller) and an optional environment prefix.
+RunResult runSffd(const std::string& args, const std::string& env = "") {
+  fs::path dir = fs::temp_directory_path() / ("sffd_cli_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  std::string outFile = (dir / "stdout").string(), errFile = (dir / "stderr").string();
+  std::string cmd = env + " " + kSffd + " " + args + " >" + outFile + " 2>" + errFile;
+  int raw = std::system(cmd.c_str());
+  RunResult r;
+  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : 128;
+  auto slurp = [](const std::string& p) {
+    std::ifstream f(p);
+    std::stringstream ss;
+    ss << f.rdbuf();
+    return ss.str();
+  };
+  r.out = slurp(outFile);
+  r.err = slurp(errFile);
+  return r;
+}
+
+fs::path tempDir(const std::string& name) {
+  fs::path d = fs::temp_directory_path() / ("sffd_test_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+std::vector<glm::dvec3> readPoints(const std::string& path) {
+  std::ifstream f(path);
+  std::vector<glm::dvec3> pts;
+  double x, y, z;
+  while (f >> x >> y >> z) pts.push_back({x, y, z});
+  return pts;
+}
+
+// One line, "sffd: error: ...", on stderr.
+void expectOneErrorLine(const RunResult& r) {
+  EXPECT_EQ(r.err.rfind("sffd: error: ", 0), 0u) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+}
+
+class PygemOracle : public ::testing::TestWithParam<std::string> {};
+
+// PyGeM's test_ffd_sphere_mod: every facet corner of test_sphere.stl, deformed, equals PyGeM's
+// expected_points.txt within PyGeM's 1.5e-6 (1e-10 for the CPU reference), outside points unmoved.
+TEST_P(PygemOracle, SphereMatchesExpectedPoints) {
+  fs::path dir = tempDir("pygem_" + GetParam());
+  std::string out = (dir / "sphere.obj").string();
+  std::string base = kData + "/pygem/sphere_ffd/";
+  RunResult r = runSffd("deform " + base + "test_sphere.stl -l " + base + "parameters_test_ffd_sphere.prm --method classic --backend " +
+                        GetParam() + " -o " + out + " --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  sffd::Mesh in = sffd::readMesh(base + "test_sphere.stl");
+  sffd::Mesh res = sffd::readMesh(out);
+  ASSERT_EQ(in.positions.size(), res.positions.size());
+  std::vector<glm::dvec3> input = readPoints(base + "input_points.txt"), expected = readPoints(base + "expected_points.txt");
+  ASSERT_EQ(input.size(), 7200u);
+  double tol = GetParam() == "cpu" ? 1e-10 : 1.5e-6;
+  double worst = 0;
+  size_t moved = 0, unmoved = 0;
+  for (size_t i = 0; i < input.size(); ++i) {
+    // Find the vertex of the (welded) mesh at this facet corner.
+    size_t v = 0;
+    double best = 1e30;
+    for (size_t k = 0; k < in.positions.size(); ++k) {
+      double d = glm::length(in.positions[k] - input[i]);
+      if (d < best) best = d, v = k;
+    }
+    ASSERT_LT(best, 1e-9) << "facet corner " << i << " not found in the mesh as read";
+    for (int a = 0; a < 3; ++a) worst = std::max(worst, std::abs(res.positions[v][a] - expected[i][a]));
+    if (glm::length(expected[i] - input[i]) > 1e-9) ++moved;
+    else {
+      ++unmoved;
+      EXPECT_EQ(res.positions[v], in.positions[v]) << "an outside point moved";
+    }
+  }
+  EXPECT_LT(worst, tol);
+  EXPECT_EQ(moved, 3932u);
+  EXPECT_EQ(unmoved, 3268u);
+  RecordProperty("max_abs_error", std::to_string(worst));
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, PygemOracle, ::testing::Values("cpu", "vulkan", "gl-egl", "gl-osmesa"),
+                         [](const auto& info) {
+                           std::string n = info.param;
+                           for (char& c : n) if (c == '-') c = '_';
+                           return n;
+                         });
+
+TEST(Cli, IdentityPrmLeavesTheSphere) {
+  fs::path dir = tempDir("identity");
+  std::string out = (dir / "id.obj").string();
+  RunResult r = runSffd("deform " + kData + "/pygem/sphere_ffd/input_welded.obj -l " + kData +
+                        "/pygem/identity/parameters_test_ffd_identity.prm --method classic -o " + out + " --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  sffd::Mesh in = sffd::readMesh(kData + "/pygem/sphere_ffd/input_welded.obj"), res = sffd::readMesh(out);
+  ASSERT_EQ(in.positions.size(), res.positions.size());
+  for (size_t v = 0; v < in.positions.size(); ++v) EXPECT_NEAR(glm::length(in.positions[v] - res.positions[v]), 0, 1e-9);
+}
+
+TEST(Cli, LatticeThenDeformWritesStats) {
+  fs::path dir = tempDir("lattice");
+  std::string lat = (dir / "twist.json").string(), out = (dir / "t.ply").string(), stats = (dir / "s.json").string();
+  RunResult r = runSffd("lattice " + kData + "/acaffd/sphere.obj -o " + lat + " --preset twist:0.5 --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  r = runSffd("deform " + kData + "/acaffd/sphere.obj -l " + lat + " --method classic -o " + out + " --stats " + stats + " --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::ifstream sf(stats);
+  nlohmann::json j = nlohmann::json::parse(sf);
+  EXPECT_EQ(j["method"], "classic");
+  EXPECT_EQ(j["input"]["triangles"], j["output"]["triangles"]);
+  EXPECT_TRUE(j["timings_ms"].contains("deform"));
+  EXPECT_TRUE(j.contains("backend") && j.contains("device"));
+}
+
+TEST(Cli, DevicesListsLavapipeAndLlvmpipe) {
+  RunResult r = runSffd("devices");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("vulkan"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("gl-egl"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("llvmpipe"), std::string::npos) << r.out;
+}
+
+TEST(Cli, MissingVulkanLoaderIsADeviceError) {
+  RunResult r = runSffd("deform " + kData + "/acaffd/cube.obj -l " + kData + "/acaffd/lattices/cube_control_points0.npy --method classic --backend vulkan -o /tmp/never.obj",
+                        "SFFD_VULKAN_LIBRARY=libvulkan-missing.so.9");
+  EXPECT_EQ(r.status, 3);
+  expectOneErrorLine(r);
+  EXPECT_FALSE(fs::exists("/tmp/never.obj"));
+}
+
+TEST(Cli, MissingIcdIsADeviceErrorAndAutoFallsBack) {
+  std::string args = "deform " + kData + "/acaffd/cube.obj -l " + kData + "/acaffd/lattices/cube_control_points0.npy --method classic ";
+  fs::path dir = tempDir("fallback");
+  RunResult r = runSffd(args + "--backend vulkan -o " + (dir / "a.obj").string(), "VK_DRIVER_FILES=/nonexistent.json VK_ICD_FILENAMES=/nonexistent.json");
+  EXPECT_EQ(r.status, 3);
+  expectOneErrorLine(r);
+  r = runSffd(args + "--backend auto -o " + (dir / "b.obj").string(), "VK_DRIVER_FILES=/nonexistent.json VK_ICD_FILENAMES=/nonexistent.json");
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir / "b.obj"));
+}
+
+TEST(Cli, ErrorsHaveOneLineAndTheContractStatus) {
+  fs::path dir = tempDir("errors");
+  std::string out = (dir / "o.obj").string();
+  std::string cube = kData + "/acaffd/cube.obj", lat = kData + "/acaffd/lattices/cube_control_points0.npy";
+  struct Case { std::string args; int status; };
+  std::vector<Case> cases = {
+      {"", 2},
+      {"frobnicate", 2},
+      {"deform " + cube + " -o " + out, 2},                                        // no lattice
+      {"deform " + cube + " -l " + lat + " --method classic", 2},                  // no output
+      {"deform " + cube + " -l " + lat + " --method nope -o " + out, 2},
+      {"deform " + cube + " -l " + lat + " --method classic --bogus -o " + out, 2},
+      {"deform /nonexistent.obj -l " + lat + " --method classic -o " + out, 2},
+      {"deform " + cube + " -l /nonexistent.json --method classic -o " + out, 2},
+      {"deform " + cube + " -l " + lat + " --method classic -o " + cube, 2},      // output = input
+      {"deform " + cube + " -l " + lat + " --method classic --backend metal -o " + out, 2},
+      {"deform " + cube + " -l " + lat + " --method classic --device no-such-gpu --backend vulkan -o " + out, 3},
+      {"deform " + cube + " -l " + lat + " --method classic -o /nonexistent-dir/o.obj", 2},
+      {"lattice " + cube + " -o " + (dir / "l.json").string() + " --degree 6,2,2", 2},
+      {"lattice " + cube + " -o " + (dir / "l.json").string() + " --preset wobble", 2},
+  };
+  for (const Case& c : cases) {
+    RunResult r = runSffd(c.args);
+    EXPECT_EQ(r.status, c.status) << c.args << "\n" << r.err;
+    expectOneErrorLine(r);
+  }
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_FALSE(fs::exists(dir / "l.json"));
+  for (const auto& e : fs::directory_iterator(dir)) ADD_FAILURE() << "left behind: " << e.path();
+}
+
+TEST(Cli, HelpForEveryCommand) {
+  for (const char* c : {"deform", "lattice", "devices", "conform"}) {
+    RunResult r = runSffd(std::string(c) + " --help");
+    EXPECT_EQ(r.status, 0) << c;
+    EXPECT_NE(r.out.find("usage: sffd"), std::string::npos) << c;
+  }
+}
+
+TEST(Cli, ConformPassesAndStrictIsBitIdentical) {
+  std::string base = "conform " + kData + "/acaffd/sphere.obj -l " + kData + "/acaffd/lattices/sphere_control_points0.npy --method classic";
+  RunResult r = runSffd(base);
+  EXPECT_EQ(r.status, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("conform: PASS"), std::string::npos) << r.out;
+  r = runSffd(base + " --strict");
+  EXPECT_EQ(r.status, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("max_abs=0 max_ulp=0 mismatched=0/"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("max_ulp=1"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("conform: PASS"), std::string::npos) << r.out;
+}
+
+}  // namespace
