@@ -34,20 +34,21 @@ void latticeBernstein(uint n, real s, out real b[SFFD_MAX_DEGREE + 1], out real 
     if (k == n) {
       // derivative of degree n from the degree n-1 basis: n * (B[p-1] - B[p])
       for (uint p = 0u; p <= n; ++p) {
-        P real lower = p > 0u ? b[p - 1u] : real(0);
-        P real upper = p < n ? b[p] : real(0);
+        // Indices clamped so that no lane reads outside the array, even where a select evaluates both sides.
+        P real lower = p > 0u ? b[p > 0u ? p - 1u : 0u] : real(0);
+        P real upper = p < n ? b[min(p, uint(SFFD_MAX_DEGREE))] : real(0);
         P real d = real(n) * (lower - upper);
         db[p] = d;
       }
     }
-    P real top = s * b[k - 1u];
-    b[k] = top;
-    for (uint j = k - 1u; j >= 1u; --j) {
-      P real v = t * b[j] + s * b[j - 1u];
+    // Raise the degree in place: b[j] <- t*b[j] + s*b[j-1] (b[k] was 0, b[-1] is taken as 0).
+    P real prev = real(0);
+    for (uint j = 0u; j <= k; ++j) {
+      P real cur = b[j];
+      P real v = t * cur + s * prev;
       b[j] = v;
+      prev = cur;
     }
-    P real first = t * b[0];
-    b[0] = first;
   }
 }
 

@@ -1,4 +1,5 @@
 // sffd lattice MESH -o LATTICE.json: an identity lattice fitted to a mesh, optionally deformed by a preset.
+#include <algorithm>
 #include <charconv>
 
 #include "cli.h"

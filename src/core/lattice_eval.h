@@ -64,9 +64,13 @@ class LatticeEvaluator {
           Real upper = p < n ? b[p] : Real(0);
           db[p] = Real(n) * (lower - upper);
         }
-      b[k] = s * b[k - 1];
-      for (uint32_t j = k - 1; j >= 1; --j) b[j] = t * b[j] + s * b[j - 1];
-      b[0] = t * b[0];
+      // Raise the degree in place: b[j] <- t*b[j] + s*b[j-1] (b[k] was 0, b[-1] is taken as 0).
+      Real prev = Real(0);
+      for (uint32_t j = 0; j <= k; ++j) {
+        Real cur = b[j];
+        b[j] = t * cur + s * prev;
+        prev = cur;
+      }
     }
   }
 

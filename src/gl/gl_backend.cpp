@@ -103,7 +103,7 @@ class GlBackend final : public Backend {
     }
     L.float64 = true;   // GL 4.0+ core has doubles (ARB_gpu_shader_fp64)
     GLint bits = 0;
-    glGetQueryiv(GL_TIME_ELAPSED, GL_QUERY_COUNTER_BITS, &bits);
+    glGetQueryiv(GL_TIMESTAMP, GL_QUERY_COUNTER_BITS, &bits);
     L.timestamps = bits > 0;
 
     GLint uboAlign = 0, maxBlock = 0;
@@ -125,7 +125,10 @@ class GlBackend final : public Backend {
       for (auto& [key, p] : programs_) glDeleteProgram(p.name);
       for (auto& [id, b] : buffers_) glDeleteBuffers(1, &b.name);
       for (const Pending& p : pending_)
-        if (p.query) glDeleteQueries(1, &p.query);
+        if (p.begin) {
+          glDeleteQueries(1, &p.begin);
+          glDeleteQueries(1, &p.end);
+        }
       if (!freeQueries_.empty()) glDeleteQueries(static_cast<GLsizei>(freeQueries_.size()), freeQueries_.data());
       glDeleteBuffers(1, &ubo_);
       glFinish();
@@ -256,13 +259,17 @@ class GlBackend final : public Backend {
     }
 
     glUseProgram(prog.name);
-    Pending rec{std::string(d.label.empty() ? d.kernel : d.label), 0};
+    Pending rec{std::string(d.label.empty() ? d.kernel : d.label), 0, 0};
+    // A pair of GL_TIMESTAMP counters, not a GL_TIME_ELAPSED query: llvmpipe's elapsed time covers only
+    // rasterizer scenes and gives 0 or garbage for compute, while its timestamps bracket the dispatch,
+    // which llvmpipe runs to completion before returning.
     if (L.timestamps) {
-      rec.query = takeQuery();
-      glBeginQuery(GL_TIME_ELAPSED, rec.query);
+      rec.begin = takeQuery();
+      rec.end = takeQuery();
+      glQueryCounter(rec.begin, GL_TIMESTAMP);
     }
     glDispatchCompute(d.groups[0], d.groups[1], d.groups[2]);
-    if (rec.query) glEndQuery(GL_TIME_ELAPSED);
+    if (rec.end) glQueryCounter(rec.end, GL_TIMESTAMP);
     pending_.push_back(std::move(rec));
     dirty_ = true;
     checkGl(("dispatch of " + what).c_str());
@@ -288,11 +295,13 @@ class GlBackend final : public Backend {
     for (Pending& p : pending_) {
       DispatchTiming t;
       t.label = std::move(p.label);
-      if (p.query) {
-        GLuint64 ns = 0;
-        glGetQueryObjectui64v(p.query, GL_QUERY_RESULT, &ns);   // waits for the result
-        t.gpuMs = static_cast<double>(ns) * 1e-6;
-        freeQueries_.push_back(p.query);
+      if (p.begin) {
+        GLuint64 t0 = 0, t1 = 0;
+        glGetQueryObjectui64v(p.begin, GL_QUERY_RESULT, &t0);   // waits for the result
+        glGetQueryObjectui64v(p.end, GL_QUERY_RESULT, &t1);
+        t.gpuMs = t1 >= t0 ? static_cast<double>(t1 - t0) * 1e-6 : 0.0;
+        freeQueries_.push_back(p.begin);
+        freeQueries_.push_back(p.end);
       }
       out.push_back(std::move(t));
     }
@@ -308,7 +317,7 @@ class GlBackend final : public Backend {
   };
   struct Pending {
     std::string label;
-    GLuint query = 0;
+    GLuint begin = 0, end = 0;   // GL_TIMESTAMP queries around the dispatch (0: no timing)
   };
   static constexpr uint64_t kRingBytes = 64 * 1024;
   // Everything later work may consume: storage and uniform reads, buffer transfers, indirect commands,

@@ -2,6 +2,7 @@
 // Mesa's llvmpipe. No X display is needed except for the GLFW test, which is skipped without one.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -93,6 +94,7 @@ template <class Real>
 struct ClassicRun {
   std::vector<Real> pos, nrm;
   std::vector<DispatchTiming> timings;
+  double wallMs = 0;   // from the dispatch to the end of the downloads
   uint32_t groups[3] = {1, 1, 1};
 };
 
@@ -125,6 +127,7 @@ ClassicRun<Real> runClassic(Backend& b, KernelVariant v, const HandLattice<Real>
   ClassicRun<Real> r;
   gridFor(n, b.info().limits, d.groups);
   std::memcpy(r.groups, d.groups, sizeof r.groups);
+  auto t0 = std::chrono::steady_clock::now();
   b.dispatch(d);
   b.barrier();
   r.pos.resize(pos.size());
@@ -132,6 +135,7 @@ ClassicRun<Real> runClassic(Backend& b, KernelVariant v, const HandLattice<Real>
   b.download(io[2], 0, r.pos.data(), bytes);
   b.download(io[3], 0, r.nrm.data(), bytes);
   b.finish();
+  r.wallMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   r.timings = b.takeTimings();
   for (BufferId id : io) b.destroyBuffer(id);
   b.destroyBuffer(frame);
@@ -325,6 +329,13 @@ TEST_P(GlProviderTest, DispatchBeyond65535GroupsViaGridFor) {
   ClassicRun<float> r = runClassic(*b, {false, false}, L, pos, nrm);
   EXPECT_EQ(r.groups[0], 65535u);
   EXPECT_EQ(r.groups[1], 2u);
+  ASSERT_EQ(r.timings.size(), 1u);
+  std::printf("%s: %zu vertices, 65535 x 2 groups: %.1f ms by timestamps, %.1f ms wall with downloads\n",
+              b->info().provider.c_str(), n, r.timings[0].gpuMs, r.wallMs);
+  if (b->info().limits.timestamps) {
+    EXPECT_GT(r.timings[0].gpuMs, 0.0);
+    EXPECT_LE(r.timings[0].gpuMs, r.wallMs);
+  }
   size_t bad = 0;
   for (size_t i = 0; i < n; ++i) {
     bool ok = std::abs(r.pos[4 * i] - pos[4 * i]) <= 1e-6f && std::abs(r.pos[4 * i + 1] - pos[4 * i + 1]) <= 1e-6f &&

@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cctype>
 #include <cstring>
+#include <iterator>
+#include <utility>
 
 #include "error.h"
 #include "shader_layout.h"
@@ -118,15 +120,19 @@ class VulkanBackend final : public Backend {
       return;
     }
     if (bytes == 0) return finish();
+    // Staged: copy into host-visible memory behind all recorded work, submit, read it.
     Allocation staging = device_.allocate(bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUse::Download);
-    recorder_.releaseAfterSubmit(staging);   // freed by finish(), after the copy below is read
-    recorder_.memoryBarrier(kWorkStages, kWorkWrites, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
-    VkBufferCopy region{offset, 0, bytes};
-    device_.api().vkCmdCopyBuffer(recorder_.commands(), b.memory.buffer, staging.buffer, 1, &region);
-    // Keep the staging memory alive across the submit: read it before recycle() frees it.
-    const Api& api = device_.api();
-    (void)api;
-    finishInto(data, staging, bytes);
+    try {
+      recorder_.memoryBarrier(kWorkStages, kWorkWrites, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
+      VkBufferCopy region{offset, 0, bytes};
+      device_.api().vkCmdCopyBuffer(recorder_.commands(), b.memory.buffer, staging.buffer, 1, &region);
+      finish();
+      std::memcpy(data, staging.mapped, bytes);
+    } catch (...) {
+      device_.release(staging);
+      throw;
+    }
+    device_.release(staging);
   }
 
   void dispatch(const Dispatch& d) override {
@@ -142,7 +148,7 @@ class VulkanBackend final : public Backend {
     uint32_t count = 0;
     auto write = [&](uint32_t binding, VkDescriptorType type, VkBuffer buffer, VkDeviceSize offset, VkDeviceSize range) {
       infos[count] = {buffer, offset, range};
-      writes[count] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+      writes[count] = vkStruct<VkWriteDescriptorSet>(VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET);
       writes[count].dstBinding = binding;
       writes[count].descriptorCount = 1;
       writes[count].descriptorType = type;
@@ -226,17 +232,6 @@ class VulkanBackend final : public Backend {
     if (range > limits.maxStorageBufferRange)
       throw Error(ErrorKind::Internal, where + std::to_string(range) + " bytes exceed the device's storage binding limit");
     return range;
-  }
-
-  // Submits (the recorded copy into `staging` included) and reads the staging memory back before
-  // the recorder frees it.
-  void finishInto(void* data, const Allocation& staging, uint64_t bytes) {
-    // The staging allocation is in the recorder's release list; copy out of it by keeping a local
-    // mapping pointer, valid until recycle() runs inside submitAndWait(). To read it after the
-    // wait but before the release, take it off the list here and release it ourselves.
-    (void)data;
-    (void)staging;
-    (void)bytes;
   }
 
   Instance instance_;

@@ -41,7 +41,7 @@ Device::Device(const Instance& instance, const PhysicalDevice& physical)
   unified_ = unified_ && anyDeviceLocal;
 
   float priority = 1.0f;
-  VkDeviceQueueCreateInfo queueInfo{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
+  auto queueInfo = vkStruct<VkDeviceQueueCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO);
   queueInfo.queueFamilyIndex = family_;
   queueInfo.queueCount = 1;
   queueInfo.pQueuePriorities = &priority;
@@ -54,7 +54,7 @@ Device::Device(const Instance& instance, const PhysicalDevice& physical)
   if (hasDeviceExtension(api_, physical.handle, "VK_KHR_portability_subset"))
     extensions.push_back("VK_KHR_portability_subset");
 
-  VkDeviceCreateInfo ci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
+  auto ci = vkStruct<VkDeviceCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO);
   ci.queueCreateInfoCount = 1;
   ci.pQueueCreateInfos = &queueInfo;
   ci.pEnabledFeatures = &features;
@@ -80,8 +80,11 @@ uint32_t Device::memoryType(uint32_t allowedTypes, MemoryUse use) const {
   switch (use) {
     case MemoryUse::Storage:
       required = 0;
-      preferred = unified_ ? VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT | kMappable : VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
-      avoided = unified_ ? 0 : VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT;   // keep the small BAR window free
+      preferred = VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
+      if (unified_)
+        preferred |= kMappable;   // mapped directly: no staging copies
+      else
+        avoided = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT;   // plain VRAM; keeps the small BAR window free
       break;
     case MemoryUse::Upload:
       avoided = VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
@@ -108,7 +111,7 @@ uint32_t Device::memoryType(uint32_t allowedTypes, MemoryUse use) const {
 Allocation Device::allocate(uint64_t bytes, VkBufferUsageFlags usage, MemoryUse use) {
   Allocation a;
   a.size = bytes;
-  VkBufferCreateInfo bi{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+  auto bi = vkStruct<VkBufferCreateInfo>(VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO);
   bi.size = bytes > 0 ? bytes : 4;   // Vulkan forbids empty buffers
   bi.usage = usage;
   bi.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
@@ -117,7 +120,7 @@ Allocation Device::allocate(uint64_t bytes, VkBufferUsageFlags usage, MemoryUse 
     VkMemoryRequirements req;
     api_.vkGetBufferMemoryRequirements(device_, a.buffer, &req);
     uint32_t type = memoryType(req.memoryTypeBits, use);
-    VkMemoryAllocateInfo ai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+    auto ai = vkStruct<VkMemoryAllocateInfo>(VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO);
     ai.allocationSize = req.size;
     ai.memoryTypeIndex = type;
     VkResult r = api_.vkAllocateMemory(device_, &ai, nullptr, &a.memory);

@@ -33,7 +33,7 @@ VKAPI_ATTR VkBool32 VKAPI_CALL onDebugMessage(VkDebugUtilsMessageSeverityFlagBit
 }
 
 VkDebugUtilsMessengerCreateInfoEXT messengerInfo() {
-  VkDebugUtilsMessengerCreateInfoEXT info{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
+  auto info = vkStruct<VkDebugUtilsMessengerCreateInfoEXT>(VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT);
   info.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
   info.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
                      VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
@@ -96,8 +96,8 @@ PhysicalDevice describe(const Api& api, VkPhysicalDevice handle) {
   info.driver = "Vulkan " + versionString(props.apiVersion) + ", driver version " + std::to_string(props.driverVersion);
   // Driver name and info are core in 1.2 and VK_KHR_driver_properties before.
   if (props.apiVersion >= VK_API_VERSION_1_2 || hasDeviceExtension(api, handle, "VK_KHR_driver_properties")) {
-    VkPhysicalDeviceDriverProperties driver{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES};
-    VkPhysicalDeviceProperties2 props2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
+    auto driver = vkStruct<VkPhysicalDeviceDriverProperties>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES);
+    auto props2 = vkStruct<VkPhysicalDeviceProperties2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2);
     props2.pNext = &driver;
     api.vkGetPhysicalDeviceProperties2(handle, &props2);
     info.driver = std::string(driver.driverName) + " " + driver.driverInfo + ", Vulkan " + versionString(props.apiVersion);
@@ -175,13 +175,13 @@ Instance::Instance(bool validation) : api_(Api::load()) {
     flags |= VK_INSTANCE_CREATE_ENUMERATE_PORTABILITY_BIT_KHR;
   }
 
-  VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
+  auto app = vkStruct<VkApplicationInfo>(VK_STRUCTURE_TYPE_APPLICATION_INFO);
   app.pApplicationName = "sffd";
   app.pEngineName = "sffd";
   // 1.2 when the loader has it, so that 1.2 physical-device queries (driver properties) are allowed.
   app.apiVersion = loaderVersion >= VK_API_VERSION_1_2 ? VK_API_VERSION_1_2 : VK_API_VERSION_1_1;
 
-  VkInstanceCreateInfo ci{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
+  auto ci = vkStruct<VkInstanceCreateInfo>(VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO);
   ci.flags = flags;
   ci.pApplicationInfo = &app;
   ci.enabledLayerCount = uint32_t(layers.size());

@@ -102,6 +102,14 @@ struct Api {
   void loadDevice(VkDevice device);
 };
 
+// A zero-initialised Vulkan struct with its sType set.
+template <typename T>
+T vkStruct(VkStructureType type) {
+  T value{};
+  value.sType = type;
+  return value;
+}
+
 // "VK_ERROR_OUT_OF_DEVICE_MEMORY" etc.
 const char* resultName(VkResult result);
 // Throws a device Error "Vulkan: <what> failed (<result>)" for any negative result.

@@ -22,16 +22,16 @@ Recorder::Recorder(Device& device, VkDescriptorSetLayout setLayout) : device_(de
   timestamps_ = device_.info().limits.timestamps;
   timestampMask_ = device_.timestampBits() >= 64 ? ~0ull : (1ull << device_.timestampBits()) - 1;
   try {
-    VkCommandPoolCreateInfo pi{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+    auto pi = vkStruct<VkCommandPoolCreateInfo>(VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO);
     pi.flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT;
     pi.queueFamilyIndex = device_.queueFamily();
     check(api.vkCreateCommandPool(dev, &pi, nullptr, &commandPool_), "vkCreateCommandPool");
-    VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+    auto ai = vkStruct<VkCommandBufferAllocateInfo>(VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO);
     ai.commandPool = commandPool_;
     ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
     ai.commandBufferCount = 1;
     check(api.vkAllocateCommandBuffers(dev, &ai, &commands_), "vkAllocateCommandBuffers");
-    VkFenceCreateInfo fi{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+    auto fi = vkStruct<VkFenceCreateInfo>(VK_STRUCTURE_TYPE_FENCE_CREATE_INFO);
     check(api.vkCreateFence(dev, &fi, nullptr, &fence_), "vkCreateFence");
   } catch (...) {
     destroy();
@@ -60,7 +60,7 @@ void Recorder::destroy() {
 
 VkCommandBuffer Recorder::commands() {
   if (!active_) {
-    VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+    auto bi = vkStruct<VkCommandBufferBeginInfo>(VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO);
     bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
     check(device_.api().vkBeginCommandBuffer(commands_, &bi), "vkBeginCommandBuffer");
     active_ = true;
@@ -70,7 +70,7 @@ VkCommandBuffer Recorder::commands() {
 
 void Recorder::memoryBarrier(VkPipelineStageFlags srcStages, VkAccessFlags srcAccess, VkPipelineStageFlags dstStages,
                              VkAccessFlags dstAccess) {
-  VkMemoryBarrier b{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+  auto b = vkStruct<VkMemoryBarrier>(VK_STRUCTURE_TYPE_MEMORY_BARRIER);
   b.srcAccessMask = srcAccess;
   b.dstAccessMask = dstAccess;
   device_.api().vkCmdPipelineBarrier(commands(), srcStages, dstStages, 0, 1, &b, 0, nullptr, 0, nullptr);
@@ -85,7 +85,7 @@ VkDescriptorSet Recorder::descriptorSet() {
   if (pool == descriptorPools_.size()) {
     VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, kSetsPerPool},
                                      {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kSetsPerPool * SFFD_MAX_STORAGE_BINDINGS}};
-    VkDescriptorPoolCreateInfo pi{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+    auto pi = vkStruct<VkDescriptorPoolCreateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO);
     pi.maxSets = kSetsPerPool;
     pi.poolSizeCount = 2;
     pi.pPoolSizes = sizes;
@@ -93,7 +93,7 @@ VkDescriptorSet Recorder::descriptorSet() {
     check(api.vkCreateDescriptorPool(dev, &pi, nullptr, &p), "vkCreateDescriptorPool");
     descriptorPools_.push_back(p);
   }
-  VkDescriptorSetAllocateInfo ai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+  auto ai = vkStruct<VkDescriptorSetAllocateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO);
   ai.descriptorPool = descriptorPools_[pool];
   ai.descriptorSetCount = 1;
   ai.pSetLayouts = &setLayout_;
@@ -133,7 +133,7 @@ void Recorder::beginDispatch(std::string label) {
     uint32_t query = uint32_t(labels_.size()) * 2;
     uint32_t pool = query / kQueriesPerPool;
     if (pool == queryPools_.size()) {
-      VkQueryPoolCreateInfo qi{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+      auto qi = vkStruct<VkQueryPoolCreateInfo>(VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO);
       qi.queryType = VK_QUERY_TYPE_TIMESTAMP;
       qi.queryCount = kQueriesPerPool;
       VkQueryPool q = VK_NULL_HANDLE;
@@ -167,7 +167,7 @@ std::vector<DispatchTiming> Recorder::submitAndWait() {
                 VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT,
                 VK_ACCESS_HOST_READ_BIT);
   check(api.vkEndCommandBuffer(commands_), "vkEndCommandBuffer");
-  VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+  auto si = vkStruct<VkSubmitInfo>(VK_STRUCTURE_TYPE_SUBMIT_INFO);
   si.commandBufferCount = 1;
   si.pCommandBuffers = &commands_;
   check(api.vkQueueSubmit(device_.queue(), 1, &si, fence_), "vkQueueSubmit");
