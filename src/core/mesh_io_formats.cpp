@@ -307,7 +307,6 @@ Mesh readPly(const std::string& path, const std::string& text) {
       const bool isV = &e == vertexEl, isF = &e == faceEl;
       for (uint64_t item = 0; item < e.count; ++item) {
         values.assign(e.props.size(), 0.0);
-        size_t itemLine = tz.line();
         for (size_t pi = 0; pi < e.props.size(); ++pi) {
           const auto& p = e.props[pi];
           if (!p.list) {
@@ -317,7 +316,6 @@ Mesh readPly(const std::string& path, const std::string& text) {
             continue;
           }
           double cnt = number(p.countType, e.name.c_str(), item);
-          itemLine = tl;
           if (cnt < 0 || cnt > double(text.size())) throw inputError(path, tl, "bad list length " + io::quoted(t));
           const bool ours = isF && int(pi) == pidx;
           if (ours) {
@@ -338,7 +336,6 @@ Mesh readPly(const std::string& path, const std::string& text) {
           mesh.positions.push_back({values[size_t(px)], values[size_t(py)], values[size_t(pz)]});
           if (hasNormals) mesh.normals.push_back({values[size_t(pnx)], values[size_t(pny)], values[size_t(pnz)]});
         } else if (isF) {
-          (void)itemLine;
           fanTriangulate(poly.data(), poly.size(), mesh.triangles);
         }
       }

@@ -1,9 +1,11 @@
 // Tests of the OpenGL compute driver and its context providers (EGL surfaceless, OSMesa, GLFW) on
 // Mesa's llvmpipe. No X display is needed except for the GLFW test, which is skipped without one.
+#include <dlfcn.h>
 #include <gtest/gtest.h>
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <random>
@@ -400,8 +402,13 @@ void expectBitIdenticalAcrossProviders(KernelVariant v) {
   double moved = 0;
   for (size_t i = 0; i < pos.size(); ++i) moved = std::max(moved, std::abs(double(egl.pos[i]) - double(pos[i])));
   EXPECT_GT(moved, 0.01);
-  EXPECT_EQ(std::memcmp(egl.pos.data(), osmesa.pos.data(), pos.size() * sizeof(Real)), 0);
-  EXPECT_EQ(std::memcmp(egl.nrm.data(), osmesa.nrm.data(), nrm.size() * sizeof(Real)), 0);
+  bool same = std::memcmp(egl.pos.data(), osmesa.pos.data(), pos.size() * sizeof(Real)) == 0 &&
+              std::memcmp(egl.nrm.data(), osmesa.nrm.data(), nrm.size() * sizeof(Real)) == 0;
+  std::printf("%s-%s: EGL and OSMesa outputs %s\n", v.strict ? "strict" : "fast", v.f64 ? "f64" : "f32",
+              same ? "bit-identical" : "differ");
+  if (v.strict) {
+    EXPECT_TRUE(same);   // fast variants: measured and printed only
+  }
 }
 
 TEST(GlCrossProvider, StrictOutputsBitIdenticalEglVsOSMesa) {
@@ -409,6 +416,8 @@ TEST(GlCrossProvider, StrictOutputsBitIdenticalEglVsOSMesa) {
   SKIP_WITHOUT(Provider::OSMesa);
   expectBitIdenticalAcrossProviders<float>({true, false});
   expectBitIdenticalAcrossProviders<double>({true, true});
+  expectBitIdenticalAcrossProviders<float>({false, false});
+  expectBitIdenticalAcrossProviders<double>({false, true});
 }
 
 TEST(GlCrossProvider, EglThenOSMesaThenEglInOneProcess) {
@@ -439,6 +448,29 @@ TEST(GlCrossProvider, TwoLiveBackendsInterleaved) {
   EXPECT_EQ(back, y);
   egl.reset();
   expectIdentity<float>(*osmesa, {false, false}, 1e-6);
+}
+
+TEST(GlCrossProvider, TwoEglBackendsAndAnOutsideContextSwitch) {
+  // Two contexts of one provider share its EGL display; a context switch made behind sffd's back
+  // (as a viewer's own code might) is noticed and undone.
+  SKIP_WITHOUT(Provider::EGL);
+  auto a = open(Provider::EGL);
+  auto b = open(Provider::EGL);
+  expectIdentity<float>(*a, {true, false}, 1e-6);
+  expectIdentity<float>(*b, {true, false}, 1e-6);
+  void* egl = dlopen("libEGL.so.1", RTLD_NOW | RTLD_LOCAL);
+  ASSERT_NE(egl, nullptr);
+  using GetDisplay = void* (*)();
+  using MakeCurrent = unsigned (*)(void*, void*, void*, void*);
+  auto getDisplay = reinterpret_cast<GetDisplay>(dlsym(egl, "eglGetCurrentDisplay"));
+  auto makeCurrent = reinterpret_cast<MakeCurrent>(dlsym(egl, "eglMakeCurrent"));
+  ASSERT_TRUE(getDisplay && makeCurrent);
+  void* dpy = getDisplay();
+  ASSERT_NE(dpy, nullptr);
+  ASSERT_TRUE(makeCurrent(dpy, nullptr, nullptr, nullptr));   // nothing current any more
+  expectIdentity<float>(*b, {false, false}, 1e-6);
+  a.reset();   // the display stays initialised for b
+  expectIdentity<double>(*b, {true, true}, 1e-14);
 }
 
 TEST(GlSelection, ListDevicesGivesEachHeadlessProvider) {

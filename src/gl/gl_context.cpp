@@ -62,7 +62,7 @@ Context::~Context() {
 bool Context::isCurrent() const { return tCurrent == this; }
 
 void Context::activate() {
-  if (tCurrent == this) return;
+  if (tCurrent == this && providerCurrent()) return;
   if (tCurrent) {
     tCurrent->release();
     tCurrent = nullptr;

@@ -45,6 +45,7 @@ class Context {
   // there, and (re)loads glad's GL entry points through this provider; nothing to do when it already is.
   // Several contexts, even of different providers, may live in one process: every user of a context
   // calls activate() before its GL calls. Throws a device Error when the context cannot be made current.
+  // Code outside sffd that switches contexts by itself should call deactivateCurrent() first.
   void activate();
   // Releases whichever sffd context is current on the calling thread.
   static void deactivateCurrent();
@@ -53,9 +54,12 @@ class Context {
   int glVersion() const { return glVersion_; }
 
  protected:
-  // Provider primitives used by activate(): make current / make nothing current on this thread.
+  // Provider primitives used by activate(): make current / make nothing current on this thread, and
+  // whether the provider still has this context current here (code outside sffd, such as a viewer
+  // calling glfwMakeContextCurrent, may have changed it).
   virtual void makeCurrent() = 0;
   virtual void release() = 0;
+  virtual bool providerCurrent() const = 0;
   // Called first by every derived destructor: releases the context if it is current on this thread.
   void releaseIfCurrent();
 

@@ -115,8 +115,8 @@ bool hasExtension(const char* list, const std::string& ext) {
 // eglInitialize / eglTerminate counted per display: EGL returns one EGLDisplay per platform and
 // native display, so contexts of one display must not terminate it under each other.
 std::map<EGLDisplay, int>& displayUsers() {
-  static std::map<EGLDisplay, int> m;
-  return m;
+  static auto* m = new std::map<EGLDisplay, int>;   // never destroyed: contexts may outlive static destructors
+  return *m;
 }
 void unrefDisplay(EGLDisplay dpy) {
   auto& users = displayUsers();
@@ -154,6 +154,7 @@ class EglContext final : public Context {
     if (!l.MakeCurrent(dpy_, EGL_NO_SURFACE, EGL_NO_SURFACE, ctx_))
       throw deviceError("egl: eglMakeCurrent failed (" + lastError() + ")");
   }
+  bool providerCurrent() const override { return lib().GetCurrentContext() == ctx_; }
   void release() override {
     EglLib& l = lib();
     l.BindAPI(EGL_OPENGL_API);

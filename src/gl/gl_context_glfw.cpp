@@ -45,6 +45,7 @@ class GlfwContext final : public Context {
     if (glfwGetCurrentContext() != window_) throw deviceError("glfw: cannot make the window's context current (" + glfwReason() + ")");
   }
   void release() override { glfwMakeContextCurrent(nullptr); }
+  bool providerCurrent() const override { return glfwGetCurrentContext() == window_; }
 
  private:
   GLFWwindow* window_;

@@ -79,6 +79,7 @@ class OSMesaGLContext final : public Context {
       throw deviceError("osmesa: OSMesaMakeCurrent failed");
   }
   void release() override { lib().MakeCurrent(nullptr, nullptr, 0, 0, 0); }
+  bool providerCurrent() const override { return lib().GetCurrentContext() == ctx_; }
 
  private:
   static constexpr int kSide = 16;

@@ -58,7 +58,9 @@ class VulkanBackend final : public Backend {
         recorder_(device_, kernels_.setLayout()) {}
 
   ~VulkanBackend() override {
-    // Nothing is in flight (submissions are waited for); unsubmitted work is dropped with the pool.
+    // Submissions are waited for, so nothing should be in flight (unless a wait failed);
+    // unsubmitted work is dropped with the command pool.
+    device_.api().vkDeviceWaitIdle(device_.handle());
     for (Buffer& b : buffers_) device_.release(b.memory);
   }
 

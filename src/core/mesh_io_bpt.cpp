@@ -1,0 +1,216 @@
+// .bpt Bezier patch files (ALGORITHM.md 5, "Utah teapot"): a patch count, then per patch a line "3 3"
+// (the degrees) and 16 control points "x y z", P(u,v) = sum_r sum_c B3_r(u) B3_c(v) P[4r+c].
+//
+// Tessellation: each patch is sampled on a uniform (res+1) x (res+1) grid of (u, v) (res =
+// MeshReadOptions::bptResolution): vertex (i, j) of patch p is vertex p*(res+1)^2 + i*(res+1) + j at
+// u = i/res, v = j/res, with vertexPatch = p and vertexUV = (u, v). Each grid cell gives the triangles
+// (i,j)(i+1,j)(i+1,j+1) and (i,j)(i+1,j+1)(i,j+1): counter-clockwise seen from Su x Sv, 2 res^2 a patch.
+// The normal is the exact Su x Sv; where it vanishes (a collapsed patch edge: the lid apex, the bottom
+// centre) it is taken at a parameter nudged toward the patch interior.
+//
+// Welding: every patch keeps its own vertices (so that each triangle's vertices carry (u, v) of one
+// patch), but vertices of different patches whose positions agree within 1e-9 of the bounding box
+// diagonal are snapped to one position and so share a weldId. Where all the normals at one welded
+// position agree within 1e-3 rad (a smooth seam, or the nudged normals at a collapsed point) they are
+// replaced by their normalised mean, so the seam reads as smooth; a real crease keeps its split normals.
+// Degenerate triangles at collapsed edges are kept (7200 triangles for the 36-patch teapot at res 10).
+// normalsFromFile is true: the normals are the surface's exact ones, not estimated from triangles.
+#include <algorithm>
+#include <cmath>
+#include <unordered_map>
+
+#include "error.h"
+#include "io_util.h"
+#include "mesh_io_internal.h"
+
+namespace sffd::meshio {
+namespace {
+
+void bernstein3(double t, double b[4], double d[4]) {
+  double s = 1.0 - t;
+  b[0] = s * s * s;
+  b[1] = 3.0 * t * s * s;
+  b[2] = 3.0 * t * t * s;
+  b[3] = t * t * t;
+  d[0] = -3.0 * s * s;
+  d[1] = 3.0 * s * s - 6.0 * t * s;
+  d[2] = 6.0 * t * s - 3.0 * t * t;
+  d[3] = 3.0 * t * t;
+}
+
+void evalPatch(const BicubicPatch& P, double u, double v, glm::dvec3& S, glm::dvec3& Su, glm::dvec3& Sv) {
+  double bu[4], du[4], bv[4], dv[4];
+  bernstein3(u, bu, du);
+  bernstein3(v, bv, dv);
+  S = Su = Sv = glm::dvec3(0.0);
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) {
+      const glm::dvec3& q = P.points[4 * r + c];
+      S += (bu[r] * bv[c]) * q;
+      Su += (du[r] * bv[c]) * q;
+      Sv += (bu[r] * dv[c]) * q;
+    }
+}
+
+glm::dvec3 patchNormal(const BicubicPatch& P, double u, double v, double scale2) {
+  glm::dvec3 S, Su, Sv;
+  evalPatch(P, u, v, S, Su, Sv);
+  glm::dvec3 n = glm::cross(Su, Sv);
+  double len = glm::length(n);
+  if (len > 1e-10 * scale2) return n / len;
+  // Collapsed edge or corner: step toward the interior; the normal there tends to the limit normal.
+  for (double delta : {1e-6, 1e-4, 1e-2}) {
+    double uu = u + (u < 0.5 ? delta : u > 0.5 ? -delta : 0.0);
+    double vv = v + (v < 0.5 ? delta : v > 0.5 ? -delta : 0.0);
+    evalPatch(P, uu, vv, S, Su, Sv);
+    n = glm::cross(Su, Sv);
+    len = glm::length(n);
+    if (len > 1e-14 * scale2) return n / len;
+  }
+  return glm::dvec3(0, 0, 1);   // a patch collapsed to a curve or a point
+}
+
+struct CellHash {
+  size_t operator()(const std::array<int64_t, 3>& c) const {
+    uint64_t h = uint64_t(c[0]) * 0x9E3779B97F4A7C15ull;
+    h ^= uint64_t(c[1]) + 0x7F4A7C159E3779B9ull + (h << 6) + (h >> 2);
+    h ^= uint64_t(c[2]) + 0x94D049BB133111EBull + (h << 6) + (h >> 2);
+    return size_t(h);
+  }
+};
+
+}  // namespace
+
+Mesh readBpt(const std::string& path, const std::string& text, const MeshReadOptions& options) {
+  const int res = options.bptResolution;
+  if (res < 1 || res > 1000) throw inputError(path, 0, "bpt resolution must be 1..1000, not " + std::to_string(res));
+  io::Tokenizer tz(text);
+  std::string_view t;
+  size_t line = 1;
+  if (!tz.next(t, line)) throw inputError(path, 0, "empty file");
+  long long count = 0;
+  if (!io::parseInt(t, count) || count < 1) throw inputError(path, line, "bad patch count " + io::quoted(t));
+  // A patch takes at least 4 + 16 * 6 bytes of text.
+  if (uint64_t(count) > text.size() / 100 + 1)
+    throw inputError(path, line, "the file declares " + std::to_string(count) + " patches, more than it can hold (truncated?)");
+  const uint64_t perPatch = uint64_t(res + 1) * uint64_t(res + 1);
+  if (uint64_t(count) * perPatch > kMaxVertices) throw inputError(path, line, "too many vertices at this resolution");
+
+  Mesh mesh;
+  mesh.patches.resize(size_t(count));
+  for (long long p = 0; p < count; ++p) {
+    for (int d = 0; d < 2; ++d) {
+      if (!tz.next(t, line))
+        throw inputError(path, tz.line(), "file ends in patch " + std::to_string(p + 1) + " of " + std::to_string(count));
+      long long deg = 0;
+      if (!io::parseInt(t, deg)) throw inputError(path, line, "bad patch degree " + io::quoted(t) + " (expected '3 3')");
+      if (deg != 3) throw inputError(path, line, "patch degree " + std::to_string(deg) + ": only bicubic ('3 3') patches are supported");
+    }
+    for (int k = 0; k < 48; ++k) {
+      if (!tz.next(t, line))
+        throw inputError(path, tz.line(), "file ends in patch " + std::to_string(p + 1) + " of " + std::to_string(count));
+      double x = 0;
+      if (!io::parseDouble(t, x)) throw inputError(path, line, "bad number " + io::quoted(t));
+      if (!std::isfinite(x)) throw inputError(path, line, "non-finite coordinate " + io::quoted(t));
+      mesh.patches[size_t(p)].points[size_t(k / 3)][k % 3] = x;
+    }
+  }
+  if (tz.next(t, line)) throw inputError(path, line, "unexpected " + io::quoted(t) + " after the last patch");
+
+  // Sample.
+  const size_t nVert = size_t(count) * perPatch;
+  mesh.positions.resize(nVert);
+  mesh.normals.resize(nVert);
+  mesh.vertexPatch.resize(nVert);
+  mesh.vertexUV.resize(nVert);
+  mesh.triangles.reserve(size_t(count) * 2 * size_t(res) * size_t(res));
+  glm::dvec3 lo(INFINITY), hi(-INFINITY);
+  for (size_t p = 0; p < size_t(count); ++p) {
+    const BicubicPatch& P = mesh.patches[p];
+    glm::dvec3 plo(INFINITY), phi(-INFINITY);
+    for (const auto& q : P.points) {
+      plo = glm::min(plo, q);
+      phi = glm::max(phi, q);
+    }
+    glm::dvec3 ext = phi - plo;
+    double scale = std::max({ext.x, ext.y, ext.z, 1e-300});
+    const size_t base = p * perPatch;
+    for (int i = 0; i <= res; ++i)
+      for (int j = 0; j <= res; ++j) {
+        double u = double(i) / res, v = double(j) / res;
+        size_t vid = base + size_t(i) * (res + 1) + j;
+        glm::dvec3 S, Su, Sv;
+        evalPatch(P, u, v, S, Su, Sv);
+        mesh.positions[vid] = S;
+        mesh.normals[vid] = patchNormal(P, u, v, scale * scale);
+        mesh.vertexPatch[vid] = uint32_t(p);
+        mesh.vertexUV[vid] = {u, v};
+        lo = glm::min(lo, S);
+        hi = glm::max(hi, S);
+      }
+    for (int i = 0; i < res; ++i)
+      for (int j = 0; j < res; ++j) {
+        uint32_t a = uint32_t(base + size_t(i) * (res + 1) + j);
+        uint32_t b = a + uint32_t(res + 1), c = b + 1, d = a + 1;
+        mesh.triangles.push_back({a, b, c});
+        mesh.triangles.push_back({a, c, d});
+      }
+  }
+
+  // Weld positions within tol (snap each to the first representative found within reach).
+  const double tol = 1e-9 * glm::length(hi - lo);
+  if (tol > 0) {
+    std::unordered_map<std::array<int64_t, 3>, std::vector<uint32_t>, CellHash> cells;
+    cells.reserve(nVert);
+    auto cellOf = [&](const glm::dvec3& q) {
+      return std::array<int64_t, 3>{int64_t(std::floor(q.x / tol)), int64_t(std::floor(q.y / tol)), int64_t(std::floor(q.z / tol))};
+    };
+    for (size_t v = 0; v < nVert; ++v) {
+      glm::dvec3& q = mesh.positions[v];
+      auto c = cellOf(q);
+      bool snapped = false;
+      for (int dx = -1; dx <= 1 && !snapped; ++dx)
+        for (int dy = -1; dy <= 1 && !snapped; ++dy)
+          for (int dz = -1; dz <= 1 && !snapped; ++dz) {
+            auto it = cells.find({c[0] + dx, c[1] + dy, c[2] + dz});
+            if (it == cells.end()) continue;
+            for (uint32_t r : it->second)
+              if (glm::length(mesh.positions[r] - q) <= tol) {
+                q = mesh.positions[r];
+                snapped = true;
+                break;
+              }
+          }
+      if (!snapped) cells[c].push_back(uint32_t(v));
+    }
+  }
+  weldPositions(mesh);
+
+  // Smooth seams: one normal per welded position where all agree within 1e-3 rad.
+  {
+    size_t groups = 0;
+    for (uint32_t w : mesh.weldId) groups = std::max<size_t>(groups, w + 1);
+    std::vector<glm::dvec3> sum(groups, glm::dvec3(0.0));
+    std::vector<uint32_t> members(groups, 0);
+    for (size_t v = 0; v < nVert; ++v) {
+      sum[mesh.weldId[v]] += mesh.normals[v];
+      ++members[mesh.weldId[v]];
+    }
+    std::vector<uint8_t> smooth(groups, 1);
+    std::vector<glm::dvec3> mean(groups);
+    for (size_t g = 0; g < groups; ++g) {
+      double len = glm::length(sum[g]);
+      mean[g] = len > 0 ? sum[g] / len : glm::dvec3(0, 0, 1);
+      if (!(len > 0)) smooth[g] = 0;
+    }
+    const double cosTol = std::cos(1e-3);
+    for (size_t v = 0; v < nVert; ++v)
+      if (glm::dot(mesh.normals[v], mean[mesh.weldId[v]]) < cosTol) smooth[mesh.weldId[v]] = 0;
+    for (size_t v = 0; v < nVert; ++v)
+      if (members[mesh.weldId[v]] > 1 && smooth[mesh.weldId[v]]) mesh.normals[v] = mean[mesh.weldId[v]];
+  }
+  mesh.normalsFromFile = true;
+  return mesh;
+}
+
+}  // namespace sffd::meshio
