@@ -25,8 +25,9 @@ void gridFor(uint64_t threads, const DeviceLimits& limits, uint32_t groups[3]) {
   uint64_t need = (threads + SFFD_LOCAL_SIZE - 1) / SFFD_LOCAL_SIZE;
   uint64_t maxX = std::min<uint64_t>(limits.maxWorkGroupCount[0], SFFD_MAX_GROUPS_X);
   if (need == 0) need = 1;
-  uint64_t x = std::min(need, maxX);
-  uint64_t y = (need + x - 1) / x;
+  // Balanced split: rows as few as possible, then columns just enough (no half-empty second row).
+  uint64_t y = (need + maxX - 1) / maxX;
+  uint64_t x = (need + y - 1) / y;
   groups[0] = static_cast<uint32_t>(x);
   groups[1] = static_cast<uint32_t>(y);
   groups[2] = 1;

@@ -101,14 +101,14 @@ Mesh readBpt(const std::string& path, const std::string& text, const MeshReadOpt
   for (long long p = 0; p < count; ++p) {
     for (int d = 0; d < 2; ++d) {
       if (!tz.next(t, line))
-        throw inputError(path, tz.line(), "file ends in patch " + std::to_string(p + 1) + " of " + std::to_string(count));
+        throw inputError(path, line, "file ends in patch " + std::to_string(p + 1) + " of " + std::to_string(count));
       long long deg = 0;
       if (!io::parseInt(t, deg)) throw inputError(path, line, "bad patch degree " + io::quoted(t) + " (expected '3 3')");
       if (deg != 3) throw inputError(path, line, "patch degree " + std::to_string(deg) + ": only bicubic ('3 3') patches are supported");
     }
     for (int k = 0; k < 48; ++k) {
       if (!tz.next(t, line))
-        throw inputError(path, tz.line(), "file ends in patch " + std::to_string(p + 1) + " of " + std::to_string(count));
+        throw inputError(path, line, "file ends in patch " + std::to_string(p + 1) + " of " + std::to_string(count));
       double x = 0;
       if (!io::parseDouble(t, x)) throw inputError(path, line, "bad number " + io::quoted(t));
       if (!std::isfinite(x)) throw inputError(path, line, "non-finite coordinate " + io::quoted(t));

@@ -292,7 +292,7 @@ Mesh readPly(const std::string& path, const std::string& text) {
     size_t tl = 0;
     auto number = [&](PlyType ty, const char* what, uint64_t item) {
       if (!tz.next(t, tl))
-        throw inputError(path, tz.line(), std::string("file ends in ") + what + " " + std::to_string(item));
+        throw inputError(path, tl ? tl : tz.line(), std::string("file ends in ") + what + " " + std::to_string(item));
       double v = 0;
       if (plyIsFloat(ty)) {
         if (!io::parseDouble(t, v)) throw inputError(path, tl, "bad number " + io::quoted(t));
@@ -458,11 +458,11 @@ Mesh readStlAscii(const std::string& path, const std::string& text) {
   Welder w{{}, &mesh};
   std::vector<uint32_t> poly;
   auto expect = [&](const char* word) {
-    if (!tz.next(t, line)) throw inputError(path, tz.line(), std::string("file ends, expected '") + word + "' (truncated?)");
+    if (!tz.next(t, line)) throw inputError(path, line, std::string("file ends, expected '") + word + "' (truncated?)");
     if (t != word) throw inputError(path, line, std::string("expected '") + word + "', found " + io::quoted(t));
   };
   auto number = [&]() {
-    if (!tz.next(t, line)) throw inputError(path, tz.line(), "file ends, expected a number (truncated?)");
+    if (!tz.next(t, line)) throw inputError(path, line, "file ends, expected a number (truncated?)");
     double d = 0;
     if (!io::parseDouble(t, d)) throw inputError(path, line, "bad number " + io::quoted(t));
     if (!std::isfinite(d)) throw inputError(path, line, "non-finite coordinate " + io::quoted(t));
@@ -473,7 +473,7 @@ Mesh readStlAscii(const std::string& path, const std::string& text) {
   bool inSolid = true;
   while (true) {
     if (!tz.next(t, line)) {
-      if (inSolid) throw inputError(path, tz.line(), "file ends before 'endsolid' (truncated?)");
+      if (inSolid) throw inputError(path, line, "file ends before 'endsolid' (truncated?)");
       break;
     }
     if (!inSolid) {
@@ -491,7 +491,7 @@ Mesh readStlAscii(const std::string& path, const std::string& text) {
     size_t facetLine = line;
     expect("normal");
     for (int c = 0; c < 3; ++c) {
-      if (!tz.next(t, line)) throw inputError(path, tz.line(), "file ends in a facet normal (truncated?)");
+      if (!tz.next(t, line)) throw inputError(path, line, "file ends in a facet normal (truncated?)");
       double d;
       if (!io::parseDouble(t, d)) throw inputError(path, line, "bad number " + io::quoted(t));   // value unused
     }
@@ -499,7 +499,7 @@ Mesh readStlAscii(const std::string& path, const std::string& text) {
     expect("loop");
     poly.clear();
     while (true) {
-      if (!tz.next(t, line)) throw inputError(path, tz.line(), "file ends in a facet (truncated?)");
+      if (!tz.next(t, line)) throw inputError(path, line, "file ends in a facet (truncated?)");
       if (t == "endloop") break;
       if (t != "vertex") throw inputError(path, line, "expected 'vertex' or 'endloop', found " + io::quoted(t));
       glm::dvec3 p;

@@ -265,6 +265,17 @@ TEST_F(VkBackendTest, ClassicFfdIdentityAllVariants) {
   }
 }
 
+// A device without shaderFloat64 (simulated with SFFD_VK_DISABLE_F64=1) refuses f64 kernels with a
+// device Error and still runs the float ones.
+TEST_F(VkBackendTest, RefusesF64WithoutShaderFloat64) {
+  ScopedEnv env("SFFD_VK_DISABLE_F64", "1");
+  auto gpu = vk::createBackend({});
+  EXPECT_FALSE(gpu->info().limits.float64);
+  EXPECT_EQ(errorKindOf([&] { runIdentity<double>(*gpu, {false, true}, 0); }), ErrorKind::Device);
+  EXPECT_EQ(errorKindOf([&] { runIdentity<double>(*gpu, {true, true}, 0); }), ErrorKind::Device);
+  runIdentity<float>(*gpu, {true, false}, 1e-6);
+}
+
 TEST_F(VkBackendTest, UnknownKernelIsInternalError) {
   auto gpu = vk::createBackend({});
   Dispatch d;

@@ -1,8 +1,7 @@
 #include "vk_device.h"
 
 #include <bit>
-#include <cstdlib>
-#include <cstring>
+#include <string>
 #include <vector>
 
 #include "error.h"
@@ -16,13 +15,6 @@ constexpr VkMemoryPropertyFlags kMappable = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT 
 constexpr VkMemoryPropertyFlags kExcluded = VK_MEMORY_PROPERTY_LAZILY_ALLOCATED_BIT | VK_MEMORY_PROPERTY_PROTECTED_BIT |
                                             VK_MEMORY_PROPERTY_DEVICE_COHERENT_BIT_AMD;
 
-// Env SFFD_VK_STAGING=1 treats the device as discrete even on unified memory, so that the staging
-// path of real GPUs is exercised on lavapipe too.
-bool forceStaging() {
-  const char* env = std::getenv("SFFD_VK_STAGING");
-  return env && *env && std::strcmp(env, "0") != 0;
-}
-
 }  // namespace
 
 Device::Device(const Instance& instance, const PhysicalDevice& physical)
@@ -31,7 +23,9 @@ Device::Device(const Instance& instance, const PhysicalDevice& physical)
   api_.vkGetPhysicalDeviceMemoryProperties(physical.handle, &memory_);
 
   bool anyDeviceLocal = false;
-  unified_ = !forceStaging();
+  // SFFD_VK_STAGING=1 treats the device as discrete even on unified memory, so that the staging
+  // path of real GPUs is exercised on lavapipe too.
+  unified_ = !envFlag("SFFD_VK_STAGING");
   for (uint32_t i = 0; i < memory_.memoryTypeCount; ++i) {
     VkMemoryPropertyFlags f = memory_.memoryTypes[i].propertyFlags;
     if (!(f & VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT) || (f & kExcluded)) continue;

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <atomic>
 #include <cstdio>
-#include <cstdlib>
 #include <cstring>
 #include <iterator>
 
@@ -118,7 +117,8 @@ PhysicalDevice describe(const Api& api, VkPhysicalDevice handle) {
   limits.maxStorageBufferRange = props.limits.maxStorageBufferRange;
   limits.storageOffsetAlignment = props.limits.minStorageBufferOffsetAlignment;
   for (int i = 0; i < 3; ++i) limits.maxWorkGroupCount[i] = props.limits.maxComputeWorkGroupCount[i];
-  limits.float64 = features.shaderFloat64;
+  // SFFD_VK_DISABLE_F64=1 hides shaderFloat64, to test the refusal of f64 kernels on any device.
+  limits.float64 = features.shaderFloat64 && !envFlag("SFFD_VK_DISABLE_F64");
   limits.timestamps = props.limits.timestampComputeAndGraphics && props.limits.timestampPeriod > 0 && pd.timestampBits > 0;
 
   if (props.apiVersion < VK_API_VERSION_1_1)
@@ -144,8 +144,7 @@ bool hasDeviceExtension(const Api& api, VkPhysicalDevice device, const char* nam
 }
 
 bool validationRequested(bool option) {
-  const char* env = std::getenv("SFFD_VK_VALIDATION");
-  return option || (env && *env && std::strcmp(env, "0") != 0);
+  return option || envFlag("SFFD_VK_VALIDATION");
 }
 
 Instance::Instance(bool validation) : api_(Api::load()) {

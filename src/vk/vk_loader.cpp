@@ -63,6 +63,11 @@ void Api::loadDevice(VkDevice device) {
 #undef SFFD_VK_LOAD
 }
 
+bool envFlag(const char* name) {
+  const char* value = std::getenv(name);
+  return value && *value && std::string(value) != "0";
+}
+
 const char* resultName(VkResult result) {
   switch (result) {
 #define SFFD_VK_RESULT(r) \

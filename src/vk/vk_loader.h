@@ -102,6 +102,9 @@ struct Api {
   void loadDevice(VkDevice device);
 };
 
+// Whether env `name` is set to anything but "" or "0" (SFFD_VK_VALIDATION and the test switches).
+bool envFlag(const char* name);
+
 // A zero-initialised Vulkan struct with its sType set.
 template <typename T>
 T vkStruct(VkStructureType type) {
