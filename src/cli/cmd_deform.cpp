@@ -13,6 +13,7 @@ namespace {
 
 int run(const ParsedArgs& args) {
   std::string out = args.requireValue("--output");
+  args.requireValue("--lattice");
   std::string method = args.get("--method", "smooth");
   if (method != "smooth" && method != "accurate" && method != "classic")
     throw Error(ErrorKind::Input, "--method must be smooth, accurate or classic, not '" + method + "'");

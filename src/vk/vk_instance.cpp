@@ -20,13 +20,17 @@ std::atomic<size_t> gValidationMessages{0};
 
 // Prints every warning and error; counts those of the validation layer (type VALIDATION or
 // PERFORMANCE). GENERAL messages come from the loader itself (e.g. "no ICD found" while probing
-// a machine without Vulkan): they are printed but are not validation failures of sffd's usage.
+// a machine without Vulkan): printed only with SFFD_VK_VERBOSE=1, and never counted.
 VKAPI_ATTR VkBool32 VKAPI_CALL onDebugMessage(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
                                               VkDebugUtilsMessageTypeFlagsEXT type,
                                               const VkDebugUtilsMessengerCallbackDataEXT* data, void*) {
   const bool error = severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
   if (type & (VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT))
     ++gValidationMessages;
+  // The loader's own chatter stays quiet unless asked for: a failed probe ends in one device Error
+  // line of sffd's, which names the problem (the contract's one-line errors).
+  else if (!envFlag("SFFD_VK_VERBOSE"))
+    return VK_FALSE;
   std::fprintf(stderr, "sffd: vulkan %s: %s\n", error ? "error" : "warning", data && data->pMessage ? data->pMessage : "");
   return VK_FALSE;   // never abort the call that triggered it
 }
