@@ -70,6 +70,60 @@ glm::dvec3 patchNormal(const BicubicPatch& P, double u, double v, double scale2)
   return glm::dvec3(0, 0, 1);   // a patch collapsed to a curve or a point
 }
 
+void tessellate(Mesh& mesh, int res) {
+  const size_t perPatch = size_t(res + 1) * size_t(res + 1);
+  const size_t nVert = mesh.patches.size() * perPatch;
+  mesh.positions.resize(nVert);
+  mesh.normals.resize(nVert);
+  mesh.vertexPatch.resize(nVert);
+  mesh.vertexUV.resize(nVert);
+  mesh.triangles.clear();
+  mesh.triangles.reserve(mesh.patches.size() * 2 * size_t(res) * size_t(res));
+  for (size_t p = 0; p < mesh.patches.size(); ++p) {
+    const BicubicPatch& P = mesh.patches[p];
+    glm::dvec3 plo(INFINITY), phi(-INFINITY);
+    for (const auto& q : P.points) {
+      plo = glm::min(plo, q);
+      phi = glm::max(phi, q);
+    }
+    glm::dvec3 ext = phi - plo;
+    double scale = std::max({ext.x, ext.y, ext.z, 1e-300});
+    const size_t base = p * perPatch;
+    for (int i = 0; i <= res; ++i)
+      for (int j = 0; j <= res; ++j) {
+        double u = double(i) / res, v = double(j) / res;
+        size_t vid = base + size_t(i) * (res + 1) + j;
+        glm::dvec3 S, Su, Sv;
+        evalPatch(P, u, v, S, Su, Sv);
+        mesh.positions[vid] = S;
+        mesh.normals[vid] = patchNormal(P, u, v, scale * scale);
+        mesh.vertexPatch[vid] = uint32_t(p);
+        mesh.vertexUV[vid] = {u, v};
+      }
+    for (int i = 0; i < res; ++i)
+      for (int j = 0; j < res; ++j) {
+        uint32_t a = uint32_t(base + size_t(i) * (res + 1) + j);
+        uint32_t b = a + uint32_t(res + 1), c = b + 1, d = a + 1;
+        mesh.triangles.push_back({a, b, c});
+        mesh.triangles.push_back({a, c, d});
+      }
+  }
+}
+
+// Signed volume enclosed by the triangles, about the centre of their box.
+double signedVolume(const Mesh& mesh) {
+  glm::dvec3 lo(INFINITY), hi(-INFINITY);
+  for (const auto& q : mesh.positions) {
+    lo = glm::min(lo, q);
+    hi = glm::max(hi, q);
+  }
+  glm::dvec3 c = 0.5 * (lo + hi);
+  double v = 0;
+  for (const auto& t : mesh.triangles)
+    v += glm::dot(mesh.positions[t[0]] - c, glm::cross(mesh.positions[t[1]] - c, mesh.positions[t[2]] - c));
+  return v / 6;
+}
+
 struct CellHash {
   size_t operator()(const std::array<int64_t, 3>& c) const {
     uint64_t h = uint64_t(c[0]) * 0x9E3779B97F4A7C15ull;
@@ -117,44 +171,23 @@ Mesh readBpt(const std::string& path, const std::string& text, const MeshReadOpt
   }
   if (tz.next(t, line)) throw inputError(path, line, "unexpected " + io::quoted(t) + " after the last patch");
 
-  // Sample.
-  const size_t nVert = size_t(count) * perPatch;
-  mesh.positions.resize(nVert);
-  mesh.normals.resize(nVert);
-  mesh.vertexPatch.resize(nVert);
-  mesh.vertexUV.resize(nVert);
-  mesh.triangles.reserve(size_t(count) * 2 * size_t(res) * size_t(res));
-  glm::dvec3 lo(INFINITY), hi(-INFINITY);
-  for (size_t p = 0; p < size_t(count); ++p) {
-    const BicubicPatch& P = mesh.patches[p];
-    glm::dvec3 plo(INFINITY), phi(-INFINITY);
-    for (const auto& q : P.points) {
-      plo = glm::min(plo, q);
-      phi = glm::max(phi, q);
+  // Sample; if the surface faces inward (negative signed volume about its box centre), transpose every
+  // patch (swap u and v) and sample again, so that Su x Sv points outward.
+  tessellate(mesh, res);
+  if (signedVolume(mesh) < 0) {
+    for (BicubicPatch& P : mesh.patches) {
+      BicubicPatch T;
+      for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c) T.points[4 * c + r] = P.points[4 * r + c];
+      P = T;
     }
-    glm::dvec3 ext = phi - plo;
-    double scale = std::max({ext.x, ext.y, ext.z, 1e-300});
-    const size_t base = p * perPatch;
-    for (int i = 0; i <= res; ++i)
-      for (int j = 0; j <= res; ++j) {
-        double u = double(i) / res, v = double(j) / res;
-        size_t vid = base + size_t(i) * (res + 1) + j;
-        glm::dvec3 S, Su, Sv;
-        evalPatch(P, u, v, S, Su, Sv);
-        mesh.positions[vid] = S;
-        mesh.normals[vid] = patchNormal(P, u, v, scale * scale);
-        mesh.vertexPatch[vid] = uint32_t(p);
-        mesh.vertexUV[vid] = {u, v};
-        lo = glm::min(lo, S);
-        hi = glm::max(hi, S);
-      }
-    for (int i = 0; i < res; ++i)
-      for (int j = 0; j < res; ++j) {
-        uint32_t a = uint32_t(base + size_t(i) * (res + 1) + j);
-        uint32_t b = a + uint32_t(res + 1), c = b + 1, d = a + 1;
-        mesh.triangles.push_back({a, b, c});
-        mesh.triangles.push_back({a, c, d});
-      }
+    tessellate(mesh, res);
+  }
+  const size_t nVert = mesh.positions.size();
+  glm::dvec3 lo(INFINITY), hi(-INFINITY);
+  for (const auto& q : mesh.positions) {
+    lo = glm::min(lo, q);
+    hi = glm::max(hi, q);
   }
 
   // Weld positions within tol (snap each to the first representative found within reach).
