@@ -56,4 +56,23 @@ SFFD_STRUCT_BEGIN(ClassicParams)
   SFFD_UVEC4 range;          // x: first vertex of this chunk (relative to the bound ranges), y: vertex count
 SFFD_STRUCT_END(ClassicParams)
 
+// ---- kernel pn_triangles: one thread per original triangle (ALGORITHM.md 3.2) ----
+// Mesh buffers shared by the pre-compute kernels.
+#define SFFD_BINDING_MESH_POSITIONS 3      // real4 per vertex (w unused)
+#define SFFD_BINDING_MESH_NORMALS 4        // real4 per vertex, unit (w unused)
+#define SFFD_BINDING_MESH_TRIANGLES 5      // 2 uvec4 per triangle: vertex ids (w unused), weld ids (w unused)
+#define SFFD_BINDING_MESH_SLOT_NORMALS 6   // 12 real4 per triangle: per corner slot, the first then the second
+                                           // normal of the slot (w of the first: 1 crease, 0 smooth)
+#define SFFD_BINDING_PN_OUT 7              // SFFD_PN_STRIDE real4 per triangle
+#define SFFD_MESH_TRIANGLE_STRIDE 2
+#define SFFD_SLOT_NORMAL_STRIDE 12
+// PN record: the 10 cubic geometry control points (linear index order 300,210,201,120,111,102,030,021,012,003)
+// then the 6 quadratic normal control points (200,110,101,020,011,002).
+#define SFFD_PN_STRIDE 16
+#define SFFD_PN_NORMALS 10
+
+SFFD_STRUCT_BEGIN(PnParams)
+  SFFD_UVEC4 range;   // x: first triangle, y: triangle count
+SFFD_STRUCT_END(PnParams)
+
 #endif

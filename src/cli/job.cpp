@@ -68,6 +68,13 @@ Job loadJob(const ParsedArgs& args) {
   LatticeReadOptions lo;
   lo.npyDegree = args.getTriple("--degree", {2, 2, 2});
   meshBounds(job.mesh, lo.meshBoxLo, lo.meshBoxHi);
+  // .npy (reference implementation): the body box is the model's box normalised into [-1,1]^3 and
+  // the model itself sits at the --normalize scale inside it (0.99: strictly inside). The shared
+  // identity lattice t_control_points0.npy is exactly the Greville lattice of that box.
+  if (ext == ".npy" && job.normalizedTo) {
+    lo.meshBoxLo /= *job.normalizedTo;
+    lo.meshBoxHi /= *job.normalizedTo;
+  }
   lo.haveMeshBox = !job.mesh.positions.empty();
   job.lattice = readLattice(job.latticePath, lo);
   return job;

@@ -6,29 +6,10 @@
 #include <cstdint>
 #include <vector>
 
+#include "rvec.h"
 #include "shader_layout.h"
 
 namespace sffd {
-
-template <class Real>
-struct RVec3 {
-  Real x = 0, y = 0, z = 0;
-  Real& operator[](int i) { return i == 0 ? x : (i == 1 ? y : z); }
-  Real operator[](int i) const { return i == 0 ? x : (i == 1 ? y : z); }
-};
-template <class Real> RVec3<Real> operator+(RVec3<Real> a, RVec3<Real> b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-template <class Real> RVec3<Real> operator*(RVec3<Real> a, Real s) { return {a.x * s, a.y * s, a.z * s}; }
-template <class Real> Real sdot(RVec3<Real> a, RVec3<Real> b) {
-  Real xy = a.x * b.x + a.y * b.y;
-  return xy + a.z * b.z;
-}
-template <class Real> RVec3<Real> scross(RVec3<Real> a, RVec3<Real> b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-template <class Real> RVec3<Real> snormalize(RVec3<Real> v) {
-  Real len = std::sqrt(sdot(v, v));
-  return {v.x / len, v.y / len, v.z / len};
-}
 
 template <class Real>
 struct LatticeSampleT {

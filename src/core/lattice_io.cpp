@@ -17,6 +17,7 @@
 //   "comment" and keys starting with "_" are ignored; any other key is an error (catches typos).
 // Comments (// and /* */) are accepted.
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstring>
 #include <iterator>
@@ -158,6 +159,9 @@ Lattice readJson(const std::string& path, const std::string& text) {
   } catch (const json::parse_error& e) {
     size_t line = lines.lineOfOffset(e.byte > 0 ? e.byte - 1 : 0);
     throw inputError(path, line, "JSON syntax error: " + stripNlohmannPrefix(e.what()));
+  } catch (const json::exception& e) {   // e.g. out_of_range.406: a number too large for a double
+    size_t line = lines.lineOfOffset(size_t(*lines.furthest() - text.data()) - (text.empty() ? 0 : 1));
+    throw inputError(path, line, "JSON error: " + stripNlohmannPrefix(e.what()));
   }
   auto fail = [&](const std::string& at, const std::string& what) { return inputError(path, lines.line(at), what); };
   if (!j.is_object()) throw inputError(path, 1, "expected a JSON object {\"format\": \"sffd-lattice\", ...}");

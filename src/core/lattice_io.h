@@ -19,7 +19,7 @@ struct LatticeReadOptions {
 // Reads by extension (.json .prm .npy). Throws an input Error ("file:line: what") on a bad file.
 Lattice readLattice(const std::string& path, const LatticeReadOptions& options = {});
 
-// Writes the native JSON format (17 significant digits) to a temporary file renamed into place.
+// Writes the native JSON format (shortest digits that read back to the same doubles) to a temporary file renamed into place.
 void writeLatticeJson(const std::string& path, const Lattice& lattice);
 
 // Applies a preset deformation (twist, bend, taper, bulge, noise) of the given amount to the

@@ -1,5 +1,6 @@
 // PyGeM .prm and reference-implementation .npy lattice files.
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstring>
 #include <map>

@@ -2,6 +2,7 @@
 // reference implementation, the JSON format (round trip, errors with lines), and the presets.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -205,13 +206,17 @@ LatticeReadOptions boxOptions(glm::dvec3 lo, glm::dvec3 hi) {
 }
 
 TEST_F(LatticeIo, NpyReferenceFiles) {
-  // t_control_points0 is the identity (Greville points) over the normalised teapot's box, whose largest
-  // half-extent is 1: the points span that box.
+  // t_control_points0 is the identity (Greville points) over the box of t.bpt (tessellated 10 x 10 a
+  // patch) normalised so that its largest half-extent is 1 -- not 0.99: the reference implementation's
+  // body box is the model's box in [-1,1]^3, the model itself then being scaled by 0.99 inside it.
   const std::string t0 = kData + "/acaffd/lattices/t_control_points0.npy";
-  glm::dvec3 hi(1.0, 0.621697, 0.489587);
-  Lattice probe = readLattice(t0, boxOptions(-hi, hi));
+  Mesh teapot = readMesh(kData + "/acaffd/t.bpt");
   glm::dvec3 lo(1e9), up(-1e9);
-  for (const auto& p : probe.controlPoints) lo = glm::min(lo, p), up = glm::max(up, p);
+  for (const auto& p : teapot.positions) lo = glm::min(lo, p), up = glm::max(up, p);
+  glm::dvec3 centre = 0.5 * (lo + up);
+  double half = 0.5 * std::max({up.x - lo.x, up.y - lo.y, up.z - lo.z});
+  lo = (lo - centre) / half;
+  up = (up - centre) / half;
   Lattice L = readLattice(t0, boxOptions(lo, up));
   EXPECT_EQ(L.counts, (std::array<int, 3>{5, 5, 5}));
   EXPECT_EQ(L.degree, (std::array<int, 3>{2, 2, 2}));
@@ -331,13 +336,13 @@ TEST_F(LatticeIo, JsonDefaults) {
   Lattice L = readLattice(write("min.json", base + "}"));
   Lattice I = makeIdentityLattice(glm::dvec3(-1), glm::dvec3(1), {5, 5, 5}, {2, 2, 2});
   expectSameLattice(L, I);
-  EXPECT_EQ(L.controlPoints[L.index(1, 2, 3)], glm::dvec3(-2.0 / 3.0, 0.0, 2.0 / 3.0));
+  EXPECT_LT(glm::length(L.controlPoints[L.index(1, 2, 3)] - glm::dvec3(-2.0 / 3.0, 0.0, 2.0 / 3.0)), 1e-15);
   // Empty knot vectors are the default; comments are allowed; displacements add to the identity.
   std::string disp = base + ", // a comment\n \"knots\": {\"u\": [], \"v\": [], \"w\": []}, \"outside\": \"keep\", \"displacements\": [";
   for (int i = 0; i < 125; ++i) disp += std::string(i ? ", " : "") + (i == 62 ? "[0.5, 0, -0.25]" : "[0, 0, 0]");
   Lattice D = readLattice(write("disp.json", disp + "]}"));
   EXPECT_EQ(D.outside, OutsideMode::Keep);
-  EXPECT_EQ(D.controlPoints[62], glm::dvec3(0.5, 0, -0.25));   // the centre point (2,2,2) moved
+  EXPECT_EQ(D.controlPoints[62], I.controlPoints[62] + glm::dvec3(0.5, 0, -0.25));   // the centre point (2,2,2) moved
   EXPECT_EQ(D.controlPoints[61], I.controlPoints[61]);
 }
 
@@ -372,7 +377,7 @@ TEST_F(LatticeIo, JsonErrorsHaveLines) {
       {"degree6.json", doc("[1, 1, 6]", "[2, 2, 9]", box, ""), 4, "1..5"},
       {"degreef.json", doc("[1, 1, 1.5]", "[2, 2, 2]", box, ""), 4, "3 integers"},
       {"box.json", doc("[1, 1, 1]", "[2, 2, 2]", "{\"min\": [0, 0, 0], \"max\": [1, 0, 1]}", ""), 6, "zero-size"},
-      {"inf.json", doc("[1, 1, 1]", "[2, 2, 2]", "{\"min\": [0, 0, 0], \"max\": [1, 1e999, 1]}", ""), 6, "non-finite"},
+      {"inf.json", doc("[1, 1, 1]", "[2, 2, 2]", "{\"min\": [0, 0, 0], \"max\": [1, 1e999, 1]}", ""), 6, "number overflow"},
       {"count.json", doc("[1, 1, 1]", "[2, 2, 2]", box, ",\n\"control_points\": [\n  [0, 0, 0]\n]"), 7, "has 1 points"},
       {"point.json", doc("[1, 1, 1]", "[2, 2, 2]", box, ",\n\"control_points\": [\n" + pts7 + ",\n  [0, \"x\", 0]\n]"),
        15, "control_points[7]"},
@@ -431,7 +436,7 @@ TEST_F(LatticeIo, Presets) {
   EXPECT_NEAR(p.x, q.x, 1e-15);
   EXPECT_NEAR(std::hypot(p.y, p.z), std::hypot(q.y, q.z), 1e-14);
   EXPECT_NEAR(std::atan2(p.z, p.y) - std::atan2(q.z, q.y), std::numbers::pi / 4, 1e-14);
-  EXPECT_EQ(at(t, 2, 4, 4), at(I, 2, 4, 4));
+  EXPECT_LT(glm::length(at(t, 2, 4, 4) - at(I, 2, 4, 4)), 1e-15);
   Lattice tp = I;
   applyLatticePreset(tp, "taper", 1.0);
   EXPECT_NEAR(at(tp, 4, 4, 4).y, 0.5, 1e-15);   // halved at the high end

@@ -127,7 +127,8 @@ void finishMesh(Mesh& mesh, const std::vector<uint8_t>& fromFile, const std::str
       const glm::dvec3& m = mesh.normals[v];
       double len = glm::length(m);
       if (std::isfinite(m.x) && std::isfinite(m.y) && std::isfinite(m.z) && len > 0 && std::isfinite(len)) {
-        mesh.normals[v] = m / len;
+        // A normal already of unit length is kept bit for bit (so that files written by writeMesh read back exactly).
+        if (std::abs(len - 1.0) > 1e-15) mesh.normals[v] = m / len;
         compute[v] = 0;
         anyFromFile = true;
         continue;

@@ -7,6 +7,10 @@
 // (i,j)(i+1,j)(i+1,j+1) and (i,j)(i+1,j+1)(i,j+1): counter-clockwise seen from Su x Sv, 2 res^2 a patch.
 // The normal is the exact Su x Sv; where it vanishes (a collapsed patch edge: the lid apex, the bottom
 // centre) it is taken at a parameter nudged toward the patch interior.
+// Orientation: when the tessellation's signed volume (about its box centre) is negative, i.e. Su x Sv
+// points inward as it does for acaffd's t.bpt, every patch is stored transposed (points[4r+c] <->
+// points[4c+r], u and v swapped) so that Su x Sv of the stored patches points outward. `patches`,
+// vertexUV and the normals always agree with each other under the formula above.
 //
 // Welding: every patch keeps its own vertices (so that each triangle's vertices carry (u, v) of one
 // patch), but vertices of different patches whose positions agree within 1e-9 of the bounding box

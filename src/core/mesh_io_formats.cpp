@@ -4,6 +4,7 @@
 // line a file went wrong. Every count is checked against the bytes that are really there before
 // anything is allocated, and every error names the line (text) or the element (binary).
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstring>
 #include <unordered_map>
@@ -283,7 +284,6 @@ Mesh readPly(const std::string& path, const std::string& text) {
   mesh.normals.reserve(hasNormals ? size_t(vertexEl->count) : 0);
   mesh.triangles.reserve(size_t(faceEl->count));
   std::vector<uint32_t> poly;
-  std::vector<std::pair<uint64_t, size_t>> badIndex;   // checked after all elements (vertex may follow face)
   std::vector<double> values;
 
   if (format == Ascii) {

@@ -1,10 +1,16 @@
-// OpenMesh's own binary format (.om), read by OpenMesh. Its header counts are checked against the file
-// size first (OpenMesh reserves arrays from them), and the mesh it builds is checked before use: face
-// loops are walked by hand with every handle range-checked, since OpenMesh's headers keep their asserts
-// and a damaged file must not abort the program.
+// OpenMesh's own binary format (.om), read by OpenMesh. OpenMesh's .om reader is compiled with its
+// asserts on and trusts the file (a damaged chunk header aborts the whole program, as fuzzing showed),
+// so it runs in a forked child process: the child reads the file with OpenMesh, walks every face loop
+// with range-checked handles and sends positions, normals and polygons back through a pipe; if it dies
+// or fails, the file is reported as damaged. The header's counts are checked against the file size first.
+#include <cerrno>
 #include <cmath>
+#include <csignal>
 #include <cstring>
+#include <fcntl.h>
 #include <sstream>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <OpenMesh/Core/IO/MeshIO.hh>
 #include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
@@ -15,8 +21,84 @@
 
 namespace sffd::meshio {
 namespace {
+
 using OmMesh = OpenMesh::PolyMesh_ArrayKernelT<OpenMesh::DefaultTraitsDouble>;
+
+template <typename T>
+void put(std::string& out, const T& v) {
+  out.append(reinterpret_cast<const char*>(&v), sizeof v);
 }
+
+// In the child: OpenMesh reads `text`; the result is serialised into `out`:
+// u64 nv, u64 nf, u8 hasNormals, nv x 3 doubles positions, [nv x 3 doubles normals], then per face
+// u32 n and n u32 vertex indices. Returns an exit status (0 ok).
+int readInChild(const std::string& text, std::string& out) {
+  ::omlog().disable();
+  ::omout().disable();
+  ::omerr().disable();
+  OmMesh om;
+  om.request_vertex_normals();
+  OpenMesh::IO::Options opt = OpenMesh::IO::Options::VertexNormal;
+  opt += OpenMesh::IO::Options::Binary;
+  std::istringstream is(text, std::ios::in | std::ios::binary);
+  if (!OpenMesh::IO::read_mesh(om, is, ".om", opt)) return 3;
+  const bool hasNormals = opt.check(OpenMesh::IO::Options::VertexNormal) && om.has_vertex_normals();
+  const size_t n = om.n_vertices();
+  put(out, uint64_t(n));
+  put(out, uint64_t(om.n_faces()));
+  put(out, uint8_t(hasNormals));
+  for (size_t v = 0; v < n; ++v) {
+    const auto& p = om.point(OmMesh::VertexHandle{int(v)});
+    for (int c = 0; c < 3; ++c) put(out, double(p[c]));
+  }
+  if (hasNormals)
+    for (size_t v = 0; v < n; ++v) {
+      const auto& q = om.normal(OmMesh::VertexHandle{int(v)});
+      for (int c = 0; c < 3; ++c) put(out, double(q[c]));
+    }
+  const int nh = int(om.n_halfedges());
+  std::vector<uint32_t> poly;
+  for (size_t f = 0; f < om.n_faces(); ++f) {
+    OmMesh::HalfedgeHandle h0 = om.halfedge_handle(OmMesh::FaceHandle{int(f)}), h = h0;
+    if (h0.idx() < 0 || h0.idx() >= nh) return 4;
+    poly.clear();
+    do {
+      OmMesh::VertexHandle vh = om.to_vertex_handle(h);
+      if (vh.idx() < 0 || size_t(vh.idx()) >= n || int(poly.size()) > nh) return 4;
+      poly.push_back(uint32_t(vh.idx()));
+      h = om.next_halfedge_handle(h);
+      if (h.idx() < 0 || h.idx() >= nh) return 4;
+    } while (h != h0);
+    put(out, uint32_t(poly.size()));
+    for (uint32_t i : poly) put(out, i);
+  }
+  return 0;
+}
+
+bool writeAll(int fd, const std::string& s) {
+  size_t done = 0;
+  while (done < s.size()) {
+    ssize_t w = ::write(fd, s.data() + done, s.size() - done);
+    if (w < 0 && errno == EINTR) continue;
+    if (w <= 0) return false;
+    done += size_t(w);
+  }
+  return true;
+}
+
+struct Reader {
+  const std::string& s;
+  size_t pos = 0;
+  template <typename T>
+  bool get(T& v) {
+    if (s.size() - pos < sizeof v) return false;
+    std::memcpy(&v, s.data() + pos, sizeof v);
+    pos += sizeof v;
+    return true;
+  }
+};
+
+}  // namespace
 
 Mesh readOm(const std::string& path, const std::string& text) {
   if (text.size() < 16 || text[0] != 'O' || text[1] != 'M') throw inputError(path, 0, "not an OpenMesh .om file");
@@ -31,58 +113,82 @@ Mesh readOm(const std::string& path, const std::string& text) {
                                   " bytes can hold");
   if (nf == 0) throw inputError(path, 0, "no faces");
 
-  ::omlog().disable();
-  ::omout().disable();
-  ::omerr().disable();
-  OmMesh om;
-  om.request_vertex_normals();
-  OpenMesh::IO::Options opt = OpenMesh::IO::Options::VertexNormal;
-  opt += OpenMesh::IO::Options::Binary;
-  std::istringstream is(text, std::ios::in | std::ios::binary);
-  bool ok = false;
-  try {
-    ok = OpenMesh::IO::read_mesh(om, is, ".om", opt);
-  } catch (const std::exception& e) {
-    throw inputError(path, 0, std::string("OpenMesh could not read the file: ") + e.what());
+  int fds[2];
+  if (::pipe(fds) != 0) throw Error(ErrorKind::Internal, path + ": cannot create a pipe: " + std::strerror(errno));
+  std::fflush(nullptr);
+  pid_t pid = ::fork();
+  if (pid < 0) {
+    int e = errno;
+    ::close(fds[0]);
+    ::close(fds[1]);
+    throw Error(ErrorKind::Internal, path + ": cannot fork: " + std::strerror(e));
   }
-  if (!ok) throw inputError(path, 0, "OpenMesh could not read the file (damaged or unsupported .om)");
-  if (om.n_vertices() != nv || om.n_faces() != nf)
-    throw inputError(path, 0, "damaged .om file: read " + std::to_string(om.n_vertices()) + " vertices and " +
-                                  std::to_string(om.n_faces()) + " faces, the header declares " + std::to_string(nv) + " and " +
-                                  std::to_string(nf));
-  const bool hasNormals = opt.check(OpenMesh::IO::Options::VertexNormal) && om.has_vertex_normals();
-
-  Mesh mesh;
-  const size_t n = om.n_vertices();
-  mesh.positions.resize(n);
-  if (hasNormals) mesh.normals.resize(n);
-  for (size_t v = 0; v < n; ++v) {
-    OmMesh::VertexHandle vh{int(v)};
-    const auto& p = om.point(vh);
-    mesh.positions[v] = {p[0], p[1], p[2]};
-    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
-      throw inputError(path, 0, "vertex " + std::to_string(v) + ": non-finite coordinate");
-    if (hasNormals) {
-      const auto& q = om.normal(vh);
-      mesh.normals[v] = {q[0], q[1], q[2]};
+  if (pid == 0) {   // child: never returns
+    ::close(fds[0]);
+    int devnull = ::open("/dev/null", O_WRONLY);
+    if (devnull >= 0) {
+      ::dup2(devnull, 1);
+      ::dup2(devnull, 2);
     }
+    ::alarm(600);   // a file that sends OpenMesh into a loop
+    int rc = 5;
+    try {
+      std::string out;
+      rc = readInChild(text, out);
+      if (rc == 0 && !writeAll(fds[1], out)) rc = 6;
+    } catch (...) {
+      rc = 7;
+    }
+    ::_exit(rc);
   }
-  const int nh = int(om.n_halfedges());
+  ::close(fds[1]);
+  std::string data;
+  char buf[1 << 16];
+  while (true) {
+    ssize_t r = ::read(fds[0], buf, sizeof buf);
+    if (r < 0 && errno == EINTR) continue;
+    if (r <= 0) break;
+    data.append(buf, size_t(r));
+  }
+  ::close(fds[0]);
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+    std::string why = WIFSIGNALED(status) ? "OpenMesh crashed on it" : "OpenMesh could not read it";
+    throw inputError(path, 0, "damaged or unsupported .om file (" + why + ")");
+  }
+
+  Reader rd{data};
+  uint64_t n = 0, faces = 0;
+  uint8_t hasNormals = 0;
+  auto damaged = [&]() { return inputError(path, 0, "damaged .om file"); };
+  if (!rd.get(n) || !rd.get(faces) || !rd.get(hasNormals)) throw damaged();
+  if (n != nv || faces != nf)
+    throw inputError(path, 0, "damaged .om file: read " + std::to_string(n) + " vertices and " + std::to_string(faces) +
+                                  " faces, the header declares " + std::to_string(nv) + " and " + std::to_string(nf));
+  Mesh mesh;
+  mesh.positions.resize(n);
+  for (size_t v = 0; v < n; ++v) {
+    for (int c = 0; c < 3; ++c)
+      if (!rd.get(mesh.positions[v][c])) throw damaged();
+    const glm::dvec3& p = mesh.positions[v];
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+      throw inputError(path, 0, "vertex " + std::to_string(v) + ": non-finite coordinate");
+  }
+  if (hasNormals) {
+    mesh.normals.resize(n);
+    for (size_t v = 0; v < n; ++v)
+      for (int c = 0; c < 3; ++c)
+        if (!rd.get(mesh.normals[v][c])) throw damaged();
+  }
   std::vector<uint32_t> poly;
-  for (size_t f = 0; f < om.n_faces(); ++f) {
-    OmMesh::FaceHandle fh{int(f)};
-    auto bad = [&]() { return inputError(path, 0, "damaged .om file: face " + std::to_string(f) + " has broken connectivity"); };
-    OmMesh::HalfedgeHandle h0 = om.halfedge_handle(fh), h = h0;
-    if (h0.idx() < 0 || h0.idx() >= nh) throw bad();
-    poly.clear();
-    do {
-      OmMesh::VertexHandle vh = om.to_vertex_handle(h);
-      if (vh.idx() < 0 || size_t(vh.idx()) >= n || int(poly.size()) > nh) throw bad();
-      poly.push_back(uint32_t(vh.idx()));
-      h = om.next_halfedge_handle(h);
-      if (h.idx() < 0 || h.idx() >= nh) throw bad();
-    } while (h != h0);
-    if (poly.size() < 3) throw bad();
+  for (uint64_t f = 0; f < faces; ++f) {
+    uint32_t k = 0;
+    if (!rd.get(k) || k < 3 || k > n) throw damaged();
+    poly.resize(k);
+    for (uint32_t& i : poly)
+      if (!rd.get(i) || i >= n) throw damaged();
     fanTriangulate(poly.data(), poly.size(), mesh.triangles);
   }
   std::vector<uint8_t> fromFile(hasNormals ? n : 0, 1);

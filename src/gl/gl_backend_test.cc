@@ -329,10 +329,11 @@ TEST_P(GlProviderTest, DispatchBeyond65535GroupsViaGridFor) {
     nrm[4 * i + 2] = 1;
   }
   ClassicRun<float> r = runClassic(*b, {false, false}, L, pos, nrm);
-  EXPECT_EQ(r.groups[0], 65535u);
-  EXPECT_EQ(r.groups[1], 2u);
+  EXPECT_LE(r.groups[0], 65535u);
+  EXPECT_EQ(r.groups[1], 2u);   // more than 65535 groups of work: a second row of groups is needed
+  EXPECT_GE(uint64_t(r.groups[0]) * r.groups[1] * SFFD_LOCAL_SIZE, n);
   ASSERT_EQ(r.timings.size(), 1u);
-  std::printf("%s: %zu vertices, 65535 x 2 groups: %.1f ms by timestamps, %.1f ms wall with downloads\n",
+  std::printf("%s: %zu vertices, 2 rows of groups: %.1f ms by timestamps, %.1f ms wall with downloads\n",
               b->info().provider.c_str(), n, r.timings[0].gpuMs, r.wallMs);
   if (b->info().limits.timestamps) {
     EXPECT_GT(r.timings[0].gpuMs, 0.0);

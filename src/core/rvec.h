@@ -1,0 +1,35 @@
+// Small vector type of the C++ twins of the kernels (lattice_eval.h, pn_eval.h): the GLSL
+// operations the strict kernels use, one rounding each, in the same order. With -ffp-contract=off
+// the float instantiation matches the strict kernels bit for bit.
+#pragma once
+#include <cmath>
+
+#include <glm/glm.hpp>
+
+namespace sffd {
+
+template <class Real>
+struct RVec3 {
+  Real x = 0, y = 0, z = 0;
+  Real& operator[](int i) { return i == 0 ? x : (i == 1 ? y : z); }
+  Real operator[](int i) const { return i == 0 ? x : (i == 1 ? y : z); }
+  static RVec3 from(const glm::dvec3& v) { return {Real(v.x), Real(v.y), Real(v.z)}; }
+  glm::dvec3 glm() const { return {double(x), double(y), double(z)}; }
+};
+template <class Real> RVec3<Real> operator+(RVec3<Real> a, RVec3<Real> b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+template <class Real> RVec3<Real> operator-(RVec3<Real> a, RVec3<Real> b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+template <class Real> RVec3<Real> operator*(RVec3<Real> a, Real s) { return {a.x * s, a.y * s, a.z * s}; }
+template <class Real> RVec3<Real> operator/(RVec3<Real> a, Real s) { return {a.x / s, a.y / s, a.z / s}; }
+template <class Real> Real sdot(RVec3<Real> a, RVec3<Real> b) {
+  Real xy = a.x * b.x + a.y * b.y;
+  return xy + a.z * b.z;
+}
+template <class Real> RVec3<Real> scross(RVec3<Real> a, RVec3<Real> b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+template <class Real> RVec3<Real> snormalize(RVec3<Real> v) {
+  Real len = std::sqrt(sdot(v, v));
+  return {v.x / len, v.y / len, v.z / len};
+}
+
+}  // namespace sffd
