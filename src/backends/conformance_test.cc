@@ -11,6 +11,7 @@
 #include "buffer_compare.h"
 #include "classic_ffd.h"
 #include "error.h"
+#include "pn_triangles.h"
 #include "vk/vk_backend.h"
 
 using namespace sffd;
@@ -115,6 +116,30 @@ TEST_P(ClassicConformance, IdentityLatticeLeavesVerticesAndNormals) {
     EXPECT_NEAR(glm::length(glm::dvec3(out.positions[4 * v], out.positions[4 * v + 1], out.positions[4 * v + 2]) - mesh.positions[v]), 0, 1e-6);
     EXPECT_NEAR(glm::length(glm::dvec3(out.normals[4 * v], out.normals[4 * v + 1], out.normals[4 * v + 2]) - mesh.normals[v]), 0, 1e-6);
   }
+}
+
+TEST_P(ClassicConformance, PnKernelAgreesWithCpuReference) {
+  OpenedBackend b = open(GetParam());
+  for (const char* file : {"/acaffd/cube2.obj", "/acaffd/rabbit_cym.obj"}) {
+    SCOPED_TRACE(file);
+    PreparedMesh P = prepareMesh(readMesh(std::string(SFFD_SHARED_DATA) + file));
+    PnOutput cpuDouble = pnTrianglesCpu(P, {false, true}), cpuFloat = pnTrianglesCpu(P, {true, false});
+    // Fast kernels against the C++ float path: the same float inputs, so the ill-conditioned spots
+    // (normals of very short edges) agree too; the double reference would differ there by 1e-4.
+    CompareResult fast = compareBuffers(pnTrianglesGpu(*b.gpu, P, {false, false}).records, cpuFloat.records, true, {false, 64, 2e-6});
+    EXPECT_EQ(fast.mismatched, 0u) << "fast float: max_abs " << fast.maxAbs << " max_ulp " << fast.maxUlp;
+    CompareResult strict = compareBuffers(pnTrianglesGpu(*b.gpu, P, {true, false}).records, cpuFloat.records, true, {true, 0, 0});
+    EXPECT_EQ(strict.mismatched, 0u) << "strict float: max_abs " << strict.maxAbs << " max_ulp " << strict.maxUlp;
+    setenv("SFFD_MAX_CHUNK_TRIANGLES", "1000", 1);   // several chunks, the last one partial
+    CompareResult chunked = compareBuffers(pnTrianglesGpu(*b.gpu, P, {true, false}).records, cpuFloat.records, true, {true, 0, 0});
+    unsetenv("SFFD_MAX_CHUNK_TRIANGLES");
+    EXPECT_EQ(chunked.mismatched, 0u);
+    if (b.info.limits.float64) {
+      CompareResult d = compareBuffers(pnTrianglesGpu(*b.gpu, P, {true, true}).records, cpuDouble.records, false, {true, 0, 0});
+      EXPECT_EQ(d.mismatched, 0u) << "strict double";
+    }
+  }
+  EXPECT_EQ(vk::validationMessageCount(), 0u);
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, ClassicConformance, ::testing::ValuesIn(requiredBackends()),

@@ -1,5 +1,7 @@
 // sffd deform MESH -l LATTICE -o OUT: deforms a mesh and writes the result with vertex normals.
 #include <chrono>
+#include <cstdio>
+#include <optional>
 
 #include <nlohmann/json.hpp>
 
@@ -7,6 +9,8 @@
 #include "classic_ffd.h"
 #include "cli.h"
 #include "error.h"
+#include "job_budget.h"
+#include "lattice_fold.h"
 
 namespace sffd::cli {
 namespace {
@@ -19,6 +23,8 @@ int run(const ParsedArgs& args) {
     throw Error(ErrorKind::Input, "--method must be smooth, accurate or classic, not '" + method + "'");
   std::string clip = args.get("--clip", "regular");
   if (clip != "regular" && clip != "knot-box") throw Error(ErrorKind::Input, "--clip must be regular or knot-box");
+  auto opt = [&](const char* o) { return args.has(o) ? std::optional<std::string>(args.get(o)) : std::nullopt; };
+  checkSizeOptions(opt("--edge-length"), opt("--tess"));   // docs/ROBUSTNESS.md "Limits"
   checkOutputPath(out, {args.positional[0], args.get("--lattice")});
   if (args.has("--stats")) checkOutputPath(args.get("--stats"), {args.positional[0], args.get("--lattice"), out});
   if (method != "classic")
@@ -31,6 +37,9 @@ int run(const ParsedArgs& args) {
   variant.strict = args.has("--strict");
   variant.f64 = wantDouble(args, backend.info, /*autoDouble=*/true);
   PackedLattice packed = packLattice(job.lattice);
+  if (std::string w = foldWarning(checkLatticeFold(packed), job.latticePath); !w.empty()) std::fprintf(stderr, "sffd: warning: %s\n", w.c_str());
+  const DeviceLimits* limits = backend.gpu ? &backend.info.limits : nullptr;
+  checkJobFits(estimateClassicJob(job.mesh, packed, variant.f64 ? 8 : 4, limits), packed, variant.f64 ? 8 : 4, limits);
   ClassicOutput result = backend.gpu ? classicFfdGpu(*backend.gpu, job.mesh, packed, variant)
                                      : classicFfdCpu(job.mesh, packed, variant);
   Mesh deformed = applyClassicOutput(job.mesh, result);

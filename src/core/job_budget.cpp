@@ -1,0 +1,139 @@
+#include "job_budget.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <unistd.h>
+
+#include "error.h"
+#include "shader_layout.h"
+
+namespace sffd {
+
+void checkSizeOptions(const std::optional<std::string>& edgeLength, const std::optional<std::string>& tess) {
+  if (edgeLength) {
+    double l = 0;
+    const std::string& s = *edgeLength;
+    auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), l);
+    if (ec != std::errc() || p != s.data() + s.size() || !std::isfinite(l) || !(l > 0))
+      throw Error(ErrorKind::Input, "--edge-length must be a finite length > 0 in model units, not '" + s + "'");
+  }
+  if (tess) {
+    long long n = 0;
+    const std::string& s = *tess;
+    auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), n);
+    bool integer = p == s.data() + s.size() && !s.empty() && (ec == std::errc() || ec == std::errc::result_out_of_range);
+    if (!integer || ec != std::errc() || n < 1 || n > kMaxTessLevel)
+      throw Error(ErrorKind::Input, "--tess must be an integer 1.." + std::to_string(kMaxTessLevel) + ", not '" + s +
+                                        "' (level N makes N^2 triangles a patch)");
+  }
+}
+
+namespace {
+
+uint64_t meshBytes(const Mesh& m, bool withPatches) {
+  uint64_t b = m.positions.size() * sizeof(glm::dvec3) + m.normals.size() * sizeof(glm::dvec3) +
+               m.weldId.size() * sizeof(uint32_t) + m.triangles.size() * sizeof(m.triangles[0]);
+  if (withPatches)
+    b += m.patches.size() * sizeof(BicubicPatch) + m.vertexPatch.size() * sizeof(uint32_t) + m.vertexUV.size() * sizeof(glm::dvec2);
+  return b;
+}
+
+// Parses "123", "4K", "1.5G" (powers of 1024); 0 when it does not parse.
+uint64_t parseBytes(const char* s) {
+  char* end = nullptr;
+  double v = std::strtod(s, &end);
+  if (end == s || !std::isfinite(v) || v <= 0) return 0;
+  double f = 1;
+  switch (std::toupper(static_cast<unsigned char>(*end))) {
+    case 'K': f = 1024.0; ++end; break;
+    case 'M': f = 1024.0 * 1024; ++end; break;
+    case 'G': f = 1024.0 * 1024 * 1024; ++end; break;
+    case 'T': f = 1024.0 * 1024 * 1024 * 1024; ++end; break;
+    default: break;
+  }
+  if (*end == 'B' || *end == 'b') ++end;
+  if (*end != '\0') return 0;
+  double bytes = v * f;
+  return bytes >= 1.8e19 ? UINT64_MAX : uint64_t(bytes);
+}
+
+}  // namespace
+
+std::string formatBytes(uint64_t bytes) {
+  static const char* units[] = {"bytes", "KiB", "MiB", "GiB", "TiB"};
+  double v = double(bytes);
+  int u = 0;
+  while (v >= 1024 && u < 4) v /= 1024, ++u;
+  char buf[64];
+  if (u == 0) std::snprintf(buf, sizeof buf, "%llu bytes", static_cast<unsigned long long>(bytes));
+  else std::snprintf(buf, sizeof buf, "%.2f %s", v, units[u]);
+  return buf;
+}
+
+JobEstimate estimateClassicJob(const Mesh& mesh, const PackedLattice& P, size_t realBytes, const DeviceLimits* limits) {
+  JobEstimate e;
+  const uint64_t n = mesh.positions.size();
+  const uint64_t vertexBytes = 4 * uint64_t(realBytes);
+  e.chunkVertices = std::max<uint64_t>(n, 1);
+  if (limits) {   // as classicFfdGpu chunks
+    uint64_t byRange = limits->maxStorageBufferRange / vertexBytes;
+    uint64_t byGroups = uint64_t(limits->maxWorkGroupCount[0]) * limits->maxWorkGroupCount[1] * SFFD_LOCAL_SIZE;
+    e.chunkVertices = std::max<uint64_t>(1, std::min({byRange, byGroups, e.chunkVertices}));
+  }
+  e.chunks = (n + e.chunkVertices - 1) / e.chunkVertices;
+  const uint64_t lattice = (P.coeffs.size() + P.frame.size()) * uint64_t(realBytes);
+  uint64_t host = meshBytes(mesh, true)          // the input, held to the end
+                  + 8 * sizeof(double) * n       // ClassicOutput: positions and normals, 4 doubles each
+                  + meshBytes(mesh, false)       // the deformed copy written out
+                  + 76 * n                       // the writer's distinct-position index (hash node + bucket + id)
+                  + lattice                      // the coefficients converted to the kernel's real type
+                  + (1u << 20);                  // the writer's buffer
+  if (limits) {
+    host += 2 * vertexBytes * e.chunkVertices;    // upload/download staging of one chunk
+    e.deviceBytes = lattice + 4 * vertexBytes * e.chunkVertices;
+  }
+  e.hostBytes = host;
+  return e;
+}
+
+uint64_t hostMemoryLimit() {
+  if (const char* s = std::getenv("SFFD_MEMORY_LIMIT"); s && *s) {
+    uint64_t v = parseBytes(s);
+    if (v == 0) throw Error(ErrorKind::Input, std::string("SFFD_MEMORY_LIMIT must be a size like 4096, 512M or 2G, not '") + s + "'");
+    return v;
+  }
+  uint64_t limit = 0;
+  long pages = ::sysconf(_SC_PHYS_PAGES), pageSize = ::sysconf(_SC_PAGE_SIZE);
+  if (pages > 0 && pageSize > 0) limit = uint64_t(pages) * uint64_t(pageSize);
+  // A container's memory limit (cgroup v2, then v1) when it is lower.
+  for (const char* f : {"/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory/memory.limit_in_bytes"}) {
+    std::ifstream in(f);
+    std::string text;
+    if (!(in >> text) || text == "max") continue;
+    uint64_t v = parseBytes(text.c_str());
+    if (v > 0 && (limit == 0 || v < limit)) limit = v;
+  }
+  return limit;
+}
+
+void checkJobFits(const JobEstimate& e, const PackedLattice& P, size_t realBytes, const DeviceLimits* limits) {
+  const uint64_t limit = hostMemoryLimit();
+  if (limit > 0 && e.hostBytes > limit)
+    throw Error(ErrorKind::Input, "the job needs about " + formatBytes(e.hostBytes) + " of host memory, more than the limit of " +
+                                      formatBytes(limit) + (std::getenv("SFFD_MEMORY_LIMIT") ? " (SFFD_MEMORY_LIMIT)" : " (physical memory)") +
+                                      "; use a smaller mesh or split it");
+  if (limits) {
+    uint64_t coeffBytes = P.coeffs.size() * uint64_t(realBytes);
+    if (coeffBytes > limits->maxStorageBufferRange)
+      throw Error(ErrorKind::Input, "the lattice's Bezier coefficients take " + formatBytes(coeffBytes) +
+                                        ", more than one storage binding of this device can hold (" +
+                                        formatBytes(limits->maxStorageBufferRange) + "); use fewer control points or --precision float");
+  }
+}
+
+}  // namespace sffd
