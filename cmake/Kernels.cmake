@@ -1,7 +1,7 @@
 # Compiles every kernel in shaders/ to SPIR-V in four variants (strict x f64) with glslangValidator,
 # tracked by depfiles, and embeds them with the include-inlined GLSL into one generated C++ file.
 # Add a kernel by adding its stem to SFFD_KERNELS.
-set(SFFD_KERNELS classic_ffd pn_triangles)
+set(SFFD_KERNELS classic_ffd pn_triangles clip_count clip_write)
 
 set(SFFD_SHADER_DIR ${CMAKE_SOURCE_DIR}/shaders)
 set(SFFD_SPV_DIR ${CMAKE_BINARY_DIR}/spv)

@@ -8,6 +8,8 @@ endif()
 
 add_executable(split_pattern_gen tools/split_pattern_gen.cpp)
 target_include_directories(split_pattern_gen PRIVATE src/core)
+# Runs on every clean build: optimised in Debug builds too (0.5 s instead of 5; same output bytes).
+target_compile_options(split_pattern_gen PRIVATE $<$<CXX_COMPILER_ID:GNU,Clang>:-O2>)
 
 set(SFFD_SPLIT_PATTERNS_CPP ${CMAKE_BINARY_DIR}/generated/split_patterns.cpp)
 add_custom_command(

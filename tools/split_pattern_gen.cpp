@@ -64,8 +64,8 @@ struct Tri {
   int nb[3];
 };
 
-// Delaunay triangulation of points inside the canonical triangle whose corners are points 0, 1, 2
-// of `corners`. Points are inserted one at a time; each must be new and inside (or on) the domain.
+// Delaunay triangulation of points p (fixed point; x: the same in the Euclidean frame) inside the
+// triangle of points c0, c1, c2. Points are inserted one at a time, each new and inside or on it.
 class Triangulation {
  public:
   Triangulation(const std::vector<Fixed>& p, const std::vector<Vec2>& x, int c0, int c1, int c2) : p_(p), x_(x) {
@@ -426,7 +426,8 @@ int main(int argc, char** argv) {
     if (!(fs::exists(outPath) && readText(outPath) == o)) {
       fs::path tmp = outPath;
       tmp += ".tmp";
-      std::ofstream(tmp, std::ios::binary) << o;
+      std::ofstream f(tmp, std::ios::binary);
+      if (!(f << o) || (f.close(), !f)) throw std::runtime_error("cannot write " + tmp.string());
       fs::rename(tmp, outPath);
     }
     if (verbose)

@@ -62,7 +62,8 @@ SFFD_STRUCT_END(ClassicParams)
 #define SFFD_BINDING_MESH_NORMALS 4        // real4 per vertex, unit (w unused)
 #define SFFD_BINDING_MESH_TRIANGLES 5      // 2 uvec4 per triangle: vertex ids (w unused), weld ids (w unused)
 #define SFFD_BINDING_MESH_SLOT_NORMALS 6   // 12 real4 per triangle: per corner slot, the first then the second
-                                           // normal of the slot (w of the first: 1 crease, 0 smooth)
+                                           // normal of the slot (w of the first: 1 crease, 0 smooth;
+                                           // w of the second: 1 when the first is the triangle's own)
 #define SFFD_BINDING_PN_OUT 7              // SFFD_PN_STRIDE real4 per triangle
 #define SFFD_MESH_TRIANGLE_STRIDE 2
 #define SFFD_SLOT_NORMAL_STRIDE 12
@@ -70,6 +71,38 @@ SFFD_STRUCT_END(ClassicParams)
 // then the 6 quadratic normal control points (200,110,101,020,011,002).
 #define SFFD_PN_STRIDE 16
 #define SFFD_PN_NORMALS 10
+
+// ---- kernels clip_count and clip_write: regular clipping by the split-pattern table (ALGORITHM.md 4.2) ----
+// One thread per clip triangle (an original triangle, or a piece of one after the pre-split of
+// triangles whose edges need more than Nmax segments). Buffers 3..7 are the mesh and PN buffers above.
+#define SFFD_BINDING_SPLIT_TABLE 1     // uint: pattern entries (4 each), then vertices (4 each: lambda bits, edge | step << 16), then packed uint16 triangle indices
+#define SFFD_BINDING_CLIP_COUNTS 2     // uint per clip triangle: sub-triangle count (clip_count), exclusive offset (clip_write)
+#define SFFD_BINDING_CLIP_HEADERS 8    // 2 uvec4 per clip triangle: (parent, corner kinds, 0, 0), corner weld ids
+#define SFFD_BINDING_CLIP_REALS 9      // 9 real4 per clip triangle: lam[3], flat[3], edge params[3]
+#define SFFD_BINDING_SUB_HEADERS 10    // uvec4 per sub-triangle: parent, crease slot bits, 0, 0
+#define SFFD_BINDING_SUB_RECORDS 11    // SFFD_SUB_STRIDE real4 per sub-triangle
+#define SFFD_CLIP_HEADER_STRIDE 2
+#define SFFD_CLIP_REAL_STRIDE 9
+// Corner kinds of a clip triangle (packed 8 bits each in header.y): the corner is parent corner k (0..2),
+// lies on parent edge e (3 + e) at the parameter in its edge params, or inside the parent (6).
+#define SFFD_CORNER_INTERIOR 6u
+// Edge params of clip edge e (corner e -> corner e+1): x = parent edge it lies on (-1: none),
+// y = parameter of corner e along that parent edge, z = of corner e+1; parameters are measured from
+// the parent edge's endpoint with the lower weld id.
+// Sub-triangle record (ALGORITHM.md 3.3): lam[3], x_pn[3], x_flat[3], n_lin[3], n_pn[3], n_nbr[6].
+#define SFFD_SUB_STRIDE 21
+#define SFFD_SUB_LAM 0
+#define SFFD_SUB_XPN 3
+#define SFFD_SUB_XFLAT 6
+#define SFFD_SUB_NLIN 9
+#define SFFD_SUB_NPN 12
+#define SFFD_SUB_NNBR 15
+
+SFFD_STRUCT_BEGIN(ClipParams)
+  SFFD_UVEC4 range;    // x: first clip triangle, y: clip triangle count
+  SFFD_UVEC4 table;    // x: Nmax, y: first vertex word, z: first triangle word
+  SFFD_VEC4 target;    // x: target edge length l
+SFFD_STRUCT_END(ClipParams)
 
 SFFD_STRUCT_BEGIN(PnParams)
   SFFD_UVEC4 range;   // x: first triangle, y: triangle count

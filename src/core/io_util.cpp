@@ -34,6 +34,28 @@ std::string readWholeFile(const std::string& path) {
   return data;
 }
 
+void checkTextEncoding(const std::string& path, std::string& text, bool mayHoldBinary) {
+  auto startsWith = [&](std::string_view p) { return text.size() >= p.size() && std::string_view(text).substr(0, p.size()) == p; };
+  using namespace std::string_view_literals;
+  if (startsWith("\xFF\xFE\0\0"sv) || startsWith("\0\0\xFE\xFF"sv))
+    throw inputError(path, 0, "UTF-32 text (byte-order mark) is not supported; save the file as UTF-8 or ASCII");
+  if (startsWith("\xFF\xFE"sv) || startsWith("\xFE\xFF"sv))
+    throw inputError(path, 0, "UTF-16 text (byte-order mark " + std::string(text[0] == '\xFF' ? "FF FE" : "FE FF") +
+                                  ") is not supported; save the file as UTF-8 or ASCII");
+  if (startsWith("\xEF\xBB\xBF"sv)) {
+    text = text.substr(3);
+    if (text.empty()) throw inputError(path, 0, "empty file (only a UTF-8 byte-order mark)");
+  }
+  if (mayHoldBinary) return;
+  size_t nul = text.find('\0');
+  if (nul == std::string::npos) return;
+  // UTF-16 without a byte-order mark: every other byte of ASCII text is NUL.
+  bool utf16 = text.size() >= 4 && ((text[0] != '\0' && text[1] == '\0' && text[3] == '\0') ||
+                                    (text[0] == '\0' && text[1] != '\0' && text[2] == '\0'));
+  if (utf16) throw inputError(path, 0, "UTF-16 text is not supported; save the file as UTF-8 or ASCII");
+  throw inputError(path, lineOfOffset(text, nul), "binary data (a NUL byte) in a text file");
+}
+
 std::string lowerExtension(const std::string& path) {
   std::string ext = fs::path(path).extension().string();
   for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));

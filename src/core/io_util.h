@@ -13,6 +13,11 @@ namespace sffd::io {
 // or a directory.
 std::string readWholeFile(const std::string& path);
 
+// Checks the encoding of a text file read whole: a UTF-16 or UTF-32 byte-order mark, or (unless
+// `mayHoldBinary`, for formats with a binary variant) a NUL byte, is an input error naming the file
+// (and the line of the NUL); a UTF-8 byte-order mark is removed.
+void checkTextEncoding(const std::string& path, std::string& text, bool mayHoldBinary);
+
 // ".obj" for "dir/Mesh.OBJ" (lower case, with the dot; empty when there is none).
 std::string lowerExtension(const std::string& path);
 

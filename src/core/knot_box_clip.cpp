@@ -89,30 +89,53 @@ PolyVertex crossing(const Parent& T, const PolyVertex& a, const PolyVertex& b, i
   return r;
 }
 
-int side(double x, double k) { return x < k ? -1 : (x > k ? 1 : 0); }
+// Which side of p_d = k a polygon vertex is on; within `eps` of the plane counts as on it. Without the
+// tolerance a point that lies on two planes at once (where a parent edge passes through a line of the
+// lattice grid, common when mesh and lattice share a symmetry) reads as a hair off the second plane
+// after rounding, and the second plane inserts a twin point next to it. The test depends only on the
+// point, and points on a parent edge are the same bits in both of its triangles, so both decide alike.
+int side(const PolyVertex& v, int d, double k, double eps) {
+  const double x = v.p[d] - k;
+  return x < -eps ? -1 : (x > eps ? 1 : 0);
+}
 
-// Splits a convex polygon that has vertices strictly on both sides of p_d = k. Vertices on the plane
-// go to both pieces (never duplicated within one), crossings are inserted into both.
-void splitPolygon(const Parent& T, const Polygon& poly, int d, double k, Polygon& below, Polygon& above) {
+// Splits a convex polygon by p_d = k. Vertices on the plane go to both pieces (never duplicated
+// within one), crossings are inserted into both. Returns false, building nothing, when no vertex lies
+// strictly on one of the two sides: a plane that only touches the polygon makes no piece.
+bool splitPolygon(const Parent& T, const Polygon& poly, int d, double k, double eps, Polygon& below, Polygon& above,
+                  bool& wholeBelow, std::vector<int>& sides) {
+  const size_t n = poly.size();
+  sides.resize(n);
+  bool neg = false, pos = false;
+  for (size_t i = 0; i < n; ++i) {
+    sides[i] = side(poly[i], d, k, eps);
+    neg |= sides[i] < 0;
+    pos |= sides[i] > 0;
+  }
+  wholeBelow = !pos;
+  if (!neg || !pos) return false;
   below.clear();
   above.clear();
-  const size_t n = poly.size();
   for (size_t i = 0; i < n; ++i) {
-    const PolyVertex& a = poly[i];
-    const PolyVertex& b = poly[(i + 1) % n];
-    const int sa = side(a.p[d], k), sb = side(b.p[d], k);
-    if (sa <= 0) below.push_back(a);
-    if (sa >= 0) above.push_back(a);
-    if (sa * sb < 0) {
-      PolyVertex x = crossing(T, a, b, d, k);
+    const size_t j = (i + 1) % n;
+    if (sides[i] <= 0) below.push_back(poly[i]);
+    if (sides[i] >= 0) above.push_back(poly[i]);
+    if (sides[i] * sides[j] < 0) {
+      PolyVertex x = crossing(T, poly[i], poly[j], d, k);
       below.push_back(x);
       above.push_back(x);
     }
   }
+  return true;
 }
 
-// |sin| of the fan angle at the apex below this counts as collinear: zero area up to rounding.
+// Relative distance from a plane below which a vertex counts as on it (see `side`).
+constexpr double kOnPlane = 1e-13;
+// A fan triangle is degenerate (zero area up to rounding) when |sin| of its angle at the apex is below
+// kCollinear (a parent of no area), or when two of its corners are closer than kCoincident times the
+// parent's diameter (twin points that rounding may still make, a few ulps apart).
 constexpr double kCollinear = 1e-14;
+constexpr double kCoincident = 1e-13;
 
 }  // namespace
 
@@ -129,11 +152,20 @@ std::vector<SubTriangle> clipAgainstKnotBoxes(const Mesh& mesh, const Lattice& l
   out.reserve(mesh.triangles.size() * 2);
   std::vector<Polygon> current, next;
   Polygon below, above, rest;
+  std::vector<int> sides;
 
   for (size_t t = 0; t < mesh.triangles.size(); ++t) {
     const auto& tri = mesh.triangles[t];
     Parent T;
     for (int c = 0; c < 3; ++c) T.p[c] = lattice.frameLinear * mesh.positions[tri[c]] + lattice.frameOffset;
+    glm::dvec3 scale(0.0);
+    double diameter = 0;
+    for (int c = 0; c < 3; ++c) {
+      scale = glm::max(scale, glm::abs(T.p[c]));
+      diameter = std::max(diameter, glm::length(T.p[(c + 1) % 3] - T.p[c]));
+    }
+    // On-plane tolerance per axis: a few hundred ulps of the parent's coordinates in parameter space.
+    const glm::dvec3 eps = kOnPlane * (scale + glm::dvec3(diameter));
     for (int e = 0; e < 3; ++e) {
       const int a = e, b = (e + 1) % 3;
       const bool aFirst = mesh.weldId[tri[a]] <= mesh.weldId[tri[b]];
@@ -160,15 +192,18 @@ std::vector<SubTriangle> clipAgainstKnotBoxes(const Mesh& mesh, const Lattice& l
           mn = std::min(mn, pv.p[d]);
           mx = std::max(mx, pv.p[d]);
         }
-        // Only planes strictly between the extremes cut; one through a vertex merely touches.
-        auto first = std::upper_bound(planes[d].begin(), planes[d].end(), mn);
-        auto last = std::lower_bound(planes[d].begin(), planes[d].end(), mx);
+        // Candidate planes: beyond these every vertex is strictly on one side.
+        auto first = std::lower_bound(planes[d].begin(), planes[d].end(), mn - 2 * eps[d]);
+        auto last = std::upper_bound(planes[d].begin(), planes[d].end(), mx + 2 * eps[d]);
         rest = std::move(poly);
         // Ascending sweep: the piece below a plane lies below every later one, so only the piece
-        // above goes on. Each plane lies strictly between the remaining piece's extremes (its minimum
-        // is now the previous plane), so both pieces are proper.
+        // above goes on.
         for (auto it = first; it < last; ++it) {
-          splitPolygon(T, rest, d, *it, below, above);
+          bool wholeBelow = false;
+          if (!splitPolygon(T, rest, d, *it, eps[d], below, above, wholeBelow, sides)) {
+            if (wholeBelow) break;
+            continue;
+          }
           if (below.size() >= 3) next.push_back(below);
           std::swap(rest, above);
         }
@@ -182,7 +217,9 @@ std::vector<SubTriangle> clipAgainstKnotBoxes(const Mesh& mesh, const Lattice& l
     for (const Polygon& poly : current)
       for (size_t i = 1; i + 1 < poly.size(); ++i) {
         const glm::dvec3 a = poly[i].p - poly[0].p, b = poly[i + 1].p - poly[0].p;
-        if (!(glm::length(glm::cross(a, b)) > kCollinear * glm::length(a) * glm::length(b))) continue;
+        const double la = glm::length(a), lb = glm::length(b), lc = glm::length(b - a);
+        if (!(std::min({la, lb, lc}) > kCoincident * diameter)) continue;
+        if (!(glm::length(glm::cross(a, b)) > kCollinear * la * lb)) continue;
         SubTriangle s;
         s.parent = uint32_t(t);
         s.corners = {poly[0].v, poly[i].v, poly[i + 1].v};

@@ -243,6 +243,10 @@ TEST(KnotBoxClip, Cube2) {
   std::vector<SubTriangle> subs = clipAgainstKnotBoxes(m, L);
   ClipStats st = checkClip(m, L, subs);
   EXPECT_EQ(st.sharedEdgesChecked, 18u);   // crease edges included: adjacency is by weldId
+  // Each face is cut into 3x3 squares, two triangles each. The face diagonals pass exactly through
+  // grid points, where two planes meet: no twin points, no slivers.
+  EXPECT_EQ(subs.size(), 6u * 9u * 2u);
+  EXPECT_NEAR(st.minAngle, 45.0, 1e-9);
   printStats("cube2.obj", m.triangles.size(), st, 0);
 }
 
@@ -334,7 +338,9 @@ TEST(KnotBoxClip, PlanesThroughCornersAndAlongEdgesMakeNoSlivers) {
         if (v.kind == SubVertexKind::Interior) interior.push_back(v.lam);
     for (const auto& a : interior)
       for (const auto& b : interior)
-        if (glm::length(a - b) < 1e-9) EXPECT_EQ(a, b);
+        if (glm::length(a - b) < 1e-9) {
+          EXPECT_EQ(a, b);
+        }
   }
 }
 
@@ -382,6 +388,52 @@ TEST(KnotBoxClip, RandomHeightFieldWithVerticesOnPlanes) {
   ClipStats st = checkClip(m, L, subs);
   EXPECT_EQ(st.sharedEdgesChecked, size_t(3 * n * n - 2 * n));
   printStats("random height field", m.triangles.size(), st, 0);
+}
+
+TEST(KnotBoxClip, RandomFramesAndKnotsStayCrackFree) {
+  // Random rotated and scaled frames, degrees 1..3 and non-uniform knots, some of them placed exactly
+  // on vertex coordinates (planes through vertices, along edges when a mesh is axis-aligned).
+  std::mt19937 rng(2024);
+  std::uniform_real_distribution<double> uni(0.0, 1.0);
+  for (const char* name : {"cube2.obj", "sphere.obj", "rabbit_cym.obj"}) {
+    const Mesh m = load(name);
+    for (int round = 0; round < 4; ++round) {
+      SCOPED_TRACE(std::string(name) + " round " + std::to_string(round));
+      Lattice L;
+      if (round > 0) {
+        glm::dvec3 axis = glm::normalize(glm::dvec3(uni(rng) - 0.5, uni(rng) - 0.5, uni(rng) - 0.5));
+        double angle = 3 * uni(rng), c = std::cos(angle), s = std::sin(angle);
+        glm::dmat3 K(0, axis.z, -axis.y, -axis.z, 0, axis.x, axis.y, -axis.x, 0);   // cross-product matrix
+        glm::dmat3 R = glm::dmat3(1.0) + s * K + (1 - c) * K * K;
+        L.frameLinear = R * glm::dmat3(0.5 + uni(rng), 0, 0, 0, 0.5 + uni(rng), 0, 0, 0, 0.5 + uni(rng));
+        L.frameOffset = glm::dvec3(uni(rng), uni(rng), uni(rng));
+      }
+      glm::dvec3 lo(1e300), hi(-1e300);
+      for (const auto& p : m.positions) {
+        lo = glm::min(lo, param(L, p));
+        hi = glm::max(hi, param(L, p));
+      }
+      for (int a = 0; a < 3; ++a) {
+        L.degree[a] = 1 + int(rng() % 3);
+        std::vector<double> inner;
+        const int n = 1 + int(rng() % 6);
+        for (int i = 0; i < n; ++i) {
+          // Half the knots at a vertex's coordinate, half anywhere.
+          double k = rng() % 2 ? param(L, m.positions[rng() % m.positions.size()])[a] : lo[a] + (hi[a] - lo[a]) * uni(rng);
+          if (k > lo[a] && k < hi[a]) inner.push_back(k);
+        }
+        std::sort(inner.begin(), inner.end());
+        std::vector<double>& U = L.knots[a];
+        U.assign(size_t(L.degree[a]) + 1, lo[a]);
+        U.insert(U.end(), inner.begin(), inner.end());
+        U.insert(U.end(), size_t(L.degree[a]) + 1, hi[a]);
+        L.counts[a] = int(U.size()) - L.degree[a] - 1;
+      }
+      std::vector<SubTriangle> subs = clipAgainstKnotBoxes(m, L);
+      checkClip(m, L, subs);
+      if (::testing::Test::HasFailure()) return;
+    }
+  }
 }
 
 }  // namespace

@@ -308,6 +308,7 @@ Lattice readLattice(const std::string& path, const LatticeReadOptions& options) 
                      "unknown lattice format " + (ext.empty() ? std::string("(no extension)") : io::quoted(ext)) +
                          "; expected .json, .prm or .npy");
   std::string text = io::readWholeFile(path);
+  if (ext != ".npy") io::checkTextEncoding(path, text, false);   // no UTF-16, no binary; a UTF-8 BOM skipped
   if (ext == ".json") return latticeio::readJson(path, text);
   if (ext == ".prm") return latticeio::readPrm(path, text);
   return latticeio::readNpy(path, text, options);

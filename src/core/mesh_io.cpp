@@ -24,6 +24,9 @@ Mesh readMesh(const std::string& path, const MeshReadOptions& options) {
                      "unknown mesh format " + (ext.empty() ? std::string("(no extension)") : io::quoted(ext)) +
                          "; expected .obj, .off, .ply, .stl, .om or .bpt");
   std::string text = io::readWholeFile(path);
+  // Text formats: no UTF-16, no binary data, a UTF-8 byte-order mark skipped. PLY has binary
+  // variants (its header is checked by the PLY reader); STL and .om are checked by theirs.
+  if (ext == ".obj" || ext == ".off" || ext == ".bpt" || ext == ".ply") io::checkTextEncoding(path, text, ext == ".ply");
   if (ext == ".obj") return meshio::readObj(path, text);
   if (ext == ".off") return meshio::readOff(path, text);
   if (ext == ".ply") return meshio::readPly(path, text);

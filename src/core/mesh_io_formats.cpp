@@ -524,13 +524,26 @@ Mesh readStl(const std::string& path, const std::string& text) {
   // ASCII files start with "solid"; so do some binary ones (their 80-byte header is free text). Such a
   // file is binary when its size is exactly 84 + 50 n for the count at byte 80 and it does not read as
   // ASCII text (a NUL byte, or no "endsolid").
+  // A file that does not start with "solid" but is not binary either: UTF-16 text is named as such.
   bool ascii = startsWithSolid(text);
-  if (ascii && text.size() >= 84) {
+  bool sizeFits = false;
+  if (text.size() >= 84) {
     uint32_t n = 0;
     std::memcpy(&n, text.data() + 80, 4);
-    bool sizeFits = 84 + 50 * uint64_t(n) == text.size();
-    bool looksText = std::memchr(text.data(), '\0', text.size()) == nullptr && text.find("endsolid") != std::string::npos;
+    sizeFits = 84 + 50 * uint64_t(n) == text.size();
+  }
+  const bool hasNul = std::memchr(text.data(), '\0', text.size()) != nullptr;
+  if (ascii && text.size() >= 84) {
+    bool looksText = !hasNul && text.find("endsolid") != std::string::npos;
     if (sizeFits && !looksText) ascii = false;
+    // Neither size fits nor text: a binary STL with a "solid" header, cut short or padded; reported as
+    // binary (its sizes), not as an ASCII syntax error.
+    if (!sizeFits && hasNul) ascii = false;
+  }
+  if (!ascii && !sizeFits && text.size() >= 2 &&
+      (text.compare(0, 2, "\xFF\xFE") == 0 || text.compare(0, 2, "\xFE\xFF") == 0)) {
+    std::string copy = text.substr(0, 4);
+    io::checkTextEncoding(path, copy, true);   // throws: UTF-16 (or UTF-32) text
   }
   return ascii ? readStlAscii(path, text) : readStlBinary(path, text);
 }

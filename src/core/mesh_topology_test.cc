@@ -240,8 +240,9 @@ TEST(MeshTopology, NormalsWithinToleranceAreNotACrease) {
   MeshTopology far = buildTopology(m);
   expectConsistent(m, far);
   EXPECT_EQ(far.creaseEdges, 1u);
-  EXPECT_EQ(far.creaseSlot[0][2], 1);   // corner 1 of triangle 0, edge 0
-  EXPECT_EQ(far.creaseSlot[0][3], 0);   // corner 1 on the boundary edge 1
+  EXPECT_EQ(far.creaseSlot[0][3], 1);   // corner 1 of triangle 0 on the shared edge 1
+  EXPECT_EQ(far.creaseSlot[0][2], 0);   // corner 1 on the boundary edge 0
+  EXPECT_EQ(far.creaseSlot[0][5], 0);   // corner 2 on edge 1: the same vertex 2 on both sides
 }
 
 TEST(MeshTopology, NonManifoldEdgeIsLeftUnconnectedAndCounted) {

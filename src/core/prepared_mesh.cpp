@@ -33,7 +33,7 @@ PreparedMesh prepareMesh(const Mesh& mesh) {
       const glm::dvec3& b = ownFirst ? nOther : nOwn;
       double* d = &P.slotNormals[48 * t + 8 * s];
       d[0] = a.x, d[1] = a.y, d[2] = a.z, d[3] = P.topology.creaseSlot[t][s] ? 1 : 0;
-      d[4] = b.x, d[5] = b.y, d[6] = b.z, d[7] = 0;
+      d[4] = b.x, d[5] = b.y, d[6] = b.z, d[7] = ownFirst ? 1 : 0;
     }
   }
   return P;

@@ -13,7 +13,7 @@ struct PreparedMesh {
   std::vector<double> positions;     // 4 per vertex (x, y, z, 1)
   std::vector<double> normals;       // 4 per vertex (x, y, z, 0)
   std::vector<uint32_t> triangles;   // 8 per triangle: vertex ids, 0, weld ids, 0
-  std::vector<double> slotNormals;   // 48 per triangle: per slot, first (w: 1 crease) then second normal
+  std::vector<double> slotNormals;   // 48 per triangle: per slot, first (w: 1 crease) then second normal (w: 1 when the first is the triangle's own)
   MeshTopology topology;
   size_t triangleCount() const { return triangles.size() / 8; }
 };

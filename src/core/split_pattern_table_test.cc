@@ -186,7 +186,7 @@ struct Stats {
 TEST(SplitPatternTable, QualityMatchesTheSpec) {
   const SplitPatternTable& table = splitPatternTable();
   const int nmax = table.nmax();
-  Stats upTo19, upTo19NotFlat, all;
+  Stats upTo19, upTo19NotFlat, all, allNotFlat;
   for (int a = 1; a <= nmax; ++a)
     for (int b = a; b <= nmax; ++b)
       for (int c = b; c <= std::min(nmax, a + b); ++c) {
@@ -198,22 +198,28 @@ TEST(SplitPatternTable, QualityMatchesTheSpec) {
           double l[3], area = orient(v[0], v[1], v[2]) / 2;
           for (int i = 0; i < 3; ++i) l[i] = std::hypot(v[(i + 1) % 3].x - v[i].x, v[(i + 1) % 3].y - v[i].y);
           double q = 2 * std::sqrt(3.0) * (2 * area / (l[0] + l[1] + l[2])) / std::max({l[0], l[1], l[2]});
+          bool flat = a + b == c;
           all.q.push_back(q);
+          if (!flat) allNotFlat.q.push_back(q);
           if (c <= 19) upTo19.q.push_back(q);
-          if (c <= 19 && a + b != c) upTo19NotFlat.q.push_back(q);
+          if (c <= 19 && !flat) upTo19NotFlat.q.push_back(q);
         }
       }
+  std::string n = std::to_string(nmax);
   upTo19.print("counts <= 19");
   upTo19NotFlat.print("counts <= 19, a + b > c");
-  all.print("counts <= " + std::to_string(nmax));
+  all.print("counts <= " + n);
+  allNotFlat.print("counts <= " + n + ", a + b > c");
   for (Stats* s : {&upTo19, &all}) {
-    EXPECT_GT(s->q[0], 0.03);
     EXPECT_GT(s->p1(), 0.30);
     EXPECT_GT(s->median(), 0.92);
     EXPECT_GT(s->mean(), 0.87);
     EXPECT_LT(s->shareBelow(0.3), 0.01);
   }
-  EXPECT_GT(upTo19NotFlat.q[0], 0.08);
+  // The minima come from (nearly) flat triples, whose canonical triangle is itself a sliver that
+  // thins as c grows, so only the counts <= 19 minima are bounded (spec: 0.041; 0.088 unflat).
+  EXPECT_GE(upTo19.q[0], 0.04);
+  EXPECT_GE(upTo19NotFlat.q[0], 0.08);
 }
 
 }  // namespace
