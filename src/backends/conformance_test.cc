@@ -12,6 +12,8 @@
 #include "classic_ffd.h"
 #include "error.h"
 #include "pn_triangles.h"
+#include "regular_clip.h"
+#include "split_pattern_table.h"
 #include "vk/vk_backend.h"
 
 using namespace sffd;
@@ -138,6 +140,32 @@ TEST_P(ClassicConformance, PnKernelAgreesWithCpuReference) {
       CompareResult d = compareBuffers(pnTrianglesGpu(*b.gpu, P, {true, true}).records, cpuDouble.records, false, {true, 0, 0});
       EXPECT_EQ(d.mismatched, 0u) << "strict double";
     }
+  }
+  EXPECT_EQ(vk::validationMessageCount(), 0u);
+}
+
+TEST_P(ClassicConformance, ClipKernelsAgreeWithCpuReference) {
+  OpenedBackend b = open(GetParam());
+  for (auto [file, l] : {std::pair{"/acaffd/cube2.obj", 0.09}, std::pair{"/acaffd/rabbit_cym.obj", 0.04}}) {
+    SCOPED_TRACE(file);
+    Mesh m = readMesh(std::string(SFFD_SHARED_DATA) + file);
+    PreparedMesh P = prepareMesh(m);
+    ClipTriangles C = buildClipTriangles(m, l, splitPatternTable().nmax());
+    for (KernelVariant v : {KernelVariant{true, false}, KernelVariant{false, false}}) {
+      PnOutput pn = pnTrianglesCpu(P, {true, false});   // the same PN input for both sides
+      SubTriangleRecords cpu = regularClipCpu(P, pn, C, l, {true, false});
+      SubTriangleRecords gpu = regularClipGpu(*b.gpu, P, pn, C, l, v);
+      ASSERT_EQ(gpu.headers, cpu.headers) << "sub-triangle topology differs (strict " << v.strict << ")";
+      CompareTolerance tol = v.strict ? CompareTolerance{true, 0, 0} : CompareTolerance{false, 64, 2e-6};
+      CompareResult r = compareBuffers(gpu.records, cpu.records, true, tol);
+      EXPECT_EQ(r.mismatched, 0u) << "strict " << v.strict << ": max_abs " << r.maxAbs << " max_ulp " << r.maxUlp;
+    }
+    // Written in several chunks, the output is the same.
+    PnOutput pn = pnTrianglesCpu(P, {true, false});
+    setenv("SFFD_MAX_CHUNK_SUBTRIANGLES", "777", 1);
+    SubTriangleRecords chunked = regularClipGpu(*b.gpu, P, pn, C, l, {true, false});
+    unsetenv("SFFD_MAX_CHUNK_SUBTRIANGLES");
+    EXPECT_EQ(chunked.records, regularClipCpu(P, pn, C, l, {true, false}).records);
   }
   EXPECT_EQ(vk::validationMessageCount(), 0u);
 }
