@@ -72,10 +72,16 @@ bool wantDouble(const ParsedArgs& args, const DeviceInfo& info, bool autoDouble)
 
 void note(const ParsedArgs& args, const std::string& line);   // stderr unless --quiet
 
+// Refuses a target edge length that is not positive, or so small that the sub-triangles would
+// exceed kMaxSubTriangles (the message gives the estimate).
+constexpr double kMaxSubTriangles = 50e6;
+void checkEdgeLength(const Mesh& mesh, double l);
+
 // The commands, one file each.
 CommandSpec deformCommand();
 CommandSpec latticeCommand();
 CommandSpec devicesCommand();
 CommandSpec conformCommand();
+CommandSpec clipCommand();
 
 }  // namespace sffd::cli

@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 
@@ -97,6 +98,21 @@ OpenedBackend openBackendFromArgs(const ParsedArgs& args) {
   OpenedBackend b = openBackend(r, &notes);
   for (const std::string& n : notes) note(args, n);
   return b;
+}
+
+void checkEdgeLength(const Mesh& mesh, double l) {
+  if (!(l > 0) || !std::isfinite(l)) throw Error(ErrorKind::Input, "--edge-length must be a positive number");
+  // A near-regular split gives about area / (sqrt(3)/4 l^2) sub-triangles, and at least one a triangle.
+  double area = 0;
+  for (const auto& t : mesh.triangles)
+    area += 0.5 * glm::length(glm::cross(mesh.positions[t[1]] - mesh.positions[t[0]], mesh.positions[t[2]] - mesh.positions[t[0]]));
+  double estimate = area / (std::sqrt(3.0) / 4 * l * l) + double(mesh.triangles.size());
+  if (estimate > kMaxSubTriangles) {
+    char buf[200];
+    std::snprintf(buf, sizeof buf, "--edge-length %g would make about %.3g sub-triangles, above the limit of %.3g", l,
+                  estimate, kMaxSubTriangles);
+    throw Error(ErrorKind::Input, buf);
+  }
 }
 
 bool wantDouble(const ParsedArgs& args, const DeviceInfo& info, bool autoDouble) {

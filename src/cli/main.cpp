@@ -10,7 +10,7 @@
 using namespace sffd;
 
 static std::vector<cli::CommandSpec> commands() {
-  return {cli::deformCommand(), cli::latticeCommand(), cli::devicesCommand(), cli::conformCommand()};
+  return {cli::deformCommand(), cli::latticeCommand(), cli::devicesCommand(), cli::conformCommand(), cli::clipCommand()};
 }
 
 static void usage(FILE* f) {

@@ -509,3 +509,88 @@ SubTriangleRecords regularClipGpu(Backend& backend, const PreparedMesh& mesh, co
 }
 
 }  // namespace sffd
+
+namespace sffd {
+namespace {
+
+// Whether a parent site lies on parent edge e (corners e and e+1 do, edge sites of e do).
+bool siteOnEdge(SubVertexKind kind, int e) {
+  int k = int(kind);
+  if (k < 3) return k == e || k == (e + 1) % 3;
+  return k == 3 + e;
+}
+
+template <class Real>
+SubTriangleRecords recordsCpu(const PreparedMesh& M, const PnOutput& pn, const std::vector<SubTriangle>& subs) {
+  std::vector<Real> pos = convertReals<Real>(M.positions), nrm = convertReals<Real>(M.normals),
+                    slots = convertReals<Real>(M.slotNormals), rec = convertReals<Real>(pn.records);
+  SubTriangleRecords R;
+  R.headers.assign(4 * subs.size(), 0);
+  R.records.assign(subs.size() * SFFD_SUB_STRIDE * 4, 0.0);
+  auto v3 = [](const std::vector<Real>& a, size_t i) { return RVec3<Real>{a[4 * i], a[4 * i + 1], a[4 * i + 2]}; };
+  for (size_t s = 0; s < subs.size(); ++s) {
+    const SubTriangle& st = subs[s];
+    ParentT<Real> par;
+    par.id = st.parent;
+    for (int c = 0; c < 3; ++c) {
+      par.verts[c] = M.triangles[8 * st.parent + c];
+      par.welds[c] = M.triangles[8 * st.parent + 4 + c];
+      par.V[c] = v3(pos, par.verts[c]);
+      par.N[c] = v3(nrm, par.verts[c]);
+    }
+    par.pn = &rec[size_t(st.parent) * SFFD_PN_STRIDE * 4];
+    par.slot = &slots[size_t(st.parent) * SFFD_SLOT_NORMAL_STRIDE * 4];
+    SiteT<Real> site[3];
+    SiteValueT<Real> val[3];
+    for (int c = 0; c < 3; ++c) {
+      site[c].kind = uint32_t(st.corners[c].kind);
+      site[c].t = Real(st.corners[c].t);
+      site[c].lam = RVec3<Real>::from(st.corners[c].lam);
+      val[c] = par.evaluate(site[c]);
+    }
+    double* r = &R.records[s * SFFD_SUB_STRIDE * 4];
+    auto put = [&](int slot, RVec3<Real> v, Real w) {
+      r[4 * slot] = v.x, r[4 * slot + 1] = v.y, r[4 * slot + 2] = v.z, r[4 * slot + 3] = w;
+    };
+    uint32_t creaseBits = 0;
+    for (int c = 0; c < 3; ++c) {
+      put(SFFD_SUB_LAM + c, val[c].lam, 0);
+      put(SFFD_SUB_XPN + c, val[c].xpn, 0);
+      put(SFFD_SUB_XFLAT + c, val[c].xflat, 0);
+      put(SFFD_SUB_NLIN + c, val[c].nlin, 0);
+      put(SFFD_SUB_NPN + c, val[c].npn, 0);
+      for (int h = 0; h < 2; ++h) {
+        int d = h == 0 ? (c + 2) % 3 : (c + 1) % 3;
+        RVec3<Real> nn = val[c].npn;
+        Real nw = 0;
+        for (int e = 0; e < 3; ++e) {
+          if (!siteOnEdge(st.corners[c].kind, e) || !siteOnEdge(st.corners[d].kind, e)) continue;
+          auto nb = par.neighbourNormal(e, par.paramOnEdge(site[c], e));
+          if (nb[3] > Real(0.5)) {
+            nn = {nb[0], nb[1], nb[2]};
+            nw = 1;
+            creaseBits |= 1u << (2 * c + h);
+          }
+          break;
+        }
+        put(SFFD_SUB_NNBR + 2 * c + h, nn, nw);
+      }
+    }
+    R.headers[4 * s] = st.parent;
+    R.headers[4 * s + 1] = creaseBits;
+  }
+  return R;
+}
+
+}  // namespace
+
+SubTriangleRecords recordsFromSubTriangles(const PreparedMesh& mesh, const PnOutput& pn,
+                                           const std::vector<SubTriangle>& subs, KernelVariant variant) {
+  auto t0 = std::chrono::steady_clock::now();
+  SubTriangleRecords R = variant.f64 ? recordsCpu<double>(mesh, pn, subs) : recordsCpu<float>(mesh, pn, subs);
+  R.wallMs = msSince(t0);
+  R.timings.push_back({"clip", R.wallMs});
+  return R;
+}
+
+}  // namespace sffd
