@@ -1,13 +1,17 @@
 // sffd conform MESH -l LATTICE: runs the same job on several backends and compares every output
 // buffer pairwise; exit 1 past tolerance (tolerances: docs/CONFORMANCE.md).
+#include <algorithm>
 #include <cstdio>
 #include <sstream>
 
 #include "buffer_compare.h"
 #include "classic_ffd.h"
 #include "pn_triangles.h"
+#include "regular_clip.h"
+#include "split_pattern_table.h"
 #include "cli.h"
 #include "error.h"
+#include "mesh_topology.h"
 
 namespace sffd::cli {
 namespace {
@@ -43,7 +47,13 @@ int run(const ParsedArgs& args) {
   if (names.size() < 2) throw Error(ErrorKind::Input, "--backends needs at least two backends to compare");
   Job job = loadJob(args);
   PackedLattice packed = packLattice(job.lattice);
+  if (!job.mesh.normalsFromFile) applyCreaseAngle(job.mesh, args.getDouble("--crease-angle", 40.0));
   PreparedMesh prepared = prepareMesh(job.mesh);
+  glm::dvec3 lo, hi;
+  meshBounds(job.mesh, lo, hi);
+  double l = args.has("--edge-length") ? args.getDouble("--edge-length", 0) : 0.1 * std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
+  checkEdgeLength(job.mesh, l);
+  ClipTriangles clip = buildClipTriangles(job.mesh, l, splitPatternTable().nmax());
   KernelVariant variant;
   variant.strict = args.has("--strict");
   std::string precision = args.get("--precision", "float");
@@ -67,7 +77,12 @@ int run(const ParsedArgs& args) {
     r.buffers.push_back({"classic.positions", std::move(classic.positions)});
     r.buffers.push_back({"classic.normals", std::move(classic.normals)});
     PnOutput pn = b.gpu ? pnTrianglesGpu(*b.gpu, prepared, variant) : pnTrianglesCpu(prepared, cpuVariant);
+    // Each backend clips from its own PN records: the whole pre-compute stage is compared.
+    SubTriangleRecords subs = b.gpu ? regularClipGpu(*b.gpu, prepared, pn, clip, l, variant)
+                                    : regularClipCpu(prepared, pn, clip, l, cpuVariant);
     r.buffers.push_back({"pn.records", std::move(pn.records)});
+    r.buffers.push_back({"clip.headers", std::vector<double>(subs.headers.begin(), subs.headers.end())});
+    r.buffers.push_back({"clip.records", std::move(subs.records)});
     runs.push_back(std::move(r));
   }
 
