@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <sys/wait.h>
 
@@ -217,6 +218,44 @@ TEST(Cli, ConformPassesAndStrictIsBitIdentical) {
   EXPECT_NE(r.out.find("max_abs=0 max_ulp=0 mismatched=0/"), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("max_ulp=1"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("conform: PASS"), std::string::npos) << r.out;
+}
+
+}  // namespace
+
+namespace {
+
+TEST(Cli, ClipWritesACrackFreeSubTriangleMeshAndStats) {
+  fs::path dir = tempDir("clip");
+  for (const char* clip : {"regular", "knot-box"}) {
+    std::string out = (dir / (std::string(clip) + ".obj")).string(), stats = (dir / (std::string(clip) + ".json")).string();
+    RunResult r = runSffd("clip " + kData + "/acaffd/cube2.obj -l " + kData + "/acaffd/lattices/cube2_control_points5.npy --edge-length 0.3 --clip " +
+                          clip + " -o " + out + " --stats " + stats + " --quiet");
+    ASSERT_EQ(r.status, 0) << r.err;
+    sffd::Mesh m = sffd::readMesh(out);
+    // Closed: every welded edge shared by exactly two triangles.
+    std::map<std::pair<uint32_t, uint32_t>, int> uses;
+    for (const auto& t : m.triangles)
+      for (int e = 0; e < 3; ++e) {
+        uint32_t a = m.weldId[t[e]], b = m.weldId[t[(e + 1) % 3]];
+        ++uses[{std::min(a, b), std::max(a, b)}];
+      }
+    for (const auto& [edge, n] : uses) EXPECT_EQ(n, 2) << clip;
+    std::ifstream sf(stats);
+    nlohmann::json j = nlohmann::json::parse(sf);
+    EXPECT_EQ(j["clip"], clip);
+    EXPECT_EQ(j["sub_triangles"], m.triangles.size());
+    EXPECT_GT(j["quality"]["min_angle_deg"].get<double>(), 0.0);
+  }
+}
+
+TEST(Cli, ClipRefusesAnAbsurdEdgeLength) {
+  RunResult r = runSffd("clip " + kData + "/acaffd/rabbit_cym.obj -l " + kData + "/acaffd/lattices/rabbit_cym_control_points0.npy --edge-length 1e-6 -o /tmp/never_clip.obj");
+  EXPECT_EQ(r.status, 2);
+  expectOneErrorLine(r);
+  EXPECT_NE(r.err.find("sub-triangles"), std::string::npos) << r.err;
+  r = runSffd("clip " + kData + "/acaffd/cube2.obj -l " + kData + "/acaffd/lattices/cube2_control_points5.npy --edge-length -1 -o /tmp/never_clip.obj");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_FALSE(fs::exists("/tmp/never_clip.obj"));
 }
 
 }  // namespace
