@@ -83,6 +83,11 @@ Job loadJob(const ParsedArgs& args) {
 
 void checkOutputPath(const std::string& out, const std::vector<std::string>& inputs) {
   std::error_code ec;
+  // Fail before any work when the output cannot be written where asked.
+  fs::path dir = fs::path(out).parent_path();
+  if (dir.empty()) dir = ".";
+  if (!fs::is_directory(dir, ec)) throw Error(ErrorKind::Input, out + ": cannot write: no such directory");
+  if (fs::is_directory(out, ec)) throw Error(ErrorKind::Input, out + ": cannot write: is a directory");
   for (const std::string& in : inputs) {
     if (in.empty()) continue;
     if (fs::weakly_canonical(out, ec) == fs::weakly_canonical(in, ec) || (fs::exists(out) && fs::equivalent(out, in, ec)))
