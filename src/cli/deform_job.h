@@ -1,0 +1,33 @@
+// Running one deformation as the options say: the part of `sffd deform` that `render`, `error`,
+// `bench` and `view` share. Each method is one function; runDeformJob picks it.
+#pragma once
+#include <optional>
+#include <string>
+
+#include "backends/backend_select.h"
+#include "cli.h"
+#include "patch_output.h"
+
+namespace sffd::cli {
+
+struct DeformRun {
+  std::string method, clip;
+  KernelVariant variant;
+  Mesh mesh;                               // the result as `deform` writes it
+  std::optional<PatchVertices> patches;    // smooth and accurate: the tessellation with pre-images
+  size_t subTriangles = 0;
+  double pnMs = 0, clipMs = 0, deformMs = 0;   // per stage: GPU time where measured, else wall time
+};
+
+// Reads --method, --clip, --edge-length, --tess, --precision, --strict and runs the job on `backend`.
+DeformRun runDeformJob(const ParsedArgs& args, Job& job, OpenedBackend& backend);
+
+// One function per method (deform_job.cpp, smooth_job.cpp, accurate_job.cpp).
+DeformRun runClassic(const ParsedArgs& args, Job& job, OpenedBackend& backend);
+DeformRun runSmooth(const ParsedArgs& args, Job& job, OpenedBackend& backend);
+DeformRun runAccurate(const ParsedArgs& args, Job& job, OpenedBackend& backend);
+
+// Sum of the GPU times of the timings (wall time when the device measured none).
+double stageMs(const std::vector<DispatchTiming>& timings, double wallMs);
+
+}  // namespace sffd::cli
