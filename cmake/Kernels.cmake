@@ -1,7 +1,9 @@
 # Compiles every kernel in shaders/ to SPIR-V in four variants (strict x f64) with glslangValidator,
 # tracked by depfiles, and embeds them with the include-inlined GLSL into one generated C++ file.
 # Add a kernel by adding its stem to SFFD_KERNELS.
-set(SFFD_KERNELS classic_ffd pn_triangles clip_count clip_write)
+set(SFFD_KERNELS classic_ffd pn_triangles clip_count clip_write deform_smooth)
+# accurate FFD (src/core/accurate_ffd.cpp):
+list(APPEND SFFD_KERNELS accurate_patches)
 
 set(SFFD_SHADER_DIR ${CMAKE_SOURCE_DIR}/shaders)
 set(SFFD_SPV_DIR ${CMAKE_BINARY_DIR}/spv)

@@ -10,6 +10,7 @@ SFFD_PACKAGES=(
   glslang-tools glslang-dev spirv-tools
   libglm-dev libglfw3-dev libopenmesh-dev nlohmann-json3-dev libpng-dev python3-glad
   libgtest-dev libbenchmark-dev
+  clang libclang-rt-14-dev
   xvfb xauth
 )
 

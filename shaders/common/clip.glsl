@@ -177,6 +177,10 @@ real4 neighbourNormalOnEdge(Parent p, uint e, real t) {
   if (fLo.w < real(0.5) && fHi.w < real(0.5)) return real4(0);
   real3 nLo = gLo.w > real(0.5) ? gLo.xyz : fLo.xyz;   // the one that is not this triangle's own
   real3 nHi = gHi.w > real(0.5) ? gHi.xyz : fHi.xyz;
+  // At the edge's ends the neighbour's normal is its vertex normal itself, bit for bit, as the
+  // neighbour's own records hold it there.
+  if (t == real(0)) return real4(nLo, 1);
+  if (t == real(1)) return real4(nHi, 1);
   real3 nMid = pnEdgeNormal(p.V[lo], p.V[hi], nLo, nHi);
   return real4(pnEdgeNormalCurve(nLo, nMid, nHi, t), 1);
 }

@@ -104,8 +104,46 @@ SFFD_STRUCT_BEGIN(ClipParams)
   SFFD_VEC4 target;    // x: target edge length l
 SFFD_STRUCT_END(ClipParams)
 
+// ---- kernel deform_smooth: the deform stage of smooth FFD, one thread per sub-triangle (ALGORITHM.md 3.4) ----
+// Bindings 1 and 2 are the lattice (bspline.glsl).
+#define SFFD_BINDING_DEFORM_FIT 3          // reals: per interior fitting point SFFD_FIT_STRIDE values
+#define SFFD_BINDING_DEFORM_SUB_HEADERS 4  // uvec4 per sub-triangle (clip_write's headers)
+#define SFFD_BINDING_DEFORM_SUB_RECORDS 5  // SFFD_SUB_STRIDE real4 per sub-triangle (clip_write's records)
+#define SFFD_BINDING_DEFORM_PATCHES 6      // SFFD_PATCH_STRIDE real4 per patch
+#define SFFD_BINDING_DEFORM_TESS 7         // per patch: tessellation positions, then normals (real4 each)
+// Fitting point record: lambda (3), weight w of the centre fit, then the 10 cubic Bernstein values.
+#define SFFD_FIT_STRIDE 14
+// Patch record: 10 geometry control points, then 10 normal control points (linear index order).
+#define SFFD_PATCH_STRIDE 20
+#define SFFD_MAX_FIT_POINTS 91   // interior points of the degree-15 lattice: s <= 15
+
+SFFD_STRUCT_BEGIN(DeformParams)
+  SFFD_STRUCT_MEMBER(LatticeParams, lattice)
+  SFFD_UVEC4 range;    // x: first sub-triangle, y: count, z: interior fitting points, w: tessellation level
+SFFD_STRUCT_END(DeformParams)
+
 SFFD_STRUCT_BEGIN(PnParams)
   SFFD_UVEC4 range;   // x: first triangle, y: triangle count
 SFFD_STRUCT_END(PnParams)
+
+// ---- kernel accurate_patches (accurate FFD, ALGORITHM.md 2; owner: accurate FFD) ----
+// One thread per knot-box sub-triangle: the (n+1)(n+2)/2 samples of the lattice at the principal
+// lattice points of the flat sub-triangle, the exact Bezier patch P = A_n^{-1} S of degree
+// n = nu+nv+nw, then its tessellation at level L (layout of src/core/patch_output.h).
+#define SFFD_ACC_MAX_DEGREE 15           // 3 * SFFD_MAX_DEGREE
+#define SFFD_ACC_MAX_CP 136              // (n+1)(n+2)/2 for n = SFFD_ACC_MAX_DEGREE
+#define SFFD_BINDING_ACC_MATRIX 3        // reals: A_n^{-1} transposed, entry (sample l, control point k) at l*m + k
+#define SFFD_BINDING_ACC_TESS_BASIS 4    // reals: per tessellation vertex v, B^{n-1}_kappa(lambda_v) for the n(n+1)/2 kappa
+#define SFFD_BINDING_ACC_CORNERS 5       // 3 real4 per sub-triangle: its flat corners sum_i lam_i V_i (w unused)
+#define SFFD_BINDING_ACC_PATCHES 6       // m real4 per sub-triangle: the patch control points, linear index order (out)
+#define SFFD_BINDING_ACC_POSITIONS 7     // nv real4 per sub-triangle: tessellation positions (out)
+#define SFFD_BINDING_ACC_NORMALS 8       // nv real4 per sub-triangle: unit geometric normals of the patch (out)
+
+SFFD_STRUCT_BEGIN(AccurateParams)
+  SFFD_STRUCT_MEMBER(LatticeParams, lattice)
+  SFFD_UVEC4 range;   // x: first sub-triangle of this chunk (relative to the bound ranges), y: sub-triangle count
+  SFFD_UVEC4 shape;   // x: patch degree n, y: control points m = (n+1)(n+2)/2, z: tessellation level L, w: vertices (L+1)(L+2)/2
+SFFD_STRUCT_END(AccurateParams)
+// ---- end of accurate_patches ----
 
 #endif

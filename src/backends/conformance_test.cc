@@ -13,6 +13,7 @@
 #include "error.h"
 #include "pn_triangles.h"
 #include "regular_clip.h"
+#include "smooth_deform.h"
 #include "split_pattern_table.h"
 #include "vk/vk_backend.h"
 
@@ -167,6 +168,30 @@ TEST_P(ClassicConformance, ClipKernelsAgreeWithCpuReference) {
     unsetenv("SFFD_MAX_CHUNK_SUBTRIANGLES");
     EXPECT_EQ(chunked.records, regularClipCpu(P, pn, C, l, {true, false}).records);
   }
+  EXPECT_EQ(vk::validationMessageCount(), 0u);
+}
+
+TEST_P(ClassicConformance, SmoothDeformKernelAgreesWithCpuReference) {
+  OpenedBackend b = open(GetParam());
+  Mesh m = readMesh(std::string(SFFD_SHARED_DATA) + "/acaffd/cube2.obj");
+  PreparedMesh P = prepareMesh(m);
+  PnOutput pn = pnTrianglesCpu(P, {true, false});
+  double l = 0.5;
+  SubTriangleRecords subs = regularClipCpu(P, pn, buildClipTriangles(m, l, splitPatternTable().nmax()), l, {true, false});
+  PackedLattice L = packLattice(deformedLattice(OutsideMode::Extrapolate));
+  FitTable fit = makeFitTable(6);
+  SmoothOutput cpu = smoothDeformCpu(L, subs, fit, 10, {true, false});
+  for (KernelVariant v : {KernelVariant{true, false}, KernelVariant{false, false}}) {
+    SmoothOutput gpu = smoothDeformGpu(*b.gpu, L, subs, fit, 10, v);
+    CompareTolerance tol = v.strict ? CompareTolerance{true, 0, 0} : CompareTolerance{false, 64, 2e-6};
+    CompareResult p = compareBuffers(gpu.patches, cpu.patches, true, tol), t = compareBuffers(gpu.tess, cpu.tess, true, tol);
+    EXPECT_EQ(p.mismatched, 0u) << "patches, strict " << v.strict << ": max_abs " << p.maxAbs << " max_ulp " << p.maxUlp;
+    EXPECT_EQ(t.mismatched, 0u) << "tessellation, strict " << v.strict << ": max_abs " << t.maxAbs << " max_ulp " << t.maxUlp;
+  }
+  setenv("SFFD_MAX_CHUNK_SUBTRIANGLES", "50", 1);
+  SmoothOutput chunked = smoothDeformGpu(*b.gpu, L, subs, fit, 10, {true, false});
+  unsetenv("SFFD_MAX_CHUNK_SUBTRIANGLES");
+  EXPECT_EQ(chunked.tess, cpu.tess);
   EXPECT_EQ(vk::validationMessageCount(), 0u);
 }
 

@@ -83,5 +83,6 @@ CommandSpec latticeCommand();
 CommandSpec devicesCommand();
 CommandSpec conformCommand();
 CommandSpec clipCommand();
+CommandSpec renderCommand();
 
 }  // namespace sffd::cli

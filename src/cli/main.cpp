@@ -10,7 +10,8 @@
 using namespace sffd;
 
 static std::vector<cli::CommandSpec> commands() {
-  return {cli::deformCommand(), cli::latticeCommand(), cli::devicesCommand(), cli::conformCommand(), cli::clipCommand()};
+  return {cli::deformCommand(), cli::latticeCommand(), cli::devicesCommand(), cli::conformCommand(), cli::clipCommand(),
+          cli::renderCommand()};
 }
 
 static void usage(FILE* f) {

@@ -97,6 +97,8 @@ struct ParentT {
     if (slotW(sLo) < Real(0.5) && slotW(sHi) < Real(0.5)) return {0, 0, 0, 0};
     RVec3<Real> nLo = slotW(sLo + 1) > Real(0.5) ? slotAt(sLo + 1) : slotAt(sLo);
     RVec3<Real> nHi = slotW(sHi + 1) > Real(0.5) ? slotAt(sHi + 1) : slotAt(sHi);
+    if (t == Real(0)) return {nLo.x, nLo.y, nLo.z, Real(1)};
+    if (t == Real(1)) return {nHi.x, nHi.y, nHi.z, Real(1)};
     RVec3<Real> nMid = pnEdgeNormal(V[lo], V[hi], nLo, nHi);
     RVec3<Real> n = pnEdgeNormalCurve(nLo, nMid, nHi, t);
     return {n.x, n.y, n.z, Real(1)};

@@ -107,6 +107,13 @@ size_t lineOfOffset(std::string_view text, size_t offset) {
   return 1 + size_t(std::count(text.begin(), text.begin() + ptrdiff_t(offset), '\n'));
 }
 
+std::string oneLine(std::string_view message) {
+  std::string s(message);
+  for (char& c : s)
+    if (static_cast<unsigned char>(c) < 32 || c == 127) c = '?';
+  return s;
+}
+
 std::string quoted(std::string_view t) {
   std::string s = "'";
   size_t n = std::min<size_t>(t.size(), 40);

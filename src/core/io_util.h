@@ -35,6 +35,10 @@ std::string formatNumber(double v, int digits = 0);
 // 1-based line of a byte offset.
 size_t lineOfOffset(std::string_view text, size_t offset);
 
+// An error message made one printable line: control characters (a newline in a JSON key, a file
+// name) become '?'. The readers' entry points pass every message through it.
+std::string oneLine(std::string_view message);
+
 // A token for an error message: printable, at most 40 characters, quoted.
 std::string quoted(std::string_view token);
 

@@ -303,16 +303,34 @@ Lattice readJson(const std::string& path, const std::string& text) {
 
 Lattice readLattice(const std::string& path, const LatticeReadOptions& options) {
   std::string ext = io::lowerExtension(path);
-  if (ext != ".json" && ext != ".prm" && ext != ".npy")
-    throw inputError(path, 0,
-                     "unknown lattice format " + (ext.empty() ? std::string("(no extension)") : io::quoted(ext)) +
-                         "; expected .json, .prm or .npy");
-  std::string text = io::readWholeFile(path);
-  if (ext != ".npy") io::checkTextEncoding(path, text, false);   // no UTF-16, no binary; a UTF-8 BOM skipped
-  if (ext == ".json") return latticeio::readJson(path, text);
-  if (ext == ".prm") return latticeio::readPrm(path, text);
-  return latticeio::readNpy(path, text, options);
+  try {
+    if (ext != ".json" && ext != ".prm" && ext != ".npy")
+      throw inputError(path, 0,
+                       "unknown lattice format " + (ext.empty() ? std::string("(no extension)") : io::quoted(ext)) +
+                           "; expected .json, .prm or .npy");
+    return latticeio::readLatticeBytes(path, io::readWholeFile(path), options);
+  } catch (const Error& e) {
+    throw Error(e.kind(), io::oneLine(e.what()));   // a file name with a newline still makes one line
+  }
 }
+
+namespace latticeio {
+
+Lattice readLatticeBytes(const std::string& path, std::string text, const LatticeReadOptions& options) {
+  try {
+    std::string ext = io::lowerExtension(path);
+    if (text.empty()) throw inputError(path, 0, "empty file");
+    if (ext != ".npy") io::checkTextEncoding(path, text, false);   // no UTF-16, no binary; a UTF-8 BOM skipped
+    if (ext == ".json") return readJson(path, text);
+    if (ext == ".prm") return readPrm(path, text);
+    if (ext == ".npy") return readNpy(path, text, options);
+    throw inputError(path, 0, "unknown lattice format " + io::quoted(ext));
+  } catch (const Error& e) {
+    throw Error(e.kind(), io::oneLine(e.what()));   // a message is one line, whatever the file held
+  }
+}
+
+}  // namespace latticeio
 
 // ---------------------------------------------------------------------------------------------------
 // Writing: numbers in their shortest form that reads back to the same double (at most 17 significant

@@ -61,7 +61,7 @@ std::map<std::string, IniSection> parseIni(const std::string& path, const std::s
     if (t.front() == '[' && t.back() == ']' && t.size() > 2) {
       std::string name(io::trim(t.substr(1, t.size() - 2)));
       auto [it, isNew] = sections.emplace(name, IniSection{});
-      if (!isNew) throw inputError(path, line, "section [" + name + "] appears twice");
+      if (!isNew) throw inputError(path, line, "section " + io::quoted("[" + name + "]") + " appears twice");
       it->second.line = line;
       cur = &it->second;
       continue;
@@ -73,7 +73,7 @@ std::map<std::string, IniSection> parseIni(const std::string& path, const std::s
     for (char& c : key) c = char(std::tolower(static_cast<unsigned char>(c)));
     if (key.empty()) throw inputError(path, line, "empty key");
     auto [it, isNew] = cur->values.emplace(key, IniValue{});
-    if (!isNew) throw inputError(path, line, "key '" + key + "' appears twice in its section");
+    if (!isNew) throw inputError(path, line, "key " + io::quoted(key) + " appears twice in its section");
     it->second.line = line;
     std::string_view rest = io::trim(t.substr(d + 1));
     if (!rest.empty()) it->second.lines.push_back({rest, line});
@@ -258,7 +258,7 @@ NpyHeader parseNpyHeader(const std::string& path, std::string_view h) {
       ++i;
       r.haveShape = true;
     } else {
-      throw fail("unknown key '" + key + "'");
+      throw fail("unknown key " + io::quoted(key));
     }
     ws();
     if (i < h.size() && h[i] == ',') ++i;
@@ -290,7 +290,7 @@ Lattice readNpy(const std::string& path, const std::string& text, const LatticeR
   else if (h.descr == "<f8") item = 8;
   else if (h.descr == ">f4" || h.descr == ">f8")
     throw inputError(path, 0, "big-endian .npy data (" + h.descr + ") is not supported; save it as '<f4' or '<f8'");
-  else throw inputError(path, 0, "unsupported .npy dtype '" + h.descr + "' (expected float32 '<f4' or float64 '<f8')");
+  else throw inputError(path, 0, "unsupported .npy dtype " + io::quoted(h.descr) + " (expected float32 '<f4' or float64 '<f8')");
   if (h.fortran) throw inputError(path, 0, "Fortran-order .npy arrays are not supported (save with C order)");
   if (h.shape.size() != 4 || h.shape[3] != 3) {
     std::string s = "(";

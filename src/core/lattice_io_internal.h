@@ -6,6 +6,9 @@
 
 namespace sffd::latticeio {
 
+// What readLattice does once the file is read: dispatch by the extension of `path` (used by the fuzz targets).
+Lattice readLatticeBytes(const std::string& path, std::string text, const LatticeReadOptions& options = {});
+
 Lattice readJson(const std::string& path, const std::string& text);
 Lattice readPrm(const std::string& path, const std::string& text);
 Lattice readNpy(const std::string& path, const std::string& text, const LatticeReadOptions& options);

@@ -1,6 +1,7 @@
 // Mesh files: dispatch by extension, the writers (.obj .ply .off .stl), normals and welding.
 // The readers live in mesh_io_obj.cpp (OBJ), mesh_io_formats.cpp (OFF, PLY, STL), mesh_io_om.cpp
 // (OpenMesh .om) and mesh_io_bpt.cpp (Bezier patches).
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <ostream>
@@ -19,21 +20,45 @@ Mesh readMesh(const std::string& path, const MeshReadOptions& options) {
   static const char* known[] = {".obj", ".off", ".ply", ".stl", ".om", ".bpt"};
   bool ok = false;
   for (const char* k : known) ok = ok || ext == k;
-  if (!ok)
-    throw inputError(path, 0,
-                     "unknown mesh format " + (ext.empty() ? std::string("(no extension)") : io::quoted(ext)) +
-                         "; expected .obj, .off, .ply, .stl, .om or .bpt");
-  std::string text = io::readWholeFile(path);
+  try {
+    if (!ok)
+      throw inputError(path, 0,
+                       "unknown mesh format " + (ext.empty() ? std::string("(no extension)") : io::quoted(ext)) +
+                           "; expected .obj, .off, .ply, .stl, .om or .bpt");
+    return meshio::readMeshBytes(path, io::readWholeFile(path), options);
+  } catch (const Error& e) {
+    throw Error(e.kind(), io::oneLine(e.what()));   // a file name with a newline still makes one line
+  }
+}
+
+namespace meshio {
+
+namespace {
+Mesh dispatch(const std::string& path, std::string text, const MeshReadOptions& options) {
+  std::string ext = io::lowerExtension(path);
+  if (text.empty()) throw inputError(path, 0, "empty file");
   // Text formats: no UTF-16, no binary data, a UTF-8 byte-order mark skipped. PLY has binary
   // variants (its header is checked by the PLY reader); STL and .om are checked by theirs.
   if (ext == ".obj" || ext == ".off" || ext == ".bpt" || ext == ".ply") io::checkTextEncoding(path, text, ext == ".ply");
-  if (ext == ".obj") return meshio::readObj(path, text);
-  if (ext == ".off") return meshio::readOff(path, text);
-  if (ext == ".ply") return meshio::readPly(path, text);
-  if (ext == ".stl") return meshio::readStl(path, text);
-  if (ext == ".om") return meshio::readOm(path, text);
-  return meshio::readBpt(path, text, options);
+  if (ext == ".obj") return readObj(path, text);
+  if (ext == ".off") return readOff(path, text);
+  if (ext == ".ply") return readPly(path, text);
+  if (ext == ".stl") return readStl(path, text);
+  if (ext == ".om") return readOm(path, text);
+  if (ext == ".bpt") return readBpt(path, text, options);
+  throw inputError(path, 0, "unknown mesh format " + io::quoted(ext));
 }
+}  // namespace
+
+Mesh readMeshBytes(const std::string& path, std::string text, const MeshReadOptions& options) {
+  try {
+    return dispatch(path, std::move(text), options);
+  } catch (const Error& e) {
+    throw Error(e.kind(), io::oneLine(e.what()));   // a message is one line, whatever the file held
+  }
+}
+
+}  // namespace meshio
 
 // ---------------------------------------------------------------------------------------------------
 // Normals and welding
@@ -127,11 +152,17 @@ void finishMesh(Mesh& mesh, const std::vector<uint8_t>& fromFile, const std::str
   std::vector<uint8_t> compute(n, 1);
   for (size_t v = 0; v < n; ++v) {
     if (v < fromFile.size() && fromFile[v]) {
-      const glm::dvec3& m = mesh.normals[v];
-      double len = glm::length(m);
-      if (std::isfinite(m.x) && std::isfinite(m.y) && std::isfinite(m.z) && len > 0 && std::isfinite(len)) {
-        // A normal already of unit length is kept bit for bit (so that files written by writeMesh read back exactly).
-        if (std::abs(len - 1.0) > 1e-15) mesh.normals[v] = m / len;
+      const glm::dvec3 m = mesh.normals[v];
+      const double big = std::max({std::abs(m.x), std::abs(m.y), std::abs(m.z)});
+      if (std::isfinite(big) && big > 0) {
+        // A normal already of unit length is kept bit for bit (so that files written by writeMesh read
+        // back exactly); others are scaled by their largest component first, so that tiny (denormal) and
+        // huge ones normalise without underflow or overflow.
+        double len = glm::length(m);
+        if (!(std::abs(len - 1.0) <= 1e-15)) {
+          glm::dvec3 q = m / big;
+          mesh.normals[v] = q / glm::length(q);
+        }
         compute[v] = 0;
         anyFromFile = true;
         continue;

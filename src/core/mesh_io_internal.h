@@ -9,6 +9,10 @@
 
 namespace sffd::meshio {
 
+// What readMesh does once the file is read: dispatch by the extension of `path` (the fuzz targets
+// call it with bytes that never were a file).
+Mesh readMeshBytes(const std::string& path, std::string text, const MeshReadOptions& options = {});
+
 Mesh readObj(const std::string& path, const std::string& text);
 Mesh readOff(const std::string& path, const std::string& text);
 Mesh readPly(const std::string& path, const std::string& text);

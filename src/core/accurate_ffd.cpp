@@ -1,0 +1,384 @@
+#include "accurate_ffd.h"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <mutex>
+
+#include "error.h"
+#include "job_budget.h"
+#include "lattice_eval.h"
+
+namespace sffd {
+
+void triangleMultiIndex(int n, int idx, int& i, int& j, int& k) {
+  int r = 0;
+  while ((r + 1) * (r + 2) / 2 <= idx) ++r;
+  int t = idx - r * (r + 1) / 2;
+  i = n - r;
+  j = r - t;
+  k = t;
+}
+
+namespace {
+
+double msSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+long double factorialL(int n) {
+  long double f = 1;
+  for (int i = 2; i <= n; ++i) f *= i;
+  return f;
+}
+
+long double powL(long double x, int e) {
+  long double r = 1;
+  for (int i = 0; i < e; ++i) r *= x;
+  return r;
+}
+
+// B^n_{ijk} at the barycentrics (a, b, c) / d, in long double.
+long double bernsteinAtLattice(int n, int i, int j, int k, int a, int b, int c, int d) {
+  long double coef = factorialL(n) / (factorialL(i) * factorialL(j) * factorialL(k));
+  return coef * powL((long double)a / d, i) * powL((long double)b / d, j) * powL((long double)c / d, k);
+}
+
+std::vector<long double> interpolationMatrixL(int n) {
+  const int m = triangleControlPoints(n);
+  std::vector<long double> A(size_t(m) * m);
+  for (int l = 0; l < m; ++l) {
+    int a, b, c;
+    triangleMultiIndex(n, l, a, b, c);
+    for (int k = 0; k < m; ++k) {
+      int i, j, kk;
+      triangleMultiIndex(n, k, i, j, kk);
+      A[size_t(l) * m + k] = bernsteinAtLattice(n, i, j, kk, a, b, c, n);
+    }
+  }
+  return A;
+}
+
+// Gauss-Jordan elimination with partial pivoting, in long double.
+std::vector<double> invert(std::vector<long double> A, int m) {
+  std::vector<long double> X(size_t(m) * m, 0.0L);
+  for (int i = 0; i < m; ++i) X[size_t(i) * m + i] = 1;
+  for (int col = 0; col < m; ++col) {
+    int piv = col;
+    for (int r = col + 1; r < m; ++r)
+      if (std::fabs(A[size_t(r) * m + col]) > std::fabs(A[size_t(piv) * m + col])) piv = r;
+    if (A[size_t(piv) * m + col] == 0) throw Error(ErrorKind::Internal, "interpolation matrix is singular");
+    if (piv != col)
+      for (int c = 0; c < m; ++c) {
+        std::swap(A[size_t(piv) * m + c], A[size_t(col) * m + c]);
+        std::swap(X[size_t(piv) * m + c], X[size_t(col) * m + c]);
+      }
+    long double inv = 1 / A[size_t(col) * m + col];
+    for (int c = 0; c < m; ++c) {
+      A[size_t(col) * m + c] *= inv;
+      X[size_t(col) * m + c] *= inv;
+    }
+    for (int r = 0; r < m; ++r) {
+      if (r == col) continue;
+      long double f = A[size_t(r) * m + col];
+      if (f == 0) continue;
+      for (int c = 0; c < m; ++c) {
+        A[size_t(r) * m + c] -= f * A[size_t(col) * m + c];
+        X[size_t(r) * m + c] -= f * X[size_t(col) * m + c];
+      }
+    }
+  }
+  return std::vector<double>(X.begin(), X.end());
+}
+
+}  // namespace
+
+double triangleBernstein(int n, int i, int j, int k, const glm::dvec3& lambda) {
+  double coef = double(factorialL(n) / (factorialL(i) * factorialL(j) * factorialL(k)));
+  return coef * std::pow(lambda.x, i) * std::pow(lambda.y, j) * std::pow(lambda.z, k);
+}
+
+std::vector<double> interpolationMatrix(int n) {
+  std::vector<long double> A = interpolationMatrixL(n);
+  return std::vector<double>(A.begin(), A.end());
+}
+
+const std::vector<double>& interpolationInverse(int n) {
+  if (n < 1 || n > SFFD_ACC_MAX_DEGREE)
+    throw Error(ErrorKind::Input, "accurate FFD: patch degree " + std::to_string(n) + " is outside 1.." +
+                                      std::to_string(SFFD_ACC_MAX_DEGREE));
+  static std::array<std::vector<double>, SFFD_ACC_MAX_DEGREE + 1> cache;
+  static std::array<std::once_flag, SFFD_ACC_MAX_DEGREE + 1> once;
+  std::call_once(once[n], [n] { cache[n] = invert(interpolationMatrixL(n), triangleControlPoints(n)); });
+  return cache[n];
+}
+
+std::vector<double> tessellationBasis(int n, int L) {
+  const int nb = n * (n + 1) / 2;
+  std::vector<double> B;
+  B.reserve(size_t(tessVertexCount(L)) * nb);
+  for (int r = 0; r <= L; ++r)
+    for (int q = 0; q <= r; ++q)
+      for (int kappa = 0; kappa < nb; ++kappa) {
+        int i, j, k;
+        triangleMultiIndex(n - 1, kappa, i, j, k);
+        B.push_back(double(bernsteinAtLattice(n - 1, i, j, k, L - r, r - q, q, L)));
+      }
+  return B;
+}
+
+AccurateJob makeAccurateJob(const Mesh& mesh, const Lattice& lattice, std::vector<SubTriangle> subs, int level) {
+  AccurateJob job;
+  job.degree = lattice.degree[0] + lattice.degree[1] + lattice.degree[2];
+  if (job.degree > SFFD_ACC_MAX_DEGREE)
+    throw Error(ErrorKind::Input, "accurate FFD: patch degree " + std::to_string(job.degree) + " exceeds " +
+                                      std::to_string(SFFD_ACC_MAX_DEGREE));
+  if (level < 1 || level > kMaxTessLevel)
+    throw Error(ErrorKind::Input, "--tess must be an integer 1.." + std::to_string(kMaxTessLevel));
+  job.level = level;
+  job.subs = std::move(subs);
+  job.corners.resize(job.subs.size() * 12);
+  for (size_t s = 0; s < job.subs.size(); ++s) {
+    const SubTriangle& T = job.subs[s];
+    const auto& tri = mesh.triangles[T.parent];
+    for (int c = 0; c < 3; ++c) {
+      const glm::dvec3& l = T.corners[c].lam;
+      // On a parent edge one weight is 0 and the sum is the same bits from both triangles of the edge
+      // (addition commutes); + 0.0 turns a -0 into +0 so that no coordinate differs only in its sign.
+      glm::dvec3 x = (l.x * mesh.positions[tri[0]] + l.y * mesh.positions[tri[1]]) + l.z * mesh.positions[tri[2]];
+      double* o = &job.corners[12 * s + 4 * c];
+      o[0] = x.x + 0.0, o[1] = x.y + 0.0, o[2] = x.z + 0.0, o[3] = 0;
+    }
+  }
+  return job;
+}
+
+namespace {
+
+// The C++ twin of shaders/accurate_patches.comp. Keep the two in step, operation for operation.
+template <class Real>
+struct AccurateTwin {
+  const LatticeEvaluator<Real>& eval;
+  const gpu::LatticeParams& L;
+
+  static RVec3<Real> flatPoint(RVec3<Real> c0, RVec3<Real> c1, RVec3<Real> c2, uint32_t i, uint32_t j, uint32_t k, uint32_t d) {
+    Real l0 = Real(i) / Real(d);
+    Real l1 = Real(j) / Real(d);
+    Real l2 = Real(k) / Real(d);
+    return (c0 * l0 + c1 * l1) + c2 * l2;
+  }
+
+  RVec3<Real> latticeValue(RVec3<Real> x) const {
+    LatticeSampleT<Real> S = eval.evaluate(x);
+    if (!S.inside && L.degree.w == SFFD_OUTSIDE_KEEP) return x;
+    return S.value;
+  }
+
+  // One sub-triangle: control points (m), positions and normals (nv) as 4 reals each.
+  void run(const Real* corners, uint32_t n, uint32_t m, uint32_t Lv, const std::vector<Real>& matrix,
+           const std::vector<Real>& basis, double* cpOut, double* posOut, double* nrmOut) const {
+    RVec3<Real> c0{corners[0], corners[1], corners[2]}, c1{corners[4], corners[5], corners[6]},
+        c2{corners[8], corners[9], corners[10]};
+    RVec3<Real> cp[SFFD_ACC_MAX_CP];
+    for (uint32_t k = 0; k < m; ++k) cp[k] = RVec3<Real>{};
+    uint32_t l = 0;
+    for (uint32_t r = 0; r <= n; ++r)
+      for (uint32_t q = 0; q <= r; ++q) {
+        RVec3<Real> S = latticeValue(flatPoint(c0, c1, c2, n - r, r - q, q, n));
+        size_t row = size_t(l) * m;
+        for (uint32_t k = 0; k < m; ++k) cp[k] = cp[k] + S * matrix[row + k];
+        ++l;
+      }
+    for (uint32_t k = 0; k < m; ++k) cpOut[4 * k] = cp[k].x, cpOut[4 * k + 1] = cp[k].y, cpOut[4 * k + 2] = cp[k].z, cpOut[4 * k + 3] = 0;
+
+    const uint32_t nb = n * (n + 1) / 2;
+    const uint32_t cA = 0, cB = n * (n + 1) / 2, cC = m - 1;
+    for (uint32_t r = 0; r <= Lv; ++r)
+      for (uint32_t q = 0; q <= r; ++q) {
+        uint32_t v = r * (r + 1) / 2 + q;
+        uint32_t i = Lv - r, j = r - q, k = q;
+        Real l0 = Real(i) / Real(Lv);
+        Real l1 = Real(j) / Real(Lv);
+        Real l2 = Real(k) / Real(Lv);
+        RVec3<Real> pos, d1, d2;
+        size_t b = size_t(v) * nb;
+        for (uint32_t rr = 0; rr < n; ++rr) {
+          uint32_t a0 = rr * (rr + 1) / 2, a1 = (rr + 1) * (rr + 2) / 2;
+          for (uint32_t tt = 0; tt <= rr; ++tt) {
+            Real w = basis[b];
+            ++b;
+            RVec3<Real> p0 = cp[a0 + tt], p1 = cp[a1 + tt], p2 = cp[a1 + tt + 1];
+            RVec3<Real> e = (p0 * l0 + p1 * l1) + p2 * l2;
+            pos = pos + e * w;
+            d1 = d1 + (p1 - p0) * w;
+            d2 = d2 + (p2 - p0) * w;
+          }
+        }
+        if (i == 0 || j == 0 || k == 0) pos = latticeValue(flatPoint(c0, c1, c2, i, j, k, Lv));
+        RVec3<Real> nrm = scross(d1, d2);
+        if (!(sdot(nrm, nrm) > Real(0))) {
+          RVec3<Real> f = scross(cp[cB] - cp[cA], cp[cC] - cp[cA]);
+          nrm = sdot(f, f) > Real(0) ? f : RVec3<Real>{Real(0), Real(0), Real(1)};
+        }
+        RVec3<Real> un = snormalize(nrm);
+        double* p = posOut + 4 * size_t(v);
+        double* o = nrmOut + 4 * size_t(v);
+        p[0] = pos.x, p[1] = pos.y, p[2] = pos.z, p[3] = 0;
+        o[0] = un.x, o[1] = un.y, o[2] = un.z, o[3] = 0;
+      }
+  }
+};
+
+// A_n^{-1} transposed (sample-major), as the kernel reads it.
+template <class Real>
+std::vector<Real> kernelMatrix(int n) {
+  const std::vector<double>& inv = interpolationInverse(n);
+  const int m = triangleControlPoints(n);
+  std::vector<Real> t(size_t(m) * m);
+  for (int k = 0; k < m; ++k)
+    for (int l = 0; l < m; ++l) t[size_t(l) * m + k] = Real(inv[size_t(k) * m + l]);
+  return t;
+}
+
+template <class Real>
+void accurateCpu(const AccurateJob& job, const PackedLattice& P, AccurateOutput& out) {
+  std::vector<Real> frame = convertReals<Real>(P.frame), coeffs = convertReals<Real>(P.coeffs);
+  LatticeEvaluator<Real> eval(P.params, frame, coeffs);
+  AccurateTwin<Real> twin{eval, P.params};
+  const uint32_t n = uint32_t(job.degree), m = uint32_t(triangleControlPoints(job.degree));
+  const uint32_t Lv = uint32_t(job.level), nv = uint32_t(tessVertexCount(job.level));
+  std::vector<Real> matrix = kernelMatrix<Real>(job.degree);
+  std::vector<Real> basis = convertReals<Real>(tessellationBasis(job.degree, job.level));
+  std::vector<Real> corners = convertReals<Real>(job.corners);
+  const size_t ns = job.count();
+  out.controlPoints.resize(ns * m * 4);
+  out.positions.resize(ns * nv * 4);
+  out.normals.resize(ns * nv * 4);
+  for (size_t s = 0; s < ns; ++s)
+    twin.run(&corners[12 * s], n, m, Lv, matrix, basis, &out.controlPoints[4 * m * s], &out.positions[4 * nv * s],
+             &out.normals[4 * nv * s]);
+}
+
+template <class Real>
+void accurateGpu(Backend& backend, const AccurateJob& job, const PackedLattice& P, KernelVariant variant, AccurateOutput& out) {
+  const DeviceLimits& lim = backend.info().limits;
+  const uint32_t n = uint32_t(job.degree), m = uint32_t(triangleControlPoints(job.degree));
+  const uint32_t nv = uint32_t(tessVertexCount(job.level));
+  const size_t ns = job.count();
+  const size_t r4 = 4 * sizeof(Real);
+  // The largest per-sub-triangle binding decides the chunk (positions and normals: nv real4 each).
+  const size_t perSub = std::max<size_t>({3, m, nv}) * r4;
+  size_t chunk = size_t(lim.maxStorageBufferRange / perSub);
+  chunk = std::min<size_t>(chunk, size_t(lim.maxWorkGroupCount[0]) * lim.maxWorkGroupCount[1] * SFFD_LOCAL_SIZE);
+  if (const char* forced = std::getenv("SFFD_MAX_CHUNK_PATCHES")) chunk = std::min<size_t>(chunk, std::strtoull(forced, nullptr, 10));
+  chunk = std::max<size_t>(1, std::min(chunk, std::max<size_t>(ns, 1)));
+
+  std::vector<Real> frame = convertReals<Real>(P.frame), coeffs = convertReals<Real>(P.coeffs);
+  std::vector<Real> matrix = kernelMatrix<Real>(job.degree);
+  std::vector<Real> basis = convertReals<Real>(tessellationBasis(job.degree, job.level));
+  for (const auto* v : {&coeffs, &matrix, &basis})
+    if (v->size() * sizeof(Real) > lim.maxStorageBufferRange)
+      throw Error(ErrorKind::Input, "accurate FFD: a lattice or patch table does not fit one storage binding on this device");
+  auto upload = [&](const std::vector<Real>& v) {
+    BufferId b = backend.createBuffer(std::max<size_t>(v.size(), 1) * sizeof(Real));
+    if (!v.empty()) backend.upload(b, 0, v.data(), v.size() * sizeof(Real));
+    return b;
+  };
+  BufferId bFrame = upload(frame), bCoeffs = upload(coeffs), bMatrix = upload(matrix), bBasis = upload(basis);
+  BufferId bCorners = backend.createBuffer(chunk * 3 * r4);
+  BufferId bPatches = backend.createBuffer(chunk * m * r4);
+  BufferId bPos = backend.createBuffer(chunk * nv * r4);
+  BufferId bNrm = backend.createBuffer(chunk * nv * r4);
+
+  out.controlPoints.resize(ns * m * 4);
+  out.positions.resize(ns * nv * 4);
+  out.normals.resize(ns * nv * 4);
+  std::vector<Real> corners(chunk * 12), cps(chunk * m * 4), pos(chunk * nv * 4), nrm(chunk * nv * 4);
+  for (size_t first = 0; first < ns; first += chunk) {
+    const size_t count = std::min(chunk, ns - first);
+    for (size_t i = 0; i < 12 * count; ++i) corners[i] = Real(job.corners[12 * first + i]);
+    backend.upload(bCorners, 0, corners.data(), count * 3 * r4);
+    gpu::AccurateParams params;
+    params.lattice = P.params;
+    params.range = {0, uint32_t(count), 0, 0};
+    params.shape = {n, m, uint32_t(job.level), nv};
+    Dispatch d;
+    d.kernel = "accurate_patches";
+    d.variant = variant;
+    d.params = &params;
+    d.paramsSize = sizeof(params);
+    d.buffers = {{SFFD_BINDING_LATTICE_COEFFS, bCoeffs},  {SFFD_BINDING_LATTICE_FRAME, bFrame},
+                 {SFFD_BINDING_ACC_MATRIX, bMatrix},      {SFFD_BINDING_ACC_TESS_BASIS, bBasis},
+                 {SFFD_BINDING_ACC_CORNERS, bCorners},    {SFFD_BINDING_ACC_PATCHES, bPatches},
+                 {SFFD_BINDING_ACC_POSITIONS, bPos},      {SFFD_BINDING_ACC_NORMALS, bNrm}};
+    gridFor(count, lim, d.groups);
+    backend.dispatch(d);
+    backend.barrier();
+    backend.download(bPatches, 0, cps.data(), count * m * r4);
+    backend.download(bPos, 0, pos.data(), count * nv * r4);
+    backend.download(bNrm, 0, nrm.data(), count * nv * r4);
+    std::copy(cps.begin(), cps.begin() + count * m * 4, out.controlPoints.begin() + first * m * 4);
+    std::copy(pos.begin(), pos.begin() + count * nv * 4, out.positions.begin() + first * nv * 4);
+    std::copy(nrm.begin(), nrm.begin() + count * nv * 4, out.normals.begin() + first * nv * 4);
+  }
+  backend.finish();
+  for (BufferId b : {bFrame, bCoeffs, bMatrix, bBasis, bCorners, bPatches, bPos, bNrm}) backend.destroyBuffer(b);
+  out.timings = backend.takeTimings();
+}
+
+}  // namespace
+
+AccurateOutput accurateFfdCpu(const AccurateJob& job, const PackedLattice& lattice, KernelVariant variant) {
+  AccurateOutput out;
+  auto t0 = std::chrono::steady_clock::now();
+  if (variant.f64) accurateCpu<double>(job, lattice, out);
+  else accurateCpu<float>(job, lattice, out);
+  out.wallMs = msSince(t0);
+  out.timings.push_back({"accurate_patches", out.wallMs});
+  return out;
+}
+
+AccurateOutput accurateFfdGpu(Backend& backend, const AccurateJob& job, const PackedLattice& lattice, KernelVariant variant) {
+  if (variant.f64 && !backend.info().limits.float64)
+    throw deviceError(backend.info().name + " has no double-precision shader support; use --precision float");
+  AccurateOutput out;
+  auto t0 = std::chrono::steady_clock::now();
+  if (job.count() > 0) {
+    if (variant.f64) accurateGpu<double>(backend, job, lattice, variant, out);
+    else accurateGpu<float>(backend, job, lattice, variant, out);
+  }
+  out.wallMs = msSince(t0);
+  return out;
+}
+
+PatchVertices accuratePatchVertices(const AccurateJob& job, const AccurateOutput& out) {
+  PatchVertices pv;
+  pv.level = job.level;
+  const int L = job.level, nv = tessVertexCount(L);
+  const size_t ns = job.count();
+  pv.parent.resize(ns);
+  pv.lamParent.resize(ns * nv * 3);
+  pv.position.resize(ns * nv * 3);
+  pv.normal.resize(ns * nv * 3);
+  for (size_t s = 0; s < ns; ++s) {
+    const SubTriangle& T = job.subs[s];
+    pv.parent[s] = T.parent;
+    for (int r = 0; r <= L; ++r)
+      for (int q = 0; q <= r; ++q) {
+        const int v = r * (r + 1) / 2 + q;
+        const double l0 = double(L - r) / L, l1 = double(r - q) / L, l2 = double(q) / L;
+        glm::dvec3 lam = (l0 * T.corners[0].lam + l1 * T.corners[1].lam) + l2 * T.corners[2].lam;
+        const size_t g = s * nv + v;
+        for (int a = 0; a < 3; ++a) {
+          pv.lamParent[3 * g + a] = lam[a];
+          pv.position[3 * g + a] = out.positions[4 * g + a] + 0.0;   // -0 -> +0: welding compares bits
+          pv.normal[3 * g + a] = out.normals[4 * g + a] + 0.0;
+        }
+      }
+  }
+  return pv;
+}
+
+}  // namespace sffd

@@ -1,0 +1,41 @@
+// Kernel K3 "deform" of smooth FFD (Cui & Feng 2015, improved by Lu & Feng; ALGORITHM.md 3.4): each
+// sub-triangle becomes a cubic triangular Bezier patch fitted to the exactly deformed surface, with a
+// cubic normal patch, creases kept sharp, tessellated at level L. GPU kernel shaders/deform_smooth.comp;
+// the C++ twin here, templated on the arithmetic type.
+#pragma once
+#include <vector>
+
+#include "backend.h"
+#include "lattice_pack.h"
+#include "patch_output.h"
+#include "regular_clip.h"
+
+namespace sffd {
+
+// The interior fitting points of the degree-s sampling lattice with their centre-fit weights
+// (closed form of the constrained least squares, ALGORITHM.md 3.4 step 3): SFFD_FIT_STRIDE values each.
+struct FitTable {
+  int s = 6;
+  int points = 0;
+  std::vector<double> data;
+};
+FitTable makeFitTable(int s);
+
+struct SmoothOutput {
+  std::vector<double> patches;   // SFFD_PATCH_STRIDE * 4 per sub-triangle
+  std::vector<double> tess;      // 2 * tessVertexCount(level) * 4 per sub-triangle: positions, then normals
+  int level = 10;
+  std::vector<DispatchTiming> timings;
+  double wallMs = 0;
+};
+
+SmoothOutput smoothDeformCpu(const PackedLattice& lattice, const SubTriangleRecords& subs, const FitTable& fit,
+                             int level, KernelVariant variant);
+SmoothOutput smoothDeformGpu(Backend& backend, const PackedLattice& lattice, const SubTriangleRecords& subs,
+                             const FitTable& fit, int level, KernelVariant variant);
+
+// The tessellation with each vertex's pre-image in its parent triangle (for the writers and the
+// error analysis).
+PatchVertices patchVerticesOf(const SubTriangleRecords& subs, const SmoothOutput& out);
+
+}  // namespace sffd
