@@ -6,12 +6,15 @@
 //     polynomial of total degree n = nu+nv+nw).
 //  2. The exact triangular Bezier patch P = A_n^{-1} S (A_n^{-1} computed on the host in double, once
 //     per n, and uploaded as a storage buffer).
-//  3. Tessellation at level L (src/core/patch_output.h layout): interior vertices B^n(lambda)·P,
-//     boundary vertices R(x(lambda)) directly (the value the patch interpolates exactly there, computed
-//     from bits that both sub-triangles of a shared edge have, so the output welds closed), normals the
-//     patch's geometric normal P_lambda1 x P_lambda2 normalised. That normal is parallel to
-//     cof(J) n_face and keeps the parent's orientation; it jumps across sub-triangle edges, which is
-//     why accurate FFD shades unsmoothly (ALGORITHM.md 2.2, last paragraph).
+//  3. Tessellation at level L (src/core/patch_output.h layout): interior vertices B^n(lambda)·P;
+//     boundary vertices R(x(lambda)) directly, the value the patch interpolates exactly there, computed
+//     from bits that both sub-triangles of a shared edge have, so the output welds closed.
+//     Normals: the patch's geometric normal P_lambda1 x P_lambda2, normalised, computed through the
+//     identity P_lambda1 x P_lambda2 = cof(J) ((c1 - c0) x (c2 - c0)) with the parent's unit face normal
+//     (the sub-triangle lies in the parent's plane): differencing the control points of the slivers
+//     that knot-box clipping makes loses all float precision. It keeps the parent's orientation (also
+//     where det J < 0) and jumps across sub-triangle edges, which is why accurate FFD shades
+//     unsmoothly (ALGORITHM.md 2.2, last paragraph).
 // The C++ twin is src/core/accurate_ffd.cpp (accurateCpu): the same operations in the same order.
 #extension GL_GOOGLE_include_directive : require
 #include "common/prelude.glsl"
@@ -48,7 +51,8 @@ void main() {
   if (t >= params.range.y) return;
   uint s = params.range.x + t;
   uint n = params.shape.x, m = params.shape.y, L = params.shape.z, nv = params.shape.w;
-  real3 c0 = accCorners[3u * s].xyz, c1 = accCorners[3u * s + 1u].xyz, c2 = accCorners[3u * s + 2u].xyz;
+  uint cs = uint(SFFD_ACC_CORNER_STRIDE) * s;
+  real3 c0 = accCorners[cs].xyz, c1 = accCorners[cs + 1u].xyz, c2 = accCorners[cs + 2u].xyz, nf = accCorners[cs + 3u].xyz;
 
   // Steps 1-2: P[k] = sum over samples l (in linear order) of A^{-1}[k][l] S_l.
   real3 cp[SFFD_ACC_MAX_CP];
@@ -67,39 +71,23 @@ void main() {
   }
   for (uint k = 0u; k < m; ++k) accPatches[s * m + k] = real4(cp[k], 0);
 
-  // Step 3: tessellation. With B^{n-1} at the vertex (uploaded table), the last de Casteljau step gives
-  // the point, and the differences P_{kappa+e1} - P_{kappa+e0}, P_{kappa+e2} - P_{kappa+e0} the
-  // derivatives along lambda1 and lambda2 (up to the common factor n).
-  uint nb = n * (n + 1u) / 2u;
-  uint cA = 0u, cB = n * (n + 1u) / 2u, cC = m - 1u;   // control points of the corners (n,0,0), (0,n,0), (0,0,n)
+  // Step 3: tessellation, with B^n at the vertex from the uploaded table.
   for (uint r = 0u; r <= L; ++r) {
     for (uint q = 0u; q <= r; ++q) {
       uint v = r * (r + 1u) / 2u + q;
       uint i = L - r, j = r - q, k = q;
-      P real l0 = real(i) / real(L);
-      P real l1 = real(j) / real(L);
-      P real l2 = real(k) / real(L);
-      P real3 pos = real3(0), d1 = real3(0), d2 = real3(0);
-      uint b = v * nb;
-      for (uint rr = 0u; rr < n; ++rr) {
-        uint a0 = rr * (rr + 1u) / 2u, a1 = (rr + 1u) * (rr + 2u) / 2u;
-        for (uint tt = 0u; tt <= rr; ++tt) {
-          real w = accTessBasis[b];
-          ++b;
-          real3 p0 = cp[a0 + tt], p1 = cp[a1 + tt], p2 = cp[a1 + tt + 1u];
-          P real3 e = (p0 * l0 + p1 * l1) + p2 * l2;
-          pos = pos + e * w;
-          d1 = d1 + (p1 - p0) * w;
-          d2 = d2 + (p2 - p0) * w;
-        }
+      real3 x = accFlatPoint(c0, c1, c2, i, j, k, L);
+      LatticeSample S = latticeEvaluate(params.lattice, x);
+      bool keep = !S.inside && params.lattice.degree.w == SFFD_OUTSIDE_KEEP;
+      P real3 pos = real3(0);
+      uint b = v * m;
+      for (uint kk = 0u; kk < m; ++kk) {
+        P real3 t = pos + cp[kk] * accTessBasis[b + kk];
+        pos = t;
       }
-      if (i == 0u || j == 0u || k == 0u) pos = accLatticeValue(accFlatPoint(c0, c1, c2, i, j, k, L));
-      P real3 nrm = scross(d1, d2);
-      if (!(sdot(nrm, nrm) > real(0))) {
-        // A singular point of the patch: the normal of its corner triangle, else +z.
-        P real3 f = scross(cp[cB] - cp[cA], cp[cC] - cp[cA]);
-        nrm = sdot(f, f) > real(0) ? f : real3(0, 0, 1);
-      }
+      if (i == 0u || j == 0u || k == 0u) pos = keep ? x : S.value;
+      P real3 nrm = keep ? nf : latticeCofactorNormal(S, nf);
+      if (!(sdot(nrm, nrm) > real(0))) nrm = nf;   // a singular point of the map
       accPositions[s * nv + v] = real4(pos, 0);
       accNormals[s * nv + v] = real4(snormalize(nrm), 0);
     }

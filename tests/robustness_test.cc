@@ -200,6 +200,7 @@ const std::map<std::string, Expect>& corpusExpectations() {
       {"lattice_truncated.json", {8, "syntax error"}},
       {"lattice_truncated.npy", {0, "truncated"}},
       {"lattice_unknown_field.json", {3, "unknown field"}},
+      {"lattice_key_with_newline.json", {3, "unknown field \"control?points\""}},
       {"lattice_wrong_point_count.json", {6, "need 27"}},
       {"lattice_wrong_shape.npy", {0, "shape"}},
       {"lattice_zero_length.prm", {7, "must be positive"}},
@@ -385,6 +386,9 @@ TEST_F(Robust, OptionsAndOutputPathsAreChecked) {
   EXPECT_TRUE(fs::is_symlink(dir_ / "sym.obj"));
   EXPECT_FALSE(fs::exists(dir_ / "file" / "o.obj"));
   EXPECT_FALSE(fs::exists("/proc/sffd-robustness.obj"));
+  // A file name with a newline: still one line.
+  Result n = runSffd({"deform", (dir_ / "no\nsuch.obj").string(), "-l", l, "--method", "classic", "-o", out("o.obj")});
+  expectInputError(n, (dir_ / "no?such.obj").string() + ": cannot read", "newline in a file name");
   // A directory given as the mesh.
   Result r = runSffd({"deform", (dir_ / "out").string(), "-l", l, "--method", "classic", "-o", out("o.obj")});
   expectInputError(r, (dir_ / "out").string() + ": ", "directory as mesh");

@@ -133,11 +133,12 @@ SFFD_STRUCT_END(PnParams)
 #define SFFD_ACC_MAX_DEGREE 15           // 3 * SFFD_MAX_DEGREE
 #define SFFD_ACC_MAX_CP 136              // (n+1)(n+2)/2 for n = SFFD_ACC_MAX_DEGREE
 #define SFFD_BINDING_ACC_MATRIX 3        // reals: A_n^{-1} transposed, entry (sample l, control point k) at l*m + k
-#define SFFD_BINDING_ACC_TESS_BASIS 4    // reals: per tessellation vertex v, B^{n-1}_kappa(lambda_v) for the n(n+1)/2 kappa
-#define SFFD_BINDING_ACC_CORNERS 5       // 3 real4 per sub-triangle: its flat corners sum_i lam_i V_i (w unused)
+#define SFFD_BINDING_ACC_TESS_BASIS 4    // reals: per tessellation vertex v, B^n_k(lambda_v) for the m control points k
+#define SFFD_BINDING_ACC_CORNERS 5       // 4 real4 per sub-triangle: its flat corners sum_i lam_i V_i, the parent's unit face normal
+#define SFFD_ACC_CORNER_STRIDE 4
 #define SFFD_BINDING_ACC_PATCHES 6       // m real4 per sub-triangle: the patch control points, linear index order (out)
 #define SFFD_BINDING_ACC_POSITIONS 7     // nv real4 per sub-triangle: tessellation positions (out)
-#define SFFD_BINDING_ACC_NORMALS 8       // nv real4 per sub-triangle: unit geometric normals of the patch (out)
+#define SFFD_BINDING_ACC_NORMALS 8       // nv real4 per sub-triangle: unit geometric normals of the patch, cof(J) n_face (out)
 
 SFFD_STRUCT_BEGIN(AccurateParams)
   SFFD_STRUCT_MEMBER(LatticeParams, lattice)

@@ -15,6 +15,25 @@
 namespace sffd::cli {
 namespace {
 
+// The patch file (docs/CLI.md "Patch files"): a header line, then per patch its parent triangle and
+// 10 geometry and 10 normal control points of the cubic triangular Bezier patch, one per line.
+void writePatchFile(const std::string& path, const DeformRun& run) {
+  const size_t n = run.patches->patchCount();
+  writeFileAtomically(path, [&](std::ostream& o) {
+    char line[128];
+    o << "sffd-patches 1 " << n << " 3\n";
+    for (size_t p = 0; p < n; ++p) {
+      o << "patch " << run.patches->parent[p] << "\n";
+      for (int k = 0; k < 20; ++k) {
+        const double* c = &run.patchControlPoints[(p * 20 + k) * 4];
+        int digits = run.variant.f64 ? 17 : 9;
+        std::snprintf(line, sizeof line, "%.*g %.*g %.*g\n", digits, c[0], digits, c[1], digits, c[2]);
+        o << line;
+      }
+    }
+  });
+}
+
 int run(const ParsedArgs& args) {
   std::string out = args.requireValue("--output");
   args.requireValue("--lattice");
@@ -27,6 +46,7 @@ int run(const ParsedArgs& args) {
   checkSizeOptions(opt("--edge-length"), opt("--tess"));   // docs/ROBUSTNESS.md "Limits"
   checkOutputPath(out, {args.positional[0], args.get("--lattice")});
   if (args.has("--stats")) checkOutputPath(args.get("--stats"), {args.positional[0], args.get("--lattice"), out});
+  if (args.has("--patches")) checkOutputPath(args.get("--patches"), {args.positional[0], args.get("--lattice"), out});
 
   auto t0 = std::chrono::steady_clock::now();
   Job job = loadJob(args);
@@ -34,6 +54,10 @@ int run(const ParsedArgs& args) {
   DeformRun run = runDeformJob(args, job, backend);
   Mesh& deformed = run.mesh;
   writeMesh(out, deformed, run.variant.f64 ? 17 : 9);
+  if (args.has("--patches")) {
+    if (run.patchControlPoints.empty()) throw Error(ErrorKind::Input, "--patches needs --method smooth");
+    writePatchFile(args.get("--patches"), run);
+  }
   double totalMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 
   if (args.has("--stats")) {
@@ -64,6 +88,7 @@ CommandSpec deformCommand() {
                 "Deforms a mesh by a lattice and writes the result (.obj .ply .off .stl) with vertex normals.",
                 jobOptions(), run, 1, 1};
   c.options.insert(c.options.begin() + 1, {"--output|-o", "FILE", "output mesh (.obj .ply .off .stl)"});
+  c.options.insert(c.options.begin() + 2, {"--patches", "FILE", "smooth: also write the Bezier patches (docs/CLI.md)"});
   return c;
 }
 

@@ -51,6 +51,7 @@ DeformRun runSmooth(const ParsedArgs& args, Job& job, OpenedBackend& backend) {
                          : smoothDeformCpu(packed, subs, fit, level, run.variant);
   run.deformMs = stageMs(out.timings, out.wallMs);
   run.patches = patchVerticesOf(subs, out);
+  run.patchControlPoints = std::move(out.patches);
   run.mesh = weldPatchVertices(*run.patches);
   return run;
 }

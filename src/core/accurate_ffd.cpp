@@ -116,15 +116,15 @@ const std::vector<double>& interpolationInverse(int n) {
 }
 
 std::vector<double> tessellationBasis(int n, int L) {
-  const int nb = n * (n + 1) / 2;
+  const int m = triangleControlPoints(n);
   std::vector<double> B;
-  B.reserve(size_t(tessVertexCount(L)) * nb);
+  B.reserve(size_t(tessVertexCount(L)) * m);
   for (int r = 0; r <= L; ++r)
     for (int q = 0; q <= r; ++q)
-      for (int kappa = 0; kappa < nb; ++kappa) {
+      for (int kappa = 0; kappa < m; ++kappa) {
         int i, j, k;
-        triangleMultiIndex(n - 1, kappa, i, j, k);
-        B.push_back(double(bernsteinAtLattice(n - 1, i, j, k, L - r, r - q, q, L)));
+        triangleMultiIndex(n, kappa, i, j, k);
+        B.push_back(double(bernsteinAtLattice(n, i, j, k, L - r, r - q, q, L)));
       }
   return B;
 }
@@ -139,16 +139,22 @@ AccurateJob makeAccurateJob(const Mesh& mesh, const Lattice& lattice, std::vecto
     throw Error(ErrorKind::Input, "--tess must be an integer 1.." + std::to_string(kMaxTessLevel));
   job.level = level;
   job.subs = std::move(subs);
-  job.corners.resize(job.subs.size() * 12);
+  constexpr int stride = 4 * SFFD_ACC_CORNER_STRIDE;
+  job.corners.resize(job.subs.size() * stride);
   for (size_t s = 0; s < job.subs.size(); ++s) {
     const SubTriangle& T = job.subs[s];
     const auto& tri = mesh.triangles[T.parent];
+    glm::dvec3 nf = glm::cross(mesh.positions[tri[1]] - mesh.positions[tri[0]], mesh.positions[tri[2]] - mesh.positions[tri[0]]);
+    double len = glm::length(nf);
+    nf = len > 0 ? nf / len : glm::dvec3(0, 0, 1);
+    double* o = &job.corners[stride * s + 12];
+    o[0] = nf.x, o[1] = nf.y, o[2] = nf.z, o[3] = 0;
     for (int c = 0; c < 3; ++c) {
       const glm::dvec3& l = T.corners[c].lam;
       // On a parent edge one weight is 0 and the sum is the same bits from both triangles of the edge
       // (addition commutes); + 0.0 turns a -0 into +0 so that no coordinate differs only in its sign.
       glm::dvec3 x = (l.x * mesh.positions[tri[0]] + l.y * mesh.positions[tri[1]]) + l.z * mesh.positions[tri[2]];
-      double* o = &job.corners[12 * s + 4 * c];
+      double* o = &job.corners[stride * s + 4 * c];
       o[0] = x.x + 0.0, o[1] = x.y + 0.0, o[2] = x.z + 0.0, o[3] = 0;
     }
   }
@@ -180,7 +186,7 @@ struct AccurateTwin {
   void run(const Real* corners, uint32_t n, uint32_t m, uint32_t Lv, const std::vector<Real>& matrix,
            const std::vector<Real>& basis, double* cpOut, double* posOut, double* nrmOut) const {
     RVec3<Real> c0{corners[0], corners[1], corners[2]}, c1{corners[4], corners[5], corners[6]},
-        c2{corners[8], corners[9], corners[10]};
+        c2{corners[8], corners[9], corners[10]}, nf{corners[12], corners[13], corners[14]};
     RVec3<Real> cp[SFFD_ACC_MAX_CP];
     for (uint32_t k = 0; k < m; ++k) cp[k] = RVec3<Real>{};
     uint32_t l = 0;
@@ -193,35 +199,19 @@ struct AccurateTwin {
       }
     for (uint32_t k = 0; k < m; ++k) cpOut[4 * k] = cp[k].x, cpOut[4 * k + 1] = cp[k].y, cpOut[4 * k + 2] = cp[k].z, cpOut[4 * k + 3] = 0;
 
-    const uint32_t nb = n * (n + 1) / 2;
-    const uint32_t cA = 0, cB = n * (n + 1) / 2, cC = m - 1;
     for (uint32_t r = 0; r <= Lv; ++r)
       for (uint32_t q = 0; q <= r; ++q) {
         uint32_t v = r * (r + 1) / 2 + q;
         uint32_t i = Lv - r, j = r - q, k = q;
-        Real l0 = Real(i) / Real(Lv);
-        Real l1 = Real(j) / Real(Lv);
-        Real l2 = Real(k) / Real(Lv);
-        RVec3<Real> pos, d1, d2;
-        size_t b = size_t(v) * nb;
-        for (uint32_t rr = 0; rr < n; ++rr) {
-          uint32_t a0 = rr * (rr + 1) / 2, a1 = (rr + 1) * (rr + 2) / 2;
-          for (uint32_t tt = 0; tt <= rr; ++tt) {
-            Real w = basis[b];
-            ++b;
-            RVec3<Real> p0 = cp[a0 + tt], p1 = cp[a1 + tt], p2 = cp[a1 + tt + 1];
-            RVec3<Real> e = (p0 * l0 + p1 * l1) + p2 * l2;
-            pos = pos + e * w;
-            d1 = d1 + (p1 - p0) * w;
-            d2 = d2 + (p2 - p0) * w;
-          }
-        }
-        if (i == 0 || j == 0 || k == 0) pos = latticeValue(flatPoint(c0, c1, c2, i, j, k, Lv));
-        RVec3<Real> nrm = scross(d1, d2);
-        if (!(sdot(nrm, nrm) > Real(0))) {
-          RVec3<Real> f = scross(cp[cB] - cp[cA], cp[cC] - cp[cA]);
-          nrm = sdot(f, f) > Real(0) ? f : RVec3<Real>{Real(0), Real(0), Real(1)};
-        }
+        RVec3<Real> x = flatPoint(c0, c1, c2, i, j, k, Lv);
+        LatticeSampleT<Real> S = eval.evaluate(x);
+        bool keep = !S.inside && L.degree.w == SFFD_OUTSIDE_KEEP;
+        RVec3<Real> pos;
+        size_t b = size_t(v) * m;
+        for (uint32_t kk = 0; kk < m; ++kk) pos = pos + cp[kk] * basis[b + kk];
+        if (i == 0 || j == 0 || k == 0) pos = keep ? x : S.value;
+        RVec3<Real> nrm = keep ? nf : eval.cofactorNormal(S, nf);
+        if (!(sdot(nrm, nrm) > Real(0))) nrm = nf;
         RVec3<Real> un = snormalize(nrm);
         double* p = posOut + 4 * size_t(v);
         double* o = nrmOut + 4 * size_t(v);
@@ -257,7 +247,7 @@ void accurateCpu(const AccurateJob& job, const PackedLattice& P, AccurateOutput&
   out.positions.resize(ns * nv * 4);
   out.normals.resize(ns * nv * 4);
   for (size_t s = 0; s < ns; ++s)
-    twin.run(&corners[12 * s], n, m, Lv, matrix, basis, &out.controlPoints[4 * m * s], &out.positions[4 * nv * s],
+    twin.run(&corners[4 * SFFD_ACC_CORNER_STRIDE * s], n, m, Lv, matrix, basis, &out.controlPoints[4 * m * s], &out.positions[4 * nv * s],
              &out.normals[4 * nv * s]);
 }
 
@@ -269,7 +259,7 @@ void accurateGpu(Backend& backend, const AccurateJob& job, const PackedLattice& 
   const size_t ns = job.count();
   const size_t r4 = 4 * sizeof(Real);
   // The largest per-sub-triangle binding decides the chunk (positions and normals: nv real4 each).
-  const size_t perSub = std::max<size_t>({3, m, nv}) * r4;
+  const size_t perSub = std::max<size_t>({SFFD_ACC_CORNER_STRIDE, m, nv}) * r4;
   size_t chunk = size_t(lim.maxStorageBufferRange / perSub);
   chunk = std::min<size_t>(chunk, size_t(lim.maxWorkGroupCount[0]) * lim.maxWorkGroupCount[1] * SFFD_LOCAL_SIZE);
   if (const char* forced = std::getenv("SFFD_MAX_CHUNK_PATCHES")) chunk = std::min<size_t>(chunk, std::strtoull(forced, nullptr, 10));
@@ -287,7 +277,7 @@ void accurateGpu(Backend& backend, const AccurateJob& job, const PackedLattice& 
     return b;
   };
   BufferId bFrame = upload(frame), bCoeffs = upload(coeffs), bMatrix = upload(matrix), bBasis = upload(basis);
-  BufferId bCorners = backend.createBuffer(chunk * 3 * r4);
+  BufferId bCorners = backend.createBuffer(chunk * SFFD_ACC_CORNER_STRIDE * r4);
   BufferId bPatches = backend.createBuffer(chunk * m * r4);
   BufferId bPos = backend.createBuffer(chunk * nv * r4);
   BufferId bNrm = backend.createBuffer(chunk * nv * r4);
@@ -295,11 +285,12 @@ void accurateGpu(Backend& backend, const AccurateJob& job, const PackedLattice& 
   out.controlPoints.resize(ns * m * 4);
   out.positions.resize(ns * nv * 4);
   out.normals.resize(ns * nv * 4);
-  std::vector<Real> corners(chunk * 12), cps(chunk * m * 4), pos(chunk * nv * 4), nrm(chunk * nv * 4);
+  std::vector<Real> corners(chunk * 4 * SFFD_ACC_CORNER_STRIDE), cps(chunk * m * 4), pos(chunk * nv * 4), nrm(chunk * nv * 4);
   for (size_t first = 0; first < ns; first += chunk) {
     const size_t count = std::min(chunk, ns - first);
-    for (size_t i = 0; i < 12 * count; ++i) corners[i] = Real(job.corners[12 * first + i]);
-    backend.upload(bCorners, 0, corners.data(), count * 3 * r4);
+    const size_t cw = 4 * SFFD_ACC_CORNER_STRIDE;
+    for (size_t i = 0; i < cw * count; ++i) corners[i] = Real(job.corners[cw * first + i]);
+    backend.upload(bCorners, 0, corners.data(), count * SFFD_ACC_CORNER_STRIDE * r4);
     gpu::AccurateParams params;
     params.lattice = P.params;
     params.range = {0, uint32_t(count), 0, 0};

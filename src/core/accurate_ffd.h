@@ -12,8 +12,11 @@
 // Tessellation: interior vertices are B^n(lambda)·P. Boundary vertices are R(x_flat(lambda)), the
 // value the patch interpolates exactly there, computed from bits both sub-triangles of a shared edge
 // have, so neighbouring patches share bit-identical boundary vertices and a closed input welds into a
-// closed output. Normals are the patch's geometric normal P_l1 x P_l2 (parallel to cof(J) n_face, the
-// parent's orientation kept even where det J < 0), normalised. They jump across sub-triangle edges:
+// closed output. Normals are the patch's geometric normal P_l1 x P_l2, normalised, computed through
+// the identity P_l1 x P_l2 = cof(J) ((c1 - c0) x (c2 - c0)) with the parent's unit face normal (the
+// sub-triangle lies in the parent's plane): differencing the control points of the slivers that
+// knot-box clipping makes would lose all float precision (0.5 degree on sphere.obj in float). The
+// normal keeps the parent's orientation, also where det J < 0. It jumps across sub-triangle edges:
 // accurate FFD shades unsmoothly, which is what smooth FFD is for (ALGORITHM.md 2.2).
 //
 // Exactness: the composition is a polynomial only where the map is one. With OutsideMode::Keep (PyGeM
@@ -43,7 +46,7 @@ std::vector<double> interpolationMatrix(int n);
 // A_n^{-1}, row-major: computed once per n (n = 1..SFFD_ACC_MAX_DEGREE) by Gauss-Jordan elimination
 // with partial pivoting in long double, rounded to double, and cached. Thread-safe.
 const std::vector<double>& interpolationInverse(int n);
-// B^{n-1}_kappa(lambda_v) for every tessellation vertex v of level L (rows of n(n+1)/2), in double.
+// B^n_k(lambda_v) for every tessellation vertex v of level L (rows of m), in double.
 std::vector<double> tessellationBasis(int n, int level);
 
 // The input of the accurate kernel.
@@ -51,7 +54,9 @@ struct AccurateJob {
   int degree = 0;                     // patch degree n = nu+nv+nw
   int level = 10;                     // tessellation level L
   std::vector<SubTriangle> subs;      // knot-box sub-triangles, each in one knot box
-  std::vector<double> corners;        // 4 per corner, 3 corners per sub-triangle: flat corners sum_i lam_i V_i
+  // Per sub-triangle SFFD_ACC_CORNER_STRIDE x 4 values: the flat corners sum_i lam_i V_i (x, y, z, 0),
+  // then the parent's unit face normal.
+  std::vector<double> corners;
   size_t count() const { return subs.size(); }
 };
 

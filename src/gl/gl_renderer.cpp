@@ -692,9 +692,13 @@ std::vector<SlotCamera> Renderer::draw(const RenderOptions& o, int width, int he
   const double fovY = glm::radians(std::clamp(o.fovYDeg, 1.0, 150.0));
   const double fill = std::clamp(o.fill, 0.05, 1.0);
 
+  // Each item is centred in its slot; with a shared camera all are seen from the largest of their
+  // fitted distances, so equal sizes look equal (every item still fits: a point that fits at one
+  // distance fits at any larger one).
+  const double tanY = std::tan(fovY / 2);
   std::vector<SlotCamera> cams;
-  std::vector<const std::vector<glm::vec3>*> all;
-  for (const auto& m : meshes_) all.push_back(&m->points);
+  std::vector<Fit> fits;
+  double shared = 0;
   for (int i = 0; i < static_cast<int>(meshes_.size()); ++i) {
     SlotCamera cam;
     cam.x = areaW * i / n;
@@ -703,10 +707,20 @@ std::vector<SlotCamera> Renderer::draw(const RenderOptions& o, int width, int he
     cam.height = areaH;
     cam.fovYDeg = glm::degrees(fovY);
     cam.aspect = static_cast<double>(cam.width) / cam.height;
-    const double tanY = std::tan(fovY / 2);
-    Fit f = o.shareCamera ? fitPoints(all, right, camUp, front, tanY * cam.aspect * fill, tanY * fill)
-                          : fitPoints({&meshes_[static_cast<size_t>(i)]->points}, right, camUp, front,
-                                      tanY * cam.aspect * fill, tanY * fill);
+    fits.push_back(fitPoints({&meshes_[static_cast<size_t>(i)]->points}, right, camUp, front,
+                             tanY * cam.aspect * fill, tanY * fill));
+    shared = std::max(shared, fits.back().distance);
+    cams.push_back(cam);
+  }
+  for (size_t i = 0; i < cams.size(); ++i) {
+    SlotCamera& cam = cams[i];
+    Fit f = fits[i];
+    if (o.shareCamera) {
+      const double extra = shared - f.distance;
+      f.distance = shared;
+      f.zNear += extra;
+      f.zFar += extra;
+    }
     cam.target = f.target + sceneCentre_;
     cam.eye = cam.target + front * f.distance;
     cam.up = camUp;
@@ -714,7 +728,6 @@ std::vector<SlotCamera> Renderer::draw(const RenderOptions& o, int width, int he
     cam.zFar = f.zFar;
     cam.view = glm::lookAt(cam.eye, cam.target, camUp);
     cam.projection = glm::perspective(fovY, cam.aspect, cam.zNear, cam.zFar);
-    cams.push_back(cam);
   }
 
   // Meshes

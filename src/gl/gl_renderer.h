@@ -45,7 +45,7 @@ struct RenderOptions {
   UpAxis up = UpAxis::PosZ;
   double fovYDeg = 30;            // perspective, vertical field of view
   double fill = 0.9;              // the fitted meshes span this fraction of the slot's smaller side
-  bool shareCamera = true;        // one camera fitted to all items (same scale in every slot)
+  bool shareCamera = true;        // every slot seen from the same distance (same scale), each item centred
   bool wireframe = false;         // triangle edges over the shading
   int samples = 4;                // multisampling (clamped to GL_MAX_SAMPLES; 1: none)
   std::optional<std::array<float, 2>> scalarRange;   // default: min and max over all items' scalars

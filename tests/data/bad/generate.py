@@ -193,6 +193,8 @@ def refused():
         ' "box": {"min": [0, 0, 0], "max": [1, 1, 1]}}\n')
     put("lattice_unknown_field.json", '{"format": "sffd-lattice", "version": 1, "degree": [1, 1, 1], "counts": [2, 2, 2],\n'
         ' "box": {"min": [0, 0, 0], "max": [1, 1, 1]},\n "controlpoints": []}\n')
+    put("lattice_key_with_newline.json", '{"format": "sffd-lattice", "version": 1, "degree": [1, 1, 1], "counts": [2, 2, 2],\n'
+        ' "box": {"min": [0, 0, 0], "max": [1, 1, 1]},\n "control\\npoints": []}\n')
     put("lattice_missing_box_info.prm", PRM_WEIGHTS)
     put("lattice_missing_weights.prm", PRM_BOX)
     put("lattice_missing_key.prm", PRM_BOX.replace("box length y: 1.0\n", "") + PRM_WEIGHTS)
