@@ -1,7 +1,8 @@
 # Compiles every kernel in shaders/ to SPIR-V in four variants (strict x f64) with glslangValidator,
 # tracked by depfiles, and embeds them with the include-inlined GLSL into one generated C++ file.
 # Add a kernel by adding its stem to SFFD_KERNELS.
-set(SFFD_KERNELS classic_ffd pn_triangles clip_count clip_write deform_smooth)
+set(SFFD_KERNELS classic_ffd pn_triangles clip_count clip_write deform_smooth
+    deform_step_sample deform_step_fit deform_step_adjust deform_step_tessellate)
 # accurate FFD (src/core/accurate_ffd.cpp):
 list(APPEND SFFD_KERNELS accurate_patches)
 

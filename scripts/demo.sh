@@ -9,4 +9,5 @@ cmake --build build -j"$(nproc)" --target sffd
 mkdir -p out
 build/sffd devices
 build/sffd deform data/teapot.bpt -l data/teapot_lattice.npy --method classic -o out/demo.obj --stats out/demo_stats.json
+build/sffd render data/teapot.bpt -l data/teapot_lattice.npy --method classic -o out/demo.png
 echo "demo: wrote out/demo.obj (stats in out/demo_stats.json); the tool is build/sffd (build/sffd --help)"

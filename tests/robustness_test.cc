@@ -69,7 +69,9 @@ class Robust : public ::testing::Test {
   // Runs sffd (no shell) with `env` added, stdout/stderr captured; wait4 gives the child's peak RSS.
   // SFFD_VK_VALIDATION=1: every Vulkan run is under the validation layer, whose messages are
   // printed as "sffd: vulkan ..." lines and fail the checks below.
-  Result runSffd(const std::vector<std::string>& args, const std::vector<std::string>& env = {}) {
+  // leakCheck: a sanitizer build checks leaks too (runs that fail before any driver is loaded; Mesa's
+  // drivers leak at exit, scripts/test.sh).
+  Result runSffd(const std::vector<std::string>& args, const std::vector<std::string>& env = {}, bool leakCheck = false) {
     fs::path o = dir_ / "stdout", e = dir_ / "stderr";
     pid_t pid = ::fork();
     if (pid == 0) {
@@ -78,6 +80,8 @@ class Robust : public ::testing::Test {
       ::dup2(fe, 2);
       ::setenv("SFFD_VK_VALIDATION", "1", 1);
       ::setenv("LIBGL_ALWAYS_SOFTWARE", "1", 1);
+      if (const char* asan = std::getenv("ASAN_OPTIONS"); asan && leakCheck)
+        ::setenv("ASAN_OPTIONS", (std::string(asan) + ":detect_leaks=1").c_str(), 1);
       for (const std::string& kv : env) ::putenv(const_cast<char*>(kv.c_str()));
       std::vector<char*> argv{const_cast<char*>(kSffd.c_str())};
       for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
@@ -241,7 +245,7 @@ TEST_F(Robust, EveryCorpusFileIsRefused) {
     const bool asLattice = isLatticeFile(f);   // fuzz regression files keep the extension of the reader that failed
     std::vector<std::string> args = {"deform", asLattice ? mesh : f.string(), "-l", asLattice ? f.string() : lattice,
                                      "--method", "classic", "-o", out("result.obj")};
-    Result r = runSffd(args);
+    Result r = runSffd(args, {}, /*leakCheck=*/true);
     std::string where = f.string();
     if (!fromFuzzer) {
       auto it = corpusExpectations().find(rel.string());
@@ -288,7 +292,7 @@ TEST_F(Robust, HugeHeaderCountsAllocateNothing) {
   };
   for (const Case& c : cases) {
     std::string p = write(c.name, c.bytes);
-    Result r = runSffd({"deform", p, "-l", lattice, "--method", "classic", "-o", out("o.obj")});
+    Result r = runSffd({"deform", p, "-l", lattice, "--method", "classic", "-o", out("o.obj")}, {}, true);
     expectInputError(r, p, c.name);
     EXPECT_LT(r.maxRssKiB, 400 * 1024) << c.name << ": peak RSS " << r.maxRssKiB << " KiB";
     expectNothingWritten(c.name);

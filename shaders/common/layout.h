@@ -116,6 +116,11 @@ SFFD_STRUCT_END(ClipParams)
 // Patch record: 10 geometry control points, then 10 normal control points (linear index order).
 #define SFFD_PATCH_STRIDE 20
 #define SFFD_MAX_FIT_POINTS 91   // interior points of the degree-15 lattice: s <= 15
+// Split form (kernels deform_step_sample, _fit, _adjust, _tessellate): the samples of one sub-triangle,
+// SFFD_SAMPLE_FIXED + (interior fitting points) real4: Q[3], QN[3], E[6], EN[6], adj[3], adjNbr[6], then
+// the interior sample normals.
+#define SFFD_BINDING_DEFORM_SAMPLES 8
+#define SFFD_SAMPLE_FIXED 27
 
 SFFD_STRUCT_BEGIN(DeformParams)
   SFFD_STRUCT_MEMBER(LatticeParams, lattice)

@@ -188,6 +188,11 @@ TEST_P(ClassicConformance, SmoothDeformKernelAgreesWithCpuReference) {
     EXPECT_EQ(p.mismatched, 0u) << "patches, strict " << v.strict << ": max_abs " << p.maxAbs << " max_ulp " << p.maxUlp;
     EXPECT_EQ(t.mismatched, 0u) << "tessellation, strict " << v.strict << ": max_abs " << t.maxAbs << " max_ulp " << t.maxUlp;
   }
+  // The split form (one dispatch per step) gives the fused kernel's output, bit for bit in strict mode.
+  SmoothOutput split = smoothDeformGpu(*b.gpu, L, subs, fit, 10, {true, false}, /*split=*/true);
+  EXPECT_EQ(split.patches, cpu.patches);
+  EXPECT_EQ(split.tess, cpu.tess);
+  EXPECT_EQ(split.timings.size(), 4u);
   setenv("SFFD_MAX_CHUNK_SUBTRIANGLES", "50", 1);
   SmoothOutput chunked = smoothDeformGpu(*b.gpu, L, subs, fit, 10, {true, false});
   unsetenv("SFFD_MAX_CHUNK_SUBTRIANGLES");

@@ -73,6 +73,7 @@ int run(const ParsedArgs& args) {
         {"output", {{"vertices", deformed.positions.size()}, {"triangles", deformed.triangles.size()}}},
         {"timings_ms", {{"pn", run.pnMs}, {"clip", run.clipMs}, {"deform", run.deformMs}, {"total", totalMs}}},
     };
+    for (const auto& [step, ms] : run.stepMs) j["timings_ms"][step] = ms;
     std::string text = j.dump(1) + "\n";
     writeFileAtomically(args.get("--stats"), [&](std::ostream& o) { o << text; });
   }

@@ -20,6 +20,7 @@ struct DeformRun {
   std::vector<double> patchControlPoints;
   size_t subTriangles = 0;
   double pnMs = 0, clipMs = 0, deformMs = 0;   // per stage: GPU time where measured, else wall time
+  std::vector<std::pair<std::string, double>> stepMs;   // --split: the deform steps (deform.sample, ...)
 };
 
 // Reads --method, --clip, --edge-length, --tess, --precision, --strict and runs the job on `backend`.

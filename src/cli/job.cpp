@@ -19,6 +19,7 @@ std::vector<OptionSpec> jobOptions() {
       {"--clip", "NAME", "regular|knot-box sub-triangle clipping (default regular)"},
       {"--edge-length", "L", "target sub-triangle edge length l, in model units"},
       {"--tess", "N", "tessellation level of each patch (default 10)"},
+      {"--split", nullptr, "smooth: run the deform steps as separate dispatches (per-step timings in --stats)"},
       {"--samples", "S", "smooth: sampling density s of the fit (default nu+nv+nw; 6 is the reference implementation's)"},
       {"--crease-angle", "DEG", "crease threshold for meshes without normals (default 40)"},
       {"--normalize", "S", "center the mesh on its box and scale its largest half-extent to S (.npy: 0.99)"},

@@ -47,9 +47,17 @@ DeformRun runSmooth(const ParsedArgs& args, Job& job, OpenedBackend& backend) {
   }
   run.clipMs = stageMs(subs.timings, subs.wallMs);
   run.subTriangles = subs.size();
-  SmoothOutput out = gpu ? smoothDeformGpu(*gpu, packed, subs, fit, level, run.variant)
+  bool split = args.has("--split");
+  SmoothOutput out = gpu ? smoothDeformGpu(*gpu, packed, subs, fit, level, run.variant, split)
                          : smoothDeformCpu(packed, subs, fit, level, run.variant);
   run.deformMs = stageMs(out.timings, out.wallMs);
+  if (split && gpu) {
+    for (const DispatchTiming& t : out.timings) {
+      auto it = std::find_if(run.stepMs.begin(), run.stepMs.end(), [&](const auto& p) { return p.first == t.label; });
+      if (it == run.stepMs.end()) run.stepMs.push_back({t.label, 0.0}), it = run.stepMs.end() - 1;
+      it->second += std::max(t.gpuMs, 0.0);
+    }
+  }
   run.patches = patchVerticesOf(subs, out);
   run.patchControlPoints = std::move(out.patches);
   run.mesh = weldPatchVertices(*run.patches);

@@ -188,12 +188,13 @@ void deformCpu(const PackedLattice& P, const SubTriangleRecords& subs, const Fit
 
 template <class Real>
 void deformGpu(Backend& backend, const PackedLattice& P, const SubTriangleRecords& subs, const FitTable& F, int level,
-               KernelVariant variant, SmoothOutput& out) {
+               KernelVariant variant, bool split, SmoothOutput& out) {
   const DeviceLimits& lim = backend.info().limits;
   const size_t n = subs.size(), nv = size_t(tessVertexCount(level));
   const size_t recReals = SFFD_SUB_STRIDE * 4, patchReals = SFFD_PATCH_STRIDE * 4, tessReals = 2 * nv * 4;
+  const size_t sampleReals = (SFFD_SAMPLE_FIXED + size_t(F.points)) * 4;
   // Chunks of sub-triangles whose every per-sub-triangle buffer fits one binding.
-  size_t chunk = size_t(lim.maxStorageBufferRange / (std::max({recReals, patchReals, tessReals}) * sizeof(Real)));
+  size_t chunk = size_t(lim.maxStorageBufferRange / (std::max({recReals, patchReals, tessReals, sampleReals}) * sizeof(Real)));
   chunk = std::min<size_t>(chunk, size_t(lim.maxWorkGroupCount[0]) * lim.maxWorkGroupCount[1] * SFFD_LOCAL_SIZE);
   if (const char* forced = std::getenv("SFFD_MAX_CHUNK_SUBTRIANGLES")) chunk = std::min<size_t>(chunk, std::strtoull(forced, nullptr, 10));
   chunk = std::max<size_t>(1, std::min(chunk, std::max<size_t>(n, 1)));
@@ -207,6 +208,7 @@ void deformGpu(Backend& backend, const PackedLattice& P, const SubTriangleRecord
   BufferId bFit = make(fit.data(), fit.size() * sizeof(Real));
   BufferId bHdr = make(nullptr, chunk * 16), bRec = make(nullptr, chunk * recReals * sizeof(Real));
   BufferId bPatch = make(nullptr, chunk * patchReals * sizeof(Real)), bTess = make(nullptr, chunk * tessReals * sizeof(Real));
+  BufferId bSamples = split ? make(nullptr, chunk * sampleReals * sizeof(Real)) : 0;
   out.patches.resize(n * patchReals);
   out.tess.resize(n * tessReals);
   std::vector<Real> rec(chunk * recReals), buf(chunk * std::max(patchReals, tessReals));
@@ -219,18 +221,31 @@ void deformGpu(Backend& backend, const PackedLattice& P, const SubTriangleRecord
     backend.upload(bHdr, 0, &subs.headers[4 * first], count * 16);
     backend.upload(bRec, 0, rec.data(), count * recReals * sizeof(Real));
     params.range = {0, uint32_t(count), uint32_t(F.points), uint32_t(level)};
-    Dispatch d;
-    d.kernel = "deform_smooth";
-    d.label = "deform";
-    d.variant = variant;
-    d.params = &params;
-    d.paramsSize = sizeof(params);
-    d.buffers = {{SFFD_BINDING_LATTICE_COEFFS, bCoeffs}, {SFFD_BINDING_LATTICE_FRAME, bFrame}, {SFFD_BINDING_DEFORM_FIT, bFit},
-                 {SFFD_BINDING_DEFORM_SUB_HEADERS, bHdr}, {SFFD_BINDING_DEFORM_SUB_RECORDS, bRec},
-                 {SFFD_BINDING_DEFORM_PATCHES, bPatch}, {SFFD_BINDING_DEFORM_TESS, bTess}};
-    gridFor(count, lim, d.groups);
-    backend.dispatch(d);
-    backend.barrier();
+    std::vector<BufferBinding> buffers = {
+        {SFFD_BINDING_LATTICE_COEFFS, bCoeffs}, {SFFD_BINDING_LATTICE_FRAME, bFrame}, {SFFD_BINDING_DEFORM_FIT, bFit},
+        {SFFD_BINDING_DEFORM_SUB_HEADERS, bHdr}, {SFFD_BINDING_DEFORM_SUB_RECORDS, bRec},
+        {SFFD_BINDING_DEFORM_PATCHES, bPatch}, {SFFD_BINDING_DEFORM_TESS, bTess}};
+    if (split) buffers.push_back({SFFD_BINDING_DEFORM_SAMPLES, bSamples});
+    auto dispatch = [&](const char* kernel, const char* label) {
+      Dispatch d;
+      d.kernel = kernel;
+      d.label = label;
+      d.variant = variant;
+      d.params = &params;
+      d.paramsSize = sizeof(params);
+      d.buffers = buffers;
+      gridFor(count, lim, d.groups);
+      backend.dispatch(d);
+      backend.barrier();
+    };
+    if (split) {
+      dispatch("deform_step_sample", "deform.sample");
+      dispatch("deform_step_fit", "deform.fit");
+      dispatch("deform_step_adjust", "deform.adjust");
+      dispatch("deform_step_tessellate", "deform.tessellate");
+    } else {
+      dispatch("deform_smooth", "deform");
+    }
     backend.download(bPatch, 0, buf.data(), count * patchReals * sizeof(Real));
     std::copy(buf.begin(), buf.begin() + count * patchReals, out.patches.begin() + first * patchReals);
     backend.download(bTess, 0, buf.data(), count * tessReals * sizeof(Real));
@@ -238,6 +253,7 @@ void deformGpu(Backend& backend, const PackedLattice& P, const SubTriangleRecord
   }
   backend.finish();
   for (BufferId b : {bFrame, bCoeffs, bFit, bHdr, bRec, bPatch, bTess}) backend.destroyBuffer(b);
+  if (split) backend.destroyBuffer(bSamples);
   out.timings = backend.takeTimings();
 }
 
@@ -256,15 +272,15 @@ SmoothOutput smoothDeformCpu(const PackedLattice& lattice, const SubTriangleReco
 }
 
 SmoothOutput smoothDeformGpu(Backend& backend, const PackedLattice& lattice, const SubTriangleRecords& subs,
-                             const FitTable& fit, int level, KernelVariant variant) {
+                             const FitTable& fit, int level, KernelVariant variant, bool split) {
   if (variant.f64 && !backend.info().limits.float64)
     throw deviceError(backend.info().name + " has no double-precision shader support; use --precision float");
   SmoothOutput out;
   out.level = level;
   auto t0 = std::chrono::steady_clock::now();
   if (subs.size()) {
-    if (variant.f64) deformGpu<double>(backend, lattice, subs, fit, level, variant, out);
-    else deformGpu<float>(backend, lattice, subs, fit, level, variant, out);
+    if (variant.f64) deformGpu<double>(backend, lattice, subs, fit, level, variant, split, out);
+    else deformGpu<float>(backend, lattice, subs, fit, level, variant, split, out);
   }
   out.wallMs = msSince(t0);
   return out;

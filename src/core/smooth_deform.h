@@ -31,8 +31,10 @@ struct SmoothOutput {
 
 SmoothOutput smoothDeformCpu(const PackedLattice& lattice, const SubTriangleRecords& subs, const FitTable& fit,
                              int level, KernelVariant variant);
+// split: one dispatch per step (deform.sample: steps 1, 2, 4; deform.fit: 3; deform.adjust: 5;
+// deform.tessellate: 6), for per-step timings; the same output as the fused kernel.
 SmoothOutput smoothDeformGpu(Backend& backend, const PackedLattice& lattice, const SubTriangleRecords& subs,
-                             const FitTable& fit, int level, KernelVariant variant);
+                             const FitTable& fit, int level, KernelVariant variant, bool split = false);
 
 // The tessellation with each vertex's pre-image in its parent triangle (for the writers and the
 // error analysis).

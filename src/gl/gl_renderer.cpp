@@ -641,7 +641,7 @@ std::vector<SlotCamera> Renderer::draw(const RenderOptions& o, int width, int he
 
   // Layout: a caption band at the top when any item has a caption, a legend panel at the right
   // when any item has scalars, the rest split into equal slots, left to right.
-  const float scale = std::max(1.0f, std::round(std::min(W, H) / 320.0f));
+  const float scale = std::max(1.0f, std::round(std::min(W, H) / 280.0f));
   bool anyCaption = false, anyScalars = false;
   float sMin = std::numeric_limits<float>::infinity(), sMax = -sMin;
   for (const auto& m : meshes_) {
@@ -872,7 +872,10 @@ Image Renderer::render(const RenderOptions& o) {
     throw Error(ErrorKind::Input, "picture size " + std::to_string(o.width) + "x" + std::to_string(o.height) +
                                       " is outside 1.." + std::to_string(maxSize_) + " on " + renderer_);
   context_->activate();
-  ensureTarget(o.width, o.height, o.samples);
+  // Fewer samples for very large pictures: 4x at 8192 x 8192 would need 2 GiB of colour and depth.
+  int samples = o.samples;
+  while (samples > 1 && static_cast<double>(o.width) * o.height * samples > 64e6) samples /= 2;
+  ensureTarget(o.width, o.height, samples);
   glBindFramebuffer(GL_FRAMEBUFFER, msFbo_);
   Image img;
   img.cameras = draw(o, o.width, o.height);

@@ -47,7 +47,7 @@ struct RenderOptions {
   double fill = 0.9;              // the fitted meshes span this fraction of the slot's smaller side
   bool shareCamera = true;        // every slot seen from the same distance (same scale), each item centred
   bool wireframe = false;         // triangle edges over the shading
-  int samples = 4;                // multisampling (clamped to GL_MAX_SAMPLES; 1: none)
+  int samples = 4;                // multisampling (clamped to GL_MAX_SAMPLES, fewer above 16 Mpixels; 1: none)
   std::optional<std::array<float, 2>> scalarRange;   // default: min and max over all items' scalars
   bool legend = true;             // colour bar with the range's ends when an item has scalars
   bool gradientBackground = true; // light grey, lighter at the top; false: flat

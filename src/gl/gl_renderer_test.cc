@@ -344,6 +344,20 @@ TEST_F(RendererTest, PngRoundTrips) {
   fs::remove_all(dir);
 }
 
+// SFFD_RENDER_TEST_PICTURES=DIR keeps sample pictures there, to look at (skipped otherwise).
+TEST_F(RendererTest, SamplePictures) {
+  const char* dir = std::getenv("SFFD_RENDER_TEST_PICTURES");
+  if (!dir || !*dir) GTEST_SKIP() << "set SFFD_RENDER_TEST_PICTURES=DIR to keep sample pictures";
+  Mesh a = makeSphere(1.0, glm::dvec3(0), 24, 12), b = makeSphere(1.0, glm::dvec3(0), 96, 48);
+  std::vector<float> height;
+  for (const auto& p : b.positions) height.push_back(float(p.z * 0.02));
+  RenderOptions o;
+  o.width = 960;
+  o.height = 480;
+  o.wireframe = true;
+  writePng(std::string(dir) + "/spheres.png", renderer->render({{&a, {}, "coarse (24x12)"}, {&b, height, "height, x0.02"}}, o));
+}
+
 // EGL and OSMesa are two ways to the same Mesa: their pictures agree within a small tolerance.
 TEST(RendererProviders, EglAndOSMesaAgree) {
   SKIP_WITHOUT_LIBRARY(Provider::EGL);

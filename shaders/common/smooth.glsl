@@ -1,0 +1,174 @@
+// shaders/common/smooth.glsl: the steps of the smooth-FFD deform stage (ALGORITHM.md 3.4) as
+// functions, shared by the fused kernel deform_smooth and the split kernels deform_step_*; the C++
+// twin is src/core/smooth_deform.cpp. Both forms call the same functions, so they agree.
+//
+// Bitwise C0: everything on a sub-edge is computed from that edge's data in an order both patches
+// share (sums of two products are commutative; near-corner control points use one expression from the
+// corner; boundary tessellation vertices are evaluated on the edge curve from its lexicographically
+// smaller corner; crease-line normals are ordered the same way).
+#ifndef SFFD_SMOOTH_GLSL
+#define SFFD_SMOOTH_GLSL
+
+#include "bspline.glsl"
+#include "pn.glsl"
+
+layout(std140, SFFD_SET binding = SFFD_BINDING_PARAMS) uniform DeformBlock { DeformParams params; };
+layout(std430, SFFD_SET binding = SFFD_BINDING_DEFORM_FIT) readonly buffer Fit { real fit[]; };
+layout(std430, SFFD_SET binding = SFFD_BINDING_DEFORM_SUB_HEADERS) readonly buffer SubHeaders { uvec4 subHeaders[]; };
+layout(std430, SFFD_SET binding = SFFD_BINDING_DEFORM_SUB_RECORDS) readonly buffer SubRecords { real4 subRecords[]; };
+
+const uint kSlotCp[6] = uint[6](2u, 1u, 3u, 7u, 8u, 5u);
+const uint kCornerCp[3] = uint[3](0u, 6u, 9u);
+
+// a before b in the lexicographic order of their coordinates (a total order both patches agree on).
+bool lexLess(real3 a, real3 b) {
+  if (a.x != b.x) return a.x < b.x;
+  if (a.y != b.y) return a.y < b.y;
+  return a.z < b.z;
+}
+
+// (-5 q0 + 18 q1 - 9 q2 + 2 q3) / 6: the cubic through q0..q3 at 0, 1/3, 2/3, 1, control point near q0.
+real3 nearControlPoint(real3 q0, real3 q1, real3 q2, real3 q3) {
+  P real3 r = (((q0 * real(-5) + q1 * real(18)) + q2 * real(-9)) + q3 * real(2)) / real(6);
+  return r;
+}
+
+// Steps 1 and 2 at the corners (and step 4, which needs the same Jacobians): the deformed corners,
+// their deformed normals, and the adjusting normals of the corners and of the crease slots.
+void smoothCornerSamples(uint st, out real3 Q[3], out real3 QN[3], out real3 adj[3], out real3 adjNbr[6]) {
+  uint rec = SFFD_SUB_STRIDE * st;
+  uint creaseBits = subHeaders[st].y;
+  for (uint c = 0u; c < 3u; ++c) {
+    LatticeSample S = latticeEvaluate(params.lattice, subRecords[rec + SFFD_SUB_XPN + c].xyz);
+    Q[c] = S.value;
+    QN[c] = snormalize(latticeCofactorNormal(S, subRecords[rec + SFFD_SUB_NLIN + c].xyz));
+    adj[c] = snormalize(latticeCofactorNormal(S, subRecords[rec + SFFD_SUB_NPN + c].xyz));
+    for (uint h = 0u; h < 2u; ++h) {
+      uint s = 2u * c + h;
+      adjNbr[s] = ((creaseBits >> s) & 1u) != 0u ? snormalize(latticeCofactorNormal(S, subRecords[rec + SFFD_SUB_NNBR + s].xyz)) : adj[c];
+    }
+  }
+}
+
+// Step 2 on the edges: samples at one third from each end, E[2e] near corner e, E[2e+1] near e+1.
+void smoothEdgeSamples(uint st, out real3 E[6], out real3 EN[6]) {
+  uint rec = SFFD_SUB_STRIDE * st;
+  P real third = real(1) / real(3);
+  P real twoThirds = real(2) / real(3);
+  for (uint e = 0u; e < 3u; ++e) {
+    uint a = e, b = (e + 1u) % 3u;
+    for (uint h = 0u; h < 2u; ++h) {
+      P real wa = h == 0u ? twoThirds : third;
+      P real wb = h == 0u ? third : twoThirds;
+      P real3 x = subRecords[rec + SFFD_SUB_XPN + a].xyz * wa + subRecords[rec + SFFD_SUB_XPN + b].xyz * wb;
+      P real3 n = subRecords[rec + SFFD_SUB_NLIN + a].xyz * wa + subRecords[rec + SFFD_SUB_NLIN + b].xyz * wb;
+      LatticeSample S = latticeEvaluate(params.lattice, x);
+      E[2u * e + h] = S.value;
+      EN[2u * e + h] = snormalize(latticeCofactorNormal(S, snormalize(n)));
+    }
+  }
+}
+
+// Step 1 inside: the deformed normal at interior fitting point i (the geometry's centre comes from
+// the PN rule after the adjustment, so only the normal patch needs the interior samples).
+real3 smoothInteriorNormal(uint st, uint i) {
+  uint rec = SFFD_SUB_STRIDE * st;
+  uint f = SFFD_FIT_STRIDE * i;
+  P real3 lam = real3(fit[f], fit[f + 1u], fit[f + 2u]);
+  P real3 x = (subRecords[rec + SFFD_SUB_XPN].xyz * lam.x + subRecords[rec + SFFD_SUB_XPN + 1u].xyz * lam.y) + subRecords[rec + SFFD_SUB_XPN + 2u].xyz * lam.z;
+  P real3 n = (subRecords[rec + SFFD_SUB_NLIN].xyz * lam.x + subRecords[rec + SFFD_SUB_NLIN + 1u].xyz * lam.y) + subRecords[rec + SFFD_SUB_NLIN + 2u].xyz * lam.z;
+  LatticeSample S = latticeEvaluate(params.lattice, x);
+  P real3 r = snormalize(latticeCofactorNormal(S, snormalize(n)));
+  return r;
+}
+
+// Step 3: boundary control points by the closed form of the constrained fit.
+void smoothBoundaryControlPoints(real3 Q[3], real3 QN[3], real3 E[6], real3 EN[6], out real3 cp[10], out real3 ncp[10]) {
+  for (uint c = 0u; c < 3u; ++c) {
+    cp[kCornerCp[c]] = Q[c];
+    ncp[kCornerCp[c]] = QN[c];
+  }
+  for (uint s = 0u; s < 6u; ++s) {
+    uint c = s / 2u;
+    uint o = (s % 2u == 1u) ? (c + 1u) % 3u : (c + 2u) % 3u;
+    uint e = (s % 2u == 1u) ? c : o;               // edge index (corner e -> e+1)
+    uint nearC = c == e ? 2u * e : 2u * e + 1u;    // the edge sample a third from c
+    uint nearO = c == e ? 2u * e + 1u : 2u * e;
+    cp[kSlotCp[s]] = nearControlPoint(Q[c], E[nearC], E[nearO], Q[o]);
+    ncp[kSlotCp[s]] = nearControlPoint(QN[c], EN[nearC], EN[nearO], QN[o]);
+  }
+  cp[4] = real3(0);
+  ncp[4] = real3(0);
+}
+
+// Step 3 inside: one interior sample's share of the normal patch's least-squares centre.
+real3 smoothCentreTerm(real3 ncp[10], real3 qn, uint i) {
+  uint f = SFFD_FIT_STRIDE * i;
+  P real3 r = qn;
+  for (uint k = 0u; k < 10u; ++k)
+    if (k != 4u) r = r - ncp[k] * fit[f + 4u + k];
+  P real3 term = r * fit[f + 3u];
+  return term;
+}
+
+// Step 5: edge control points onto the deformed tangent plane, or onto the crease line; centre by the PN rule.
+void smoothAdjust(uint creaseBits, real3 adj[3], real3 adjNbr[6], inout real3 cp[10]) {
+  for (uint s = 0u; s < 6u; ++s) {
+    uint c = s / 2u;
+    real3 X = cp[kCornerCp[c]];
+    P real3 b = cp[kSlotCp[s]];
+    P real3 d = b - X;
+    bool adjusted = false;
+    if (((creaseBits >> s) & 1u) != 0u) {
+      real3 n1 = adj[c], n2 = adjNbr[s];
+      if (lexLess(n2, n1)) { real3 x = n1; n1 = n2; n2 = x; }
+      P real3 cr = scross(n1, n2);
+      P real len2 = sdot(cr, cr);
+      if (len2 > real(1e-12)) {
+        P real3 t = cr / sqrt(len2);
+        b = X + t * sdot(d, t);
+        adjusted = true;
+      }
+    }
+    if (!adjusted) b = b - adj[c] * sdot(d, adj[c]);
+    cp[kSlotCp[s]] = b;
+  }
+  P real3 edgeSum = ((((cp[1] + cp[2]) + cp[3]) + cp[5]) + cp[7]) + cp[8];
+  P real3 cornerSum = (cp[0] + cp[6]) + cp[9];
+  P real3 centre = edgeSum / real(4) - cornerSum / real(6);
+  cp[4] = centre;
+}
+
+// Step 6: tessellation vertex (r, t) at level L. Corners exact, edge vertices on the canonical edge
+// curve, the rest by the patch.
+void smoothTessVertex(real3 cp[10], real3 ncp[10], uint L, uint r, uint t, out real3 x, out real3 n) {
+  uint i = L - r, j = r - t, k = t;
+  if (i == L || j == L || k == L) {
+    uint c = i == L ? 0u : (j == L ? 1u : 2u);
+    x = cp[kCornerCp[c]];
+    n = snormalize(ncp[kCornerCp[c]]);
+  } else if (i == 0u || j == 0u || k == 0u) {
+    // Edge (a, b) = (0,1) when k == 0, (1,2) when i == 0, (2,0) when j == 0; steps from a.
+    uint a = k == 0u ? 0u : (i == 0u ? 1u : 2u), b = (a + 1u) % 3u;
+    uint stepsFromA = a == 0u ? j : (a == 1u ? k : i);
+    uint sa = 2u * a + 1u, sb = 2u * b;   // slots of a and b on edge a
+    uint lo = a, hi = b, steps = stepsFromA, slo = sa, shi = sb;
+    if (lexLess(cp[kCornerCp[b]], cp[kCornerCp[a]])) { lo = b; hi = a; steps = L - stepsFromA; slo = sb; shi = sa; }
+    P real u = real(steps) / real(L);
+    x = pnEdgeCurve(cp[kCornerCp[lo]], cp[kSlotCp[slo]], cp[kSlotCp[shi]], cp[kCornerCp[hi]], u);
+    n = snormalize(pnEdgeCurve(ncp[kCornerCp[lo]], ncp[kSlotCp[slo]], ncp[kSlotCp[shi]], ncp[kCornerCp[hi]], u));
+  } else {
+    P real3 lam = real3(real(i), real(j), real(k)) / real(L);
+    real w[10];
+    pnCubicWeights(lam, w);
+    P real3 xs = real3(0), ns = real3(0);
+    for (uint q = 0u; q < 10u; ++q) {
+      xs = xs + cp[q] * w[q];
+      ns = ns + ncp[q] * w[q];
+    }
+    x = xs;
+    n = snormalize(ns);
+  }
+}
+
+#endif

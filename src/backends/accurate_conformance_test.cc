@@ -1,0 +1,157 @@
+// Conformance of the accurate FFD kernel (shaders/accurate_patches.comp) on every GPU backend against
+// its C++ twin (src/core/accurate_ffd.cpp): strict variants bit-identical, fast variants within the
+// tolerances of docs/CONFORMANCE.md; chunked jobs equal one dispatch; the identity lattice reproduces
+// the flat mesh; the largest patch degree (5,5,5 -> n = 15) runs.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <optional>
+#include <random>
+#include <sstream>
+
+#include "accurate_ffd.h"
+#include "backends/backend_select.h"
+#include "buffer_compare.h"
+#include "knot_box_clip.h"
+#include "vk/vk_backend.h"
+
+using namespace sffd;
+
+namespace {
+
+const std::string kData = SFFD_SHARED_DATA;
+
+std::vector<std::string> requiredBackends() {
+  const char* env = std::getenv("SFFD_REQUIRE_BACKENDS");
+  std::stringstream ss(env ? env : "vulkan,gl-egl,gl-osmesa");
+  std::vector<std::string> names;
+  for (std::string n; std::getline(ss, n, ',');)
+    if (!n.empty()) names.push_back(n);
+  return names;
+}
+
+OpenedBackend open(const std::string& name) {
+  BackendRequest r;
+  r.name = name;
+  r.validation = true;
+  return openBackend(r);
+}
+
+Lattice latticeFor(const Mesh& m, std::array<int, 3> counts, std::array<int, 3> degree, double amount, OutsideMode outside,
+                   double margin) {
+  glm::dvec3 lo = m.positions[0], hi = lo;
+  for (const auto& p : m.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
+  Lattice L = makeIdentityLattice(lo - margin, hi + margin, counts, degree);
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> u(-amount, amount);
+  for (auto& p : L.controlPoints) p += glm::dvec3(u(rng), u(rng), u(rng));
+  L.outside = outside;
+  return L;
+}
+
+// `cpTol`: the control points' tolerance when it differs (fast float: A_n^{-1} amplifies the samples'
+// rounding by up to |A_n^{-1}|_inf, 412 for n = 7, where the tessellated values do not).
+void expectBuffers(const AccurateOutput& a, const AccurateOutput& b, bool float32, const CompareTolerance& tol, const std::string& what,
+                   std::optional<CompareTolerance> cpTol = std::nullopt) {
+  const std::pair<const char*, std::pair<const std::vector<double>*, const std::vector<double>*>> buffers[] = {
+      {"control points", {&a.controlPoints, &b.controlPoints}},
+      {"positions", {&a.positions, &b.positions}},
+      {"normals", {&a.normals, &b.normals}}};
+  for (const auto& [name, ab] : buffers) {
+    ASSERT_EQ(ab.first->size(), ab.second->size()) << what << " " << name;
+    CompareResult r = compareBuffers(*ab.first, *ab.second, float32, ab.first == &a.controlPoints && cpTol ? *cpTol : tol);
+    EXPECT_EQ(r.mismatched, 0u) << what << " " << name << ": max_abs " << r.maxAbs << " max_ulp " << r.maxUlp << " mismatched "
+                                << r.mismatched << "/" << r.total;
+    std::printf("%-28s %-15s max_abs=%.3g max_ulp=%llu mismatched=%zu/%zu\n", what.c_str(), name, r.maxAbs,
+                (unsigned long long)r.maxUlp, r.mismatched, r.total);
+  }
+}
+
+class AccurateConformance : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(AccurateConformance, AgreesWithCpuTwinInEveryVariant) {
+  OpenedBackend b = open(GetParam());
+  ASSERT_TRUE(b.gpu);
+  Mesh mesh = readMesh(kData + "/acaffd/sphere.obj");
+  // Extrapolate: a margin-less box; Keep: a box smaller than the sphere, so the outside rule is exercised.
+  for (auto [outside, margin] : {std::pair{OutsideMode::Extrapolate, 0.0}, std::pair{OutsideMode::Keep, -0.05}}) {
+    Lattice L = latticeFor(mesh, {5, 6, 4}, {2, 3, 2}, 0.1, outside, margin);
+    PackedLattice P = packLattice(L);
+    AccurateJob job = makeAccurateJob(mesh, L, clipAgainstKnotBoxes(mesh, L), 10);
+    ASSERT_GT(job.count(), 1000u);
+    std::string o = outside == OutsideMode::Keep ? " keep" : "";
+    AccurateOutput cpuDouble = accurateFfdCpu(job, P, {false, true}), cpuFloat = accurateFfdCpu(job, P, {true, false});
+    // Strict float: bit-identical to the C++ float path.
+    expectBuffers(accurateFfdGpu(*b.gpu, job, P, {true, false}), cpuFloat, true, {true, 0, 0}, "strict float" + o);
+    // Fast float against the double reference: positions and normals within 1e-5 of the largest value,
+    // control points within 2 |A_7^{-1}|_inf 2^-24 = 5e-5, rounded up to 1e-4 (patch degree 2+3+2 = 7).
+    expectBuffers(accurateFfdGpu(*b.gpu, job, P, {false, false}), cpuDouble, true, {false, 64, 1e-5}, "fast float" + o,
+                  CompareTolerance{false, 64, 1e-4});
+    if (b.info.limits.float64) {
+      expectBuffers(accurateFfdGpu(*b.gpu, job, P, {true, true}), cpuDouble, false, {true, 0, 0}, "strict double" + o);
+      expectBuffers(accurateFfdGpu(*b.gpu, job, P, {false, true}), cpuDouble, false, {false, 0, 1e-12}, "fast double" + o);
+    }
+  }
+  EXPECT_EQ(vk::validationMessageCount(), 0u);
+}
+
+TEST_P(AccurateConformance, LargestPatchDegree) {
+  OpenedBackend b = open(GetParam());
+  Mesh mesh = readMesh(kData + "/acaffd/cube2.obj");
+  Lattice L = latticeFor(mesh, {6, 6, 6}, {5, 5, 5}, 0.05, OutsideMode::Extrapolate, 0.01);
+  PackedLattice P = packLattice(L);
+  AccurateJob job = makeAccurateJob(mesh, L, clipAgainstKnotBoxes(mesh, L), 6);
+  ASSERT_EQ(job.degree, 15);
+  expectBuffers(accurateFfdGpu(*b.gpu, job, P, {true, false}), accurateFfdCpu(job, P, {true, false}), true, {true, 0, 0}, "n=15 strict float");
+  if (b.info.limits.float64)
+    expectBuffers(accurateFfdGpu(*b.gpu, job, P, {true, true}), accurateFfdCpu(job, P, {false, true}), false, {true, 0, 0}, "n=15 strict double");
+  EXPECT_EQ(vk::validationMessageCount(), 0u);
+}
+
+TEST_P(AccurateConformance, ChunkedJobEqualsOneDispatch) {
+  OpenedBackend b = open(GetParam());
+  Mesh mesh = readMesh(kData + "/acaffd/sphere.obj");
+  Lattice L = latticeFor(mesh, {5, 5, 5}, {2, 2, 2}, 0.1, OutsideMode::Extrapolate, 0.01);
+  PackedLattice P = packLattice(L);
+  AccurateJob job = makeAccurateJob(mesh, L, clipAgainstKnotBoxes(mesh, L), 10);
+  AccurateOutput whole = accurateFfdGpu(*b.gpu, job, P, {true, false});
+  setenv("SFFD_MAX_CHUNK_PATCHES", "97", 1);   // many chunks, the last one partial
+  AccurateOutput chunked = accurateFfdGpu(*b.gpu, job, P, {true, false});
+  unsetenv("SFFD_MAX_CHUNK_PATCHES");
+  EXPECT_EQ(whole.controlPoints, chunked.controlPoints);
+  EXPECT_EQ(whole.positions, chunked.positions);
+  EXPECT_EQ(whole.normals, chunked.normals);
+}
+
+TEST_P(AccurateConformance, IdentityLatticeReproducesTheFlatMesh) {
+  OpenedBackend b = open(GetParam());
+  Mesh mesh = readMesh(kData + "/acaffd/sphere.obj");
+  Lattice L = latticeFor(mesh, {5, 5, 5}, {2, 2, 2}, 0.0, OutsideMode::Extrapolate, 0.0);
+  AccurateJob job = makeAccurateJob(mesh, L, clipAgainstKnotBoxes(mesh, L), 10);
+  PatchVertices pv = accuratePatchVertices(job, accurateFfdGpu(*b.gpu, job, packLattice(L), {false, false}));
+  double worstPos = 0, worstNrm = 0;
+  const int nv = tessVertexCount(10);
+  for (size_t p = 0; p < pv.patchCount(); ++p) {
+    const auto& t = mesh.triangles[pv.parent[p]];
+    glm::dvec3 nf = glm::normalize(glm::cross(mesh.positions[t[1]] - mesh.positions[t[0]], mesh.positions[t[2]] - mesh.positions[t[0]]));
+    for (int v = 0; v < nv; ++v) {
+      size_t g = p * nv + v;
+      const double* l = &pv.lamParent[3 * g];
+      glm::dvec3 x = l[0] * mesh.positions[t[0]] + l[1] * mesh.positions[t[1]] + l[2] * mesh.positions[t[2]];
+      worstPos = std::max(worstPos, glm::length(glm::dvec3(pv.position[3 * g], pv.position[3 * g + 1], pv.position[3 * g + 2]) - x));
+      worstNrm = std::max(worstNrm, glm::length(glm::dvec3(pv.normal[3 * g], pv.normal[3 * g + 1], pv.normal[3 * g + 2]) - nf));
+    }
+  }
+  std::printf("%s identity, fast float: max position error %.3g, max normal error %.3g\n", GetParam().c_str(), worstPos, worstNrm);
+  EXPECT_LT(worstPos, 5e-6);   // interior vertices pass through A_6^{-1} (|.|_inf = 169) in float
+  EXPECT_LT(worstNrm, 1e-6);
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, AccurateConformance, ::testing::ValuesIn(requiredBackends()),
+                         [](const auto& info) {
+                           std::string n = info.param;
+                           for (char& c : n) if (c == '-') c = '_';
+                           return n;
+                         });
+
+}  // namespace
