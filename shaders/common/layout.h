@@ -132,22 +132,28 @@ SFFD_STRUCT_BEGIN(PnParams)
 SFFD_STRUCT_END(PnParams)
 
 // ---- kernel accurate_patches (accurate FFD, ALGORITHM.md 2; owner: accurate FFD) ----
-// One thread per knot-box sub-triangle: the (n+1)(n+2)/2 samples of the lattice at the principal
-// lattice points of the flat sub-triangle, the exact Bezier patch P = A_n^{-1} S of degree
-// n = nu+nv+nw, then its tessellation at level L (layout of src/core/patch_output.h).
+// Three dispatches a chunk of knot-box sub-triangles (range.z selects the stage), so that no invocation
+// runs more than a few hundred loop iterations (llvmpipe ends every invocation after 65535 in all):
+//   stage 0, a thread per (sub-triangle, sample l): S_l = R(x(l/n)) at the principal lattice points;
+//   stage 1, a thread per (sub-triangle, control point k): P_k = sum_l A_n^{-1}[k][l] S_l (l ascending);
+//   stage 2, a thread per (sub-triangle, tessellation vertex): position and normal (patch_output.h layout).
 #define SFFD_ACC_MAX_DEGREE 15           // 3 * SFFD_MAX_DEGREE
 #define SFFD_ACC_MAX_CP 136              // (n+1)(n+2)/2 for n = SFFD_ACC_MAX_DEGREE
+#define SFFD_ACC_STAGE_SAMPLES 0u
+#define SFFD_ACC_STAGE_PATCHES 1u
+#define SFFD_ACC_STAGE_TESSELLATE 2u
 #define SFFD_BINDING_ACC_MATRIX 3        // reals: A_n^{-1} transposed, entry (sample l, control point k) at l*m + k
 #define SFFD_BINDING_ACC_TESS_BASIS 4    // reals: per tessellation vertex v, B^n_k(lambda_v) for the m control points k
 #define SFFD_BINDING_ACC_CORNERS 5       // 4 real4 per sub-triangle: its flat corners sum_i lam_i V_i, the parent's unit face normal
 #define SFFD_ACC_CORNER_STRIDE 4
-#define SFFD_BINDING_ACC_PATCHES 6       // m real4 per sub-triangle: the patch control points, linear index order (out)
-#define SFFD_BINDING_ACC_POSITIONS 7     // nv real4 per sub-triangle: tessellation positions (out)
-#define SFFD_BINDING_ACC_NORMALS 8       // nv real4 per sub-triangle: unit geometric normals of the patch, cof(J) n_face (out)
+#define SFFD_BINDING_ACC_PATCHES 6       // m real4 per sub-triangle: the patch control points, linear index order (stage 1 writes)
+#define SFFD_BINDING_ACC_POSITIONS 7     // nv real4 per sub-triangle: tessellation positions (stage 2 writes)
+#define SFFD_BINDING_ACC_NORMALS 8       // nv real4 per sub-triangle: unit geometric normals of the patch, cof(J) n_face (stage 2)
+#define SFFD_BINDING_ACC_SAMPLES 9       // m real4 per sub-triangle: the samples S_l (stage 0 writes, stage 1 reads)
 
 SFFD_STRUCT_BEGIN(AccurateParams)
   SFFD_STRUCT_MEMBER(LatticeParams, lattice)
-  SFFD_UVEC4 range;   // x: first sub-triangle of this chunk (relative to the bound ranges), y: sub-triangle count
+  SFFD_UVEC4 range;   // x: first sub-triangle of this chunk (relative to the bound ranges), y: sub-triangle count, z: stage
   SFFD_UVEC4 shape;   // x: patch degree n, y: control points m = (n+1)(n+2)/2, z: tessellation level L, w: vertices (L+1)(L+2)/2
 SFFD_STRUCT_END(AccurateParams)
 // ---- end of accurate_patches ----

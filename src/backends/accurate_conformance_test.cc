@@ -98,13 +98,25 @@ TEST_P(AccurateConformance, AgreesWithCpuTwinInEveryVariant) {
 TEST_P(AccurateConformance, LargestPatchDegree) {
   OpenedBackend b = open(GetParam());
   Mesh mesh = readMesh(kData + "/acaffd/cube2.obj");
-  Lattice L = latticeFor(mesh, {6, 6, 6}, {5, 5, 5}, 0.05, OutsideMode::Extrapolate, 0.01);
+  Lattice L = latticeFor(mesh, {7, 6, 7}, {5, 5, 5}, 0.05, OutsideMode::Extrapolate, 0.01);
   PackedLattice P = packLattice(L);
-  AccurateJob job = makeAccurateJob(mesh, L, clipAgainstKnotBoxes(mesh, L), 6);
+  AccurateJob job = makeAccurateJob(mesh, L, clipAgainstKnotBoxes(mesh, L), 10);
   ASSERT_EQ(job.degree, 15);
   expectBuffers(accurateFfdGpu(*b.gpu, job, P, {true, false}), accurateFfdCpu(job, P, {true, false}), true, {true, 0, 0}, "n=15 strict float");
   if (b.info.limits.float64)
     expectBuffers(accurateFfdGpu(*b.gpu, job, P, {true, true}), accurateFfdCpu(job, P, {false, true}), false, {true, 0, 0}, "n=15 strict double");
+  EXPECT_EQ(vk::validationMessageCount(), 0u);
+}
+
+TEST_P(AccurateConformance, HighestTessellationLevel) {
+  // --tess 64 (2145 vertices a patch): one invocation per patch would run past llvmpipe's 65535 loop
+  // iterations and leave the last vertices unwritten; the staged kernel must not.
+  OpenedBackend b = open(GetParam());
+  Mesh mesh = readMesh(kData + "/acaffd/cube2.obj");
+  Lattice L = latticeFor(mesh, {5, 5, 5}, {2, 2, 2}, 0.1, OutsideMode::Extrapolate, 0.01);
+  PackedLattice P = packLattice(L);
+  AccurateJob job = makeAccurateJob(mesh, L, clipAgainstKnotBoxes(mesh, L), 64);
+  expectBuffers(accurateFfdGpu(*b.gpu, job, P, {true, false}), accurateFfdCpu(job, P, {true, false}), true, {true, 0, 0}, "tess 64 strict float");
   EXPECT_EQ(vk::validationMessageCount(), 0u);
 }
 
@@ -155,3 +167,4 @@ INSTANTIATE_TEST_SUITE_P(Backends, AccurateConformance, ::testing::ValuesIn(requ
                          });
 
 }  // namespace
+

@@ -83,6 +83,7 @@ CommandSpec latticeCommand();
 CommandSpec devicesCommand();
 CommandSpec conformCommand();
 CommandSpec clipCommand();
+CommandSpec errorCommand();
 CommandSpec renderCommand();
 
 }  // namespace sffd::cli

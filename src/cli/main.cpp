@@ -11,6 +11,7 @@ using namespace sffd;
 
 static std::vector<cli::CommandSpec> commands() {
   return {cli::deformCommand(), cli::latticeCommand(), cli::devicesCommand(), cli::conformCommand(), cli::clipCommand(),
+          cli::errorCommand(),
           cli::renderCommand()};
 }
 

@@ -207,9 +207,12 @@ struct AccurateTwin {
         LatticeSampleT<Real> S = eval.evaluate(x);
         bool keep = !S.inside && L.degree.w == SFFD_OUTSIDE_KEEP;
         RVec3<Real> pos;
-        size_t b = size_t(v) * m;
-        for (uint32_t kk = 0; kk < m; ++kk) pos = pos + cp[kk] * basis[b + kk];
-        if (i == 0 || j == 0 || k == 0) pos = keep ? x : S.value;
+        if (i == 0 || j == 0 || k == 0) {
+          pos = keep ? x : S.value;
+        } else {
+          size_t b = size_t(v) * m;
+          for (uint32_t kk = 0; kk < m; ++kk) pos = pos + cp[kk] * basis[b + kk];
+        }
         RVec3<Real> nrm = keep ? nf : eval.cofactorNormal(S, nf);
         if (!(sdot(nrm, nrm) > Real(0))) nrm = nf;
         RVec3<Real> un = snormalize(nrm);
@@ -261,7 +264,8 @@ void accurateGpu(Backend& backend, const AccurateJob& job, const PackedLattice& 
   // The largest per-sub-triangle binding decides the chunk (positions and normals: nv real4 each).
   const size_t perSub = std::max<size_t>({SFFD_ACC_CORNER_STRIDE, m, nv}) * r4;
   size_t chunk = size_t(lim.maxStorageBufferRange / perSub);
-  chunk = std::min<size_t>(chunk, size_t(lim.maxWorkGroupCount[0]) * lim.maxWorkGroupCount[1] * SFFD_LOCAL_SIZE);
+  chunk = std::min<size_t>(chunk, size_t(lim.maxWorkGroupCount[0]) * lim.maxWorkGroupCount[1] * SFFD_LOCAL_SIZE / std::max(m, nv));
+  chunk = std::min<size_t>(chunk, size_t(UINT32_MAX) / std::max(m, nv));   // thread indices are 32-bit
   if (const char* forced = std::getenv("SFFD_MAX_CHUNK_PATCHES")) chunk = std::min<size_t>(chunk, std::strtoull(forced, nullptr, 10));
   chunk = std::max<size_t>(1, std::min(chunk, std::max<size_t>(ns, 1)));
 
@@ -278,6 +282,7 @@ void accurateGpu(Backend& backend, const AccurateJob& job, const PackedLattice& 
   };
   BufferId bFrame = upload(frame), bCoeffs = upload(coeffs), bMatrix = upload(matrix), bBasis = upload(basis);
   BufferId bCorners = backend.createBuffer(chunk * SFFD_ACC_CORNER_STRIDE * r4);
+  BufferId bSamples = backend.createBuffer(chunk * m * r4);
   BufferId bPatches = backend.createBuffer(chunk * m * r4);
   BufferId bPos = backend.createBuffer(chunk * nv * r4);
   BufferId bNrm = backend.createBuffer(chunk * nv * r4);
@@ -291,22 +296,27 @@ void accurateGpu(Backend& backend, const AccurateJob& job, const PackedLattice& 
     const size_t cw = 4 * SFFD_ACC_CORNER_STRIDE;
     for (size_t i = 0; i < cw * count; ++i) corners[i] = Real(job.corners[cw * first + i]);
     backend.upload(bCorners, 0, corners.data(), count * SFFD_ACC_CORNER_STRIDE * r4);
-    gpu::AccurateParams params;
-    params.lattice = P.params;
-    params.range = {0, uint32_t(count), 0, 0};
-    params.shape = {n, m, uint32_t(job.level), nv};
-    Dispatch d;
-    d.kernel = "accurate_patches";
-    d.variant = variant;
-    d.params = &params;
-    d.paramsSize = sizeof(params);
-    d.buffers = {{SFFD_BINDING_LATTICE_COEFFS, bCoeffs},  {SFFD_BINDING_LATTICE_FRAME, bFrame},
-                 {SFFD_BINDING_ACC_MATRIX, bMatrix},      {SFFD_BINDING_ACC_TESS_BASIS, bBasis},
-                 {SFFD_BINDING_ACC_CORNERS, bCorners},    {SFFD_BINDING_ACC_PATCHES, bPatches},
-                 {SFFD_BINDING_ACC_POSITIONS, bPos},      {SFFD_BINDING_ACC_NORMALS, bNrm}};
-    gridFor(count, lim, d.groups);
-    backend.dispatch(d);
-    backend.barrier();
+    // Samples, then control points, then the tessellation: three dispatches, a barrier between each.
+    for (uint32_t stage : {SFFD_ACC_STAGE_SAMPLES, SFFD_ACC_STAGE_PATCHES, SFFD_ACC_STAGE_TESSELLATE}) {
+      gpu::AccurateParams params;
+      params.lattice = P.params;
+      params.range = {0, uint32_t(count), stage, 0};
+      params.shape = {n, m, uint32_t(job.level), nv};
+      Dispatch d;
+      d.kernel = "accurate_patches";
+      d.variant = variant;
+      d.params = &params;
+      d.paramsSize = sizeof(params);
+      d.label = stage == SFFD_ACC_STAGE_SAMPLES ? "accurate_samples" : stage == SFFD_ACC_STAGE_PATCHES ? "accurate_patches" : "accurate_tessellate";
+      d.buffers = {{SFFD_BINDING_LATTICE_COEFFS, bCoeffs},  {SFFD_BINDING_LATTICE_FRAME, bFrame},
+                   {SFFD_BINDING_ACC_MATRIX, bMatrix},      {SFFD_BINDING_ACC_TESS_BASIS, bBasis},
+                   {SFFD_BINDING_ACC_CORNERS, bCorners},    {SFFD_BINDING_ACC_PATCHES, bPatches},
+                   {SFFD_BINDING_ACC_POSITIONS, bPos},      {SFFD_BINDING_ACC_NORMALS, bNrm},
+                   {SFFD_BINDING_ACC_SAMPLES, bSamples}};
+      gridFor(uint64_t(count) * (stage == SFFD_ACC_STAGE_TESSELLATE ? nv : m), lim, d.groups);
+      backend.dispatch(d);
+      backend.barrier();
+    }
     backend.download(bPatches, 0, cps.data(), count * m * r4);
     backend.download(bPos, 0, pos.data(), count * nv * r4);
     backend.download(bNrm, 0, nrm.data(), count * nv * r4);
@@ -315,7 +325,7 @@ void accurateGpu(Backend& backend, const AccurateJob& job, const PackedLattice& 
     std::copy(nrm.begin(), nrm.begin() + count * nv * 4, out.normals.begin() + first * nv * 4);
   }
   backend.finish();
-  for (BufferId b : {bFrame, bCoeffs, bMatrix, bBasis, bCorners, bPatches, bPos, bNrm}) backend.destroyBuffer(b);
+  for (BufferId b : {bFrame, bCoeffs, bMatrix, bBasis, bCorners, bSamples, bPatches, bPos, bNrm}) backend.destroyBuffer(b);
   out.timings = backend.takeTimings();
 }
 

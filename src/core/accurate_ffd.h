@@ -5,8 +5,9 @@
 // P = A_n^{-1} S, A_n[l][k] = B^n_k(l/n) (linear index order of ALGORITHM.md 0). Each patch is then
 // tessellated at level L (patch_output.h).
 //
-// Runs on a GPU backend (kernel shaders/accurate_patches.comp, one thread per sub-triangle) or on the
-// CPU reference (the same operations in C++, templated on the arithmetic type: double is the oracle,
+// Runs on a GPU backend (kernel shaders/accurate_patches.comp, three dispatches per chunk: a thread per
+// sample, per control point and per tessellation vertex, because llvmpipe ends an invocation after
+// 65535 loop iterations in all, which one thread per patch exceeds at --tess 38) or on the CPU reference (the same operations in C++, templated on the arithmetic type: double is the oracle,
 // float in the strict kernels' order matches the strict kernels bit for bit).
 //
 // Tessellation: interior vertices are B^n(lambda)·P. Boundary vertices are R(x_flat(lambda)), the

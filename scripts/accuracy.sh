@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# Regenerates the error tables of docs/ACCURACY.md: the paper's Tables 3 to 6 cases (cube2 with
+# cube2_control_points5, the teapot t.bpt with t_control_points1; l = 0.2, level 10), improved
+# (regular) against 2015 (knot-box) clipping, and the l sweep. Needs a built build/sffd.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+SFFD=${SFFD:-build/sffd}
+D=../shared/data/acaffd
+row() {  # label mesh lattice normalize clip l
+  "$SFFD" error "$D/$2" -l "$D/lattices/$3" --normalize "$4" --clip "$5" --edge-length "$6" --tess 10 --backend cpu --json --quiet \
+    | /usr/bin/python3 -c "
+import json, sys
+j = json.load(sys.stdin); g = j['geometry']; n = j['normal_deg']; v = j.get('volume')
+vol = '%.5g / %.5g (%.2e)' % (v['result'], v['reference'], v['rel_error']) if v else '-'
+print('| $1 | $5 | $6 | %.3g / %.3g | %.3g / %.3g | %s |' % (g['avg'], g['max'], n['avg'], n['max'], vol))"
+}
+echo "| case | clipping | l | geometry avg / max | normal avg / max (deg) | volume result / reference (rel) |"
+echo "|---|---|---|---|---|---|"
+row "cube2 + cube2_control_points5 (0.99)" cube2.obj cube2_control_points5.npy 0.99 regular 0.2
+row "cube2 + cube2_control_points5 (0.99)" cube2.obj cube2_control_points5.npy 0.99 knot-box 0.2
+row "t.bpt + t_control_points1 (1/1.1)" t.bpt t_control_points1.npy 0.9090909090909091 regular 0.2
+row "t.bpt + t_control_points1 (1/1.1)" t.bpt t_control_points1.npy 0.9090909090909091 knot-box 0.2
+echo
+echo "l sweep (teapot, regular clipping): l, sub-triangles, geometry avg, geometry max, normal avg, normal max"
+for l in 0.4 0.3 0.2 0.15 0.1 0.07 0.05; do
+  "$SFFD" error "$D/t.bpt" -l "$D/lattices/t_control_points1.npy" --normalize 0.9090909090909091 --edge-length $l --backend cpu --json --quiet \
+    | /usr/bin/python3 -c "
+import json, sys
+j = json.load(sys.stdin); print($l, j.get('sub_triangles', 0), j['geometry']['avg'], j['geometry']['max'], j['normal_deg']['avg'], j['normal_deg']['max'])"
+done

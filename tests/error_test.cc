@@ -1,0 +1,123 @@
+// End-to-end tests of `sffd error` (CONTRACT.md, docs/ACCURACY.md "Error metrics"): the JSON contract,
+// accurate FFD measured against the exact FFD (about 0), classic FFD (positive), closed and open meshes.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+const std::string kAcaffd = std::string(SFFD_SHARED_DATA) + "/acaffd/";
+const std::string kSffd = SFFD_BINARY;
+
+struct Result {
+  int status = -1;
+  std::string out, err;
+};
+
+Result sffd(const std::string& args) {
+  fs::path dir = fs::temp_directory_path() / ("sffd_error_test_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  std::string o = (dir / "stdout").string(), e = (dir / "stderr").string();
+  int raw = std::system((kSffd + " " + args + " >" + o + " 2>" + e).c_str());
+  Result r;
+  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : 128;
+  auto slurp = [](const std::string& p) {
+    std::ifstream f(p);
+    std::stringstream ss;
+    ss << f.rdbuf();
+    return ss.str();
+  };
+  r.out = slurp(o);
+  r.err = slurp(e);
+  return r;
+}
+
+void expectStats(const nlohmann::json& s) {
+  for (const char* k : {"avg", "max", "std"}) {
+    ASSERT_TRUE(s.contains(k)) << k;
+    EXPECT_TRUE(s[k].is_number()) << k;
+  }
+  EXPECT_LE(s["avg"].get<double>(), s["max"].get<double>());
+}
+
+const std::string kCube = kAcaffd + "cube2.obj -l " + kAcaffd + "lattices/cube2_control_points5.npy";
+const std::string kTeapot = kAcaffd + "t.bpt -l " + kAcaffd + "lattices/t_control_points1.npy --normalize 0.9090909";
+
+}  // namespace
+
+TEST(ErrorCommand, AccurateOnTheCubeIsExactAndHasAVolume) {
+  Result r = sffd("error " + kCube + " --method accurate --json --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["method"], "accurate");
+  EXPECT_EQ(j["clip"], "knot-box");
+  EXPECT_EQ(j["vertices"].get<size_t>() % 66, 0u);
+  EXPECT_GT(j["vertices"].get<size_t>(), 0u);
+  expectStats(j["geometry"]);
+  expectStats(j["normal_deg"]);
+  // Double precision by default where the device has it (lavapipe has), float otherwise.
+  double tol = j.value("precision", "") == "double" ? 1e-9 : 1e-4;
+  EXPECT_LT(j["geometry"]["max"].get<double>(), tol);
+  ASSERT_TRUE(j["volume"].is_object()) << r.out;
+  for (const char* k : {"reference", "result", "rel_error"}) EXPECT_TRUE(j["volume"][k].is_number()) << k;
+  EXPECT_GT(j["volume"]["reference"].get<double>(), 0);
+  EXPECT_LT(j["volume"]["rel_error"].get<double>(), 5e-3);   // the level-10 tessellation of the exact patches
+}
+
+TEST(ErrorCommand, ClassicHasAPositiveErrorOnTheSameJob) {
+  Result a = sffd("error " + kCube + " --method accurate --json --quiet --backend cpu");
+  Result c = sffd("error " + kCube + " --method classic --json --quiet --backend cpu");
+  ASSERT_EQ(a.status, 0) << a.err;
+  ASSERT_EQ(c.status, 0) << c.err;
+  nlohmann::json ja = nlohmann::json::parse(a.out), jc = nlohmann::json::parse(c.out);
+  EXPECT_EQ(jc["method"], "classic");
+  EXPECT_EQ(jc["vertices"].get<size_t>(), 12u * 66u);   // 12 triangles tessellated at level 10
+  EXPECT_GT(jc["geometry"]["avg"].get<double>(), 1e-2);
+  EXPECT_GT(jc["normal_deg"]["avg"].get<double>(), 1.0);
+  // The same exact reference volume, whichever method is measured.
+  EXPECT_DOUBLE_EQ(ja["volume"]["reference"].get<double>(), jc["volume"]["reference"].get<double>());
+  EXPECT_GT(jc["volume"]["rel_error"].get<double>(), ja["volume"]["rel_error"].get<double>());
+}
+
+TEST(ErrorCommand, TheOpenTeapotHasNoVolume) {
+  Result r = sffd("error " + kTeapot + " --method classic --json --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_TRUE(j["volume"].is_null()) << r.out;
+  expectStats(j["geometry"]);
+  // Against the exact bicubic surface: the flat triangles miss it between the vertices.
+  EXPECT_GT(j["geometry"]["avg"].get<double>(), 1e-4);
+}
+
+TEST(ErrorCommand, AccurateTeapotRunsOnTheExactSurfaceReference) {
+  Result r = sffd("error " + kTeapot + " --method accurate --json --quiet --tess 2");
+  ASSERT_EQ(r.status, 0) << r.err;
+  nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_TRUE(j["volume"].is_null());
+  EXPECT_EQ(j["vertices"].get<size_t>() % 6, 0u);   // 6 vertices a patch at level 2
+  EXPECT_GT(j["geometry"]["max"].get<double>(), 1e-3);
+}
+
+TEST(ErrorCommand, HumanReadableSummaryAndBadOptions) {
+  Result r = sffd("error " + kCube + " --method accurate --quiet --tess 3");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("geometry"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("volume"), std::string::npos) << r.out;
+  Result bad = sffd("error " + kCube + " --method exact");
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_EQ(bad.err.rfind("sffd: error: ", 0), 0u) << bad.err;
+  Result tess = sffd("error " + kCube + " --method accurate --tess 0");
+  EXPECT_EQ(tess.status, 2) << tess.err;
+  Result help = sffd("error --help");
+  EXPECT_EQ(help.status, 0);
+  EXPECT_NE(help.out.find("--json"), std::string::npos);
+}
