@@ -22,9 +22,30 @@ row "t.bpt + t_control_points1 (1/1.1)" t.bpt t_control_points1.npy 0.9090909090
 row "t.bpt + t_control_points1 (1/1.1)" t.bpt t_control_points1.npy 0.9090909090909091 knot-box 0.2
 echo
 echo "l sweep (teapot, regular clipping): l, sub-triangles, geometry avg, geometry max, normal avg, normal max"
-for l in 0.4 0.3 0.2 0.15 0.1 0.07 0.05; do
+SWEEP=$(mktemp)
+for l in 0.4 0.3 0.2 0.15 0.1 0.07 0.05 0.035 0.025; do
   "$SFFD" error "$D/t.bpt" -l "$D/lattices/t_control_points1.npy" --normalize 0.9090909090909091 --edge-length $l --backend cpu --json --quiet \
     | /usr/bin/python3 -c "
 import json, sys
 j = json.load(sys.stdin); print($l, j.get('sub_triangles', 0), j['geometry']['avg'], j['geometry']['max'], j['normal_deg']['avg'], j['normal_deg']['max'])"
-done
+done | tee "$SWEEP"
+# The plot of docs/ACCURACY.md (Debian's python3-matplotlib, installed by scripts/figures.sh).
+/usr/bin/python3 - "$SWEEP" docs/figures/l_sweep_teapot.png <<'PY'
+import sys
+import matplotlib
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+rows = [list(map(float, l.split())) for l in open(sys.argv[1]) if l.strip()]
+l = [r[0] for r in rows]
+fig, ax = plt.subplots(1, 2, figsize=(9, 3.4), dpi=100)
+ax[0].plot(l, [r[2] for r in rows], "o-", label="geometry avg")
+ax[0].plot(l, [r[3] for r in rows], "s-", label="geometry max")
+ax[0].set_xlabel("edge length l"); ax[0].set_ylabel("distance to exact FFD"); ax[0].set_yscale("log"); ax[0].legend(fontsize=8)
+ax2 = ax[1]
+ax2.plot(l, [r[1] for r in rows], "o-", color="tab:green")
+ax2.set_xlabel("edge length l"); ax2.set_ylabel("sub-triangles"); ax2.set_yscale("log")
+fig.suptitle("teapot t.bpt + t_control_points1, smooth FFD, level 10")
+fig.tight_layout()
+fig.savefig(sys.argv[2])
+PY
+rm -f "$SWEEP"
