@@ -259,3 +259,22 @@ TEST(Cli, ClipRefusesAnAbsurdEdgeLength) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(Cli, RenderColoursByError) {
+  fs::path dir = tempDir("render_error");
+  std::string out = (dir / "e.png").string();
+  RunResult r = runSffd("render " + kData + "/acaffd/cube2.obj -l " + kData +
+                        "/acaffd/lattices/cube2_control_points5.npy --edge-length 0.5 --color-by normal --width 160 --height 120 -o " + out + " --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::ifstream f(out, std::ios::binary);
+  char sig[8] = {};
+  f.read(sig, 8);
+  EXPECT_EQ(std::string(sig + 1, 3), "PNG");
+  r = runSffd("render " + kData + "/acaffd/cube2.obj --color-by normal -o " + (dir / "f.png").string());
+  EXPECT_EQ(r.status, 2);   // colouring by error needs a lattice
+  EXPECT_FALSE(fs::exists(dir / "f.png"));
+}
+
+}  // namespace

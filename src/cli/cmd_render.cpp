@@ -2,10 +2,13 @@
 // the lattice with any --method (src/gl/gl_renderer.h draws it on its own GL context, apart from the
 // compute backend). --compare classic|input puts the classic FFD result or the input on the left.
 #include <algorithm>
+#include <cmath>
 #include <charconv>
 #include <filesystem>
 
 #include "cli.h"
+#include "error_metrics.h"
+#include "patch_output.h"
 #include "deform_job.h"
 #include "error.h"
 #include "gl/gl_renderer.h"
@@ -13,6 +16,22 @@
 
 namespace sffd::cli {
 namespace {
+
+// The tessellation with every patch vertex its own vertex, so each can carry its own error.
+Mesh unweldedMesh(const PatchVertices& pv) {
+  Mesh m;
+  const size_t nv = size_t(tessVertexCount(pv.level));
+  std::vector<uint32_t> local = tessTriangles(pv.level);
+  for (size_t v = 0; v < pv.vertexCount(); ++v) {
+    m.positions.push_back({pv.position[3 * v], pv.position[3 * v + 1], pv.position[3 * v + 2]});
+    m.normals.push_back({pv.normal[3 * v], pv.normal[3 * v + 1], pv.normal[3 * v + 2]});
+    m.weldId.push_back(uint32_t(v));
+  }
+  for (size_t p = 0; p < pv.patchCount(); ++p)
+    for (size_t i = 0; i < local.size(); i += 3)
+      m.triangles.push_back({uint32_t(p * nv + local[i]), uint32_t(p * nv + local[i + 1]), uint32_t(p * nv + local[i + 2])});
+  return m;
+}
 
 Error usageError(const std::string& what) { return Error(ErrorKind::Input, what); }
 
@@ -57,6 +76,11 @@ int run(const ParsedArgs& args) {
     throw usageError("--method must be smooth, accurate or classic, not '" + method + "'");
   const std::string clip = args.get("--clip", "regular");
   if (clip != "regular" && clip != "knot-box") throw usageError("--clip must be regular or knot-box");
+  const std::string colorBy = args.get("--color-by");
+  if (args.has("--color-by") && colorBy != "geometry" && colorBy != "normal")
+    throw usageError("--color-by must be geometry or normal, not '" + colorBy + "'");
+  if (args.has("--color-by") && !args.has("--lattice")) throw usageError("--color-by needs a lattice (-l)");
+  std::vector<float> errorScalars;
   const std::string compare = args.get("--compare");
   if (args.has("--compare") && compare != "classic" && compare != "input")
     throw usageError("--compare must be classic or input, not '" + compare + "'");
@@ -90,15 +114,35 @@ int run(const ParsedArgs& args) {
       meshes.push_back(runClassic(args, classicJob, backend).mesh);
       captions.push_back("classic FFD");
     }
-    meshes.push_back(runDeformJob(args, job, backend).mesh);
-    captions.push_back(args.has("--compare") ? method + " FFD" : "");
+    DeformRun run = runDeformJob(args, job, backend);
+    if (colorBy.empty()) {
+      meshes.push_back(std::move(run.mesh));
+    } else {
+      // Every tessellation vertex coloured by its error against the exact FFD of its pre-image.
+      PatchVertices pv = run.patches ? *run.patches : linearPatchVertices(run.mesh, args.getInt("--tess", 10));
+      PackedLattice packed = packLattice(job.lattice);
+      ExactReference ref(job.mesh, packed);
+      meshes.push_back(unweldedMesh(pv));
+      errorScalars.resize(pv.vertexCount());
+      for (size_t v = 0; v < pv.vertexCount(); ++v) {
+        glm::dvec3 x, n, xr, nr;
+        ref.preImage(pv.parent[v / tessVertexCount(pv.level)], glm::dvec3(pv.lamParent[3 * v], pv.lamParent[3 * v + 1], pv.lamParent[3 * v + 2]), x, n);
+        ref.deform(x, n, xr, nr);
+        glm::dvec3 p(pv.position[3 * v], pv.position[3 * v + 1], pv.position[3 * v + 2]);
+        glm::dvec3 q(pv.normal[3 * v], pv.normal[3 * v + 1], pv.normal[3 * v + 2]);
+        errorScalars[v] = colorBy == "geometry" ? float(glm::length(p - xr))
+                                                : float(std::atan2(glm::length(glm::cross(q, nr)), glm::dot(q, nr)) * 180 / M_PI);
+      }
+    }
+    captions.push_back(args.has("--compare") ? method + " FFD" : (colorBy.empty() ? "" : colorBy + " error"));
   }
   for (const Mesh& m : meshes)
     if (m.triangles.empty()) throw Error(ErrorKind::Input, args.positional[0] + ": no triangles to draw");
 
   std::unique_ptr<gl::Renderer> renderer = gl::Renderer::createHeadless();
   std::vector<gl::RenderItem> items;
-  for (size_t i = 0; i < meshes.size(); ++i) items.push_back({&meshes[i], {}, upper(captions[i])});
+  for (size_t i = 0; i < meshes.size(); ++i)
+    items.push_back({&meshes[i], i + 1 == meshes.size() ? errorScalars : std::vector<float>{}, upper(captions[i])});
   gl::Image image = renderer->render(items, ro);
   writePng(out, image);
   size_t triangles = 0;
@@ -123,6 +167,7 @@ CommandSpec renderCommand() {
       {"--up", "AXIS", "the model's up axis: x, y, z, -x, -y, -z (default z)"},
       {"--wireframe", nullptr, "draw the triangle edges over the shading"},
       {"--compare", "WHAT", "classic|input: draw it on the left, the --method result on the right"},
+      {"--color-by", "WHAT", "geometry|normal: colour the result by its error against the exact FFD (sffd error's metrics)"},
   };
   for (const OptionSpec& o : jobOptions())
     if (std::string(o.name) != "--stats") c.options.push_back(o);   // render writes a picture only

@@ -154,7 +154,7 @@ void finishMesh(Mesh& mesh, const std::vector<uint8_t>& fromFile, const std::str
     if (v < fromFile.size() && fromFile[v]) {
       const glm::dvec3 m = mesh.normals[v];
       const double big = std::max({std::abs(m.x), std::abs(m.y), std::abs(m.z)});
-      if (std::isfinite(big) && big > 0) {
+      if (std::isfinite(m.x) && std::isfinite(m.y) && std::isfinite(m.z) && big > 0) {   // (max() passes a NaN over)
         // A normal already of unit length is kept bit for bit (so that files written by writeMesh read
         // back exactly); others are scaled by their largest component first, so that tiny (denormal) and
         // huge ones normalise without underflow or overflow.

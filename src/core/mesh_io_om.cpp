@@ -130,6 +130,9 @@ Mesh readOm(const std::string& path, const std::string& text) {
       ::dup2(devnull, 1);
       ::dup2(devnull, 2);
     }
+    // The parent's handlers (a sanitizer's, a fuzzer's, a caller's SIGALRM) are not the child's: a
+    // crash in OpenMesh just ends the child, and the alarm below really ends it.
+    for (int sig : {SIGSEGV, SIGBUS, SIGABRT, SIGFPE, SIGILL, SIGALRM}) ::signal(sig, SIG_DFL);
     ::alarm(600);   // a file that sends OpenMesh into a loop
     int rc = 5;
     try {

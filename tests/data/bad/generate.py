@@ -6,7 +6,8 @@
 Files directly in this folder must be refused by `sffd deform` (exit 2, one error line naming the
 file); files in odd/ are odd but valid and must be processed. Big inputs (a 100,000-character line,
 a 5-million-triangle mesh) are made by the tests and tools at run time, not kept here.
-odd/cube.om is not written here: it was written once by OpenMesh (README.md says how).
+odd/cube.om is not written here: it was written once by OpenMesh (README.md says how); nor is
+odd/fuzz_om_nan_normal.om, found by fuzz_mesh_binary.
 """
 import math
 import os
@@ -249,6 +250,13 @@ def odd():
     put("bom_crlf.obj", b"\xef\xbb\xbf" + ("# made on Windows\r\n" + TRI_OBJ.replace("\n", "\r\n") +
                                           "v 0 0 1\r\nf 1 3 2\r\nf 1 2 4\r\nf 1 4 3\r\nf 2 3 4\r\n").encode(), ODD)
     put("zero_normals.obj", obj(tet, [], "vn 0 0 0\n") + "f 1//1 3//1 2//1\nf 1//1 2//1 4//1\nf 1//1 4//1 3//1\nf 2//1 3//1 4//1\n", ODD)
+    # File normals with a NaN or an infinite component next to finite ones, a denormal and a huge one:
+    # recomputed or rescaled, never NaN (fuzz_mesh_binary found the NaN case in an .om file).
+    put("odd_normals.ply", "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+        "property float z\nproperty double nx\nproperty double ny\nproperty double nz\nelement face 4\n"
+        "property list uchar int vertex_indices\nend_header\n"
+        "0 0 0 1 nan 0\n1 0 0 inf 0 0\n0 1 0 0 1e-310 0\n0 0 1 1e300 1e300 1e300\n"
+        "3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n", ODD)
     # A binary STL whose 80-byte header starts with "solid" (many exporters write this).
     tris = [[tet[0], tet[2], tet[1]], [tet[0], tet[1], tet[3]], [tet[0], tet[3], tet[2]], [tet[1], tet[2], tet[3]]]
     put("solid_header_binary.stl", stl_binary(tris, header=b"solid tetra exported as binary"), ODD)
