@@ -105,4 +105,40 @@ struct ParentT {
   }
 };
 
+// Writes one sub-triangle record (shaders/common/layout.h, SFFD_SUB_*) and its header. Slot 2c is
+// corner c on the sub-edge towards corner c+2, slot 2c+1 towards c+1; `parentEdgeOf(c, d)` gives the
+// parent edge the sub-edge (c, d) lies on, or -1. Where that parent edge is a crease, the slot holds
+// the neighbour's PN normal (w = 1); elsewhere the corner's own PN normal (w = 0).
+template <class Real, class ParentEdgeOf>
+void storeSubTriangle(const ParentT<Real>& par, const SiteT<Real> site[3], const SiteValueT<Real> val[3],
+                      ParentEdgeOf parentEdgeOf, double* rec, uint32_t* hdr) {
+  auto put = [&](int slot, RVec3<Real> v, Real w) {
+    rec[4 * slot] = v.x, rec[4 * slot + 1] = v.y, rec[4 * slot + 2] = v.z, rec[4 * slot + 3] = w;
+  };
+  uint32_t creaseBits = 0;
+  for (int c = 0; c < 3; ++c) {
+    put(SFFD_SUB_LAM + c, val[c].lam, 0);
+    put(SFFD_SUB_XPN + c, val[c].xpn, 0);
+    put(SFFD_SUB_XFLAT + c, val[c].xflat, 0);
+    put(SFFD_SUB_NLIN + c, val[c].nlin, 0);
+    put(SFFD_SUB_NPN + c, val[c].npn, 0);
+    for (int h = 0; h < 2; ++h) {
+      int d = h == 0 ? (c + 2) % 3 : (c + 1) % 3;
+      RVec3<Real> nn = val[c].npn;
+      Real nw = 0;
+      int e = parentEdgeOf(c, d);
+      if (e >= 0) {
+        auto nb = par.neighbourNormal(e, par.paramOnEdge(site[c], e));
+        if (nb[3] > Real(0.5)) {
+          nn = {nb[0], nb[1], nb[2]};
+          nw = 1;
+          creaseBits |= 1u << (2 * c + h);
+        }
+      }
+      put(SFFD_SUB_NNBR + 2 * c + h, nn, nw);
+    }
+  }
+  hdr[0] = par.id, hdr[1] = creaseBits, hdr[2] = 0, hdr[3] = 0;
+}
+
 }  // namespace sffd

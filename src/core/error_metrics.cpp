@@ -3,63 +3,13 @@
 #include <algorithm>
 #include <cmath>
 
+#include "bicubic_patch.h"
 #include "knot_box_clip.h"
 #include "lattice_eval.h"
 #include "mesh_topology.h"
 
 namespace sffd {
 namespace {
-
-void bernstein3(double t, double b[4], double d[4]) {
-  double s = 1.0 - t;
-  b[0] = s * s * s;
-  b[1] = 3.0 * t * s * s;
-  b[2] = 3.0 * t * t * s;
-  b[3] = t * t * t;
-  d[0] = -3.0 * s * s;
-  d[1] = 3.0 * s * s - 6.0 * t * s;
-  d[2] = 6.0 * t * s - 3.0 * t * t;
-  d[3] = 3.0 * t * t;
-}
-
-// S(u, v), Su, Sv of a bicubic patch (the .bpt reader's formula: P = sum B3_r(u) B3_c(v) points[4r+c]).
-void evalPatch(const BicubicPatch& P, double u, double v, glm::dvec3& S, glm::dvec3& Su, glm::dvec3& Sv) {
-  double bu[4], du[4], bv[4], dv[4];
-  bernstein3(u, bu, du);
-  bernstein3(v, bv, dv);
-  S = Su = Sv = glm::dvec3(0.0);
-  for (int r = 0; r < 4; ++r)
-    for (int c = 0; c < 4; ++c) {
-      const glm::dvec3& q = P.points[4 * r + c];
-      S += (bu[r] * bv[c]) * q;
-      Su += (du[r] * bv[c]) * q;
-      Sv += (bu[r] * dv[c]) * q;
-    }
-}
-
-// The exact unit normal Su x Sv; where it vanishes (a collapsed patch edge), taken at a parameter
-// nudged toward the patch interior, as the .bpt reader does (mesh_io_bpt.cpp).
-glm::dvec3 patchNormal(const BicubicPatch& P, double u, double v) {
-  glm::dvec3 lo(INFINITY), hi(-INFINITY);
-  for (const auto& q : P.points) lo = glm::min(lo, q), hi = glm::max(hi, q);
-  glm::dvec3 ext = hi - lo;
-  double scale = std::max({ext.x, ext.y, ext.z, 1e-300});
-  double scale2 = scale * scale;
-  glm::dvec3 S, Su, Sv;
-  evalPatch(P, u, v, S, Su, Sv);
-  glm::dvec3 n = glm::cross(Su, Sv);
-  double len = glm::length(n);
-  if (len > 1e-10 * scale2) return n / len;
-  for (double delta : {1e-6, 1e-4, 1e-2}) {
-    double uu = u + (u < 0.5 ? delta : u > 0.5 ? -delta : 0.0);
-    double vv = v + (v < 0.5 ? delta : v > 0.5 ? -delta : 0.0);
-    evalPatch(P, uu, vv, S, Su, Sv);
-    n = glm::cross(Su, Sv);
-    len = glm::length(n);
-    if (len > 1e-14 * scale2) return n / len;
-  }
-  return glm::dvec3(0, 0, 1);
-}
 
 double angleDeg(const glm::dvec3& a, const glm::dvec3& b) {
   return std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b)) * (180.0 / M_PI);
@@ -95,8 +45,8 @@ void ExactReference::preImage(uint32_t parent, const glm::dvec3& lam, glm::dvec3
       glm::dvec2 uv = lam.x * mesh_.vertexUV[t[0]] + lam.y * mesh_.vertexUV[t[1]] + lam.z * mesh_.vertexUV[t[2]];
       uv = glm::clamp(uv, glm::dvec2(0.0), glm::dvec2(1.0));
       glm::dvec3 Su, Sv;
-      evalPatch(mesh_.patches[p], uv.x, uv.y, x, Su, Sv);
-      n = patchNormal(mesh_.patches[p], uv.x, uv.y);
+      evaluateBicubic(mesh_.patches[p], uv.x, uv.y, x, Su, Sv);
+      n = bicubicNormal(mesh_.patches[p], uv.x, uv.y);
       return;
     }
   }

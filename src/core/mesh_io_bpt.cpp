@@ -23,56 +23,13 @@
 #include <cmath>
 #include <unordered_map>
 
+#include "bicubic_patch.h"
 #include "error.h"
 #include "io_util.h"
 #include "mesh_io_internal.h"
 
 namespace sffd::meshio {
 namespace {
-
-void bernstein3(double t, double b[4], double d[4]) {
-  double s = 1.0 - t;
-  b[0] = s * s * s;
-  b[1] = 3.0 * t * s * s;
-  b[2] = 3.0 * t * t * s;
-  b[3] = t * t * t;
-  d[0] = -3.0 * s * s;
-  d[1] = 3.0 * s * s - 6.0 * t * s;
-  d[2] = 6.0 * t * s - 3.0 * t * t;
-  d[3] = 3.0 * t * t;
-}
-
-void evalPatch(const BicubicPatch& P, double u, double v, glm::dvec3& S, glm::dvec3& Su, glm::dvec3& Sv) {
-  double bu[4], du[4], bv[4], dv[4];
-  bernstein3(u, bu, du);
-  bernstein3(v, bv, dv);
-  S = Su = Sv = glm::dvec3(0.0);
-  for (int r = 0; r < 4; ++r)
-    for (int c = 0; c < 4; ++c) {
-      const glm::dvec3& q = P.points[4 * r + c];
-      S += (bu[r] * bv[c]) * q;
-      Su += (du[r] * bv[c]) * q;
-      Sv += (bu[r] * dv[c]) * q;
-    }
-}
-
-glm::dvec3 patchNormal(const BicubicPatch& P, double u, double v, double scale2) {
-  glm::dvec3 S, Su, Sv;
-  evalPatch(P, u, v, S, Su, Sv);
-  glm::dvec3 n = glm::cross(Su, Sv);
-  double len = glm::length(n);
-  if (len > 1e-10 * scale2) return n / len;
-  // Collapsed edge or corner: step toward the interior; the normal there tends to the limit normal.
-  for (double delta : {1e-6, 1e-4, 1e-2}) {
-    double uu = u + (u < 0.5 ? delta : u > 0.5 ? -delta : 0.0);
-    double vv = v + (v < 0.5 ? delta : v > 0.5 ? -delta : 0.0);
-    evalPatch(P, uu, vv, S, Su, Sv);
-    n = glm::cross(Su, Sv);
-    len = glm::length(n);
-    if (len > 1e-14 * scale2) return n / len;
-  }
-  return glm::dvec3(0, 0, 1);   // a patch collapsed to a curve or a point
-}
 
 void tessellate(Mesh& mesh, int res) {
   const size_t perPatch = size_t(res + 1) * size_t(res + 1);
@@ -85,22 +42,15 @@ void tessellate(Mesh& mesh, int res) {
   mesh.triangles.reserve(mesh.patches.size() * 2 * size_t(res) * size_t(res));
   for (size_t p = 0; p < mesh.patches.size(); ++p) {
     const BicubicPatch& P = mesh.patches[p];
-    glm::dvec3 plo(INFINITY), phi(-INFINITY);
-    for (const auto& q : P.points) {
-      plo = glm::min(plo, q);
-      phi = glm::max(phi, q);
-    }
-    glm::dvec3 ext = phi - plo;
-    double scale = std::max({ext.x, ext.y, ext.z, 1e-300});
     const size_t base = p * perPatch;
     for (int i = 0; i <= res; ++i)
       for (int j = 0; j <= res; ++j) {
         double u = double(i) / res, v = double(j) / res;
         size_t vid = base + size_t(i) * (res + 1) + j;
         glm::dvec3 S, Su, Sv;
-        evalPatch(P, u, v, S, Su, Sv);
+        evaluateBicubic(P, u, v, S, Su, Sv);
         mesh.positions[vid] = S;
-        mesh.normals[vid] = patchNormal(P, u, v, scale * scale);
+        mesh.normals[vid] = bicubicNormal(P, u, v);
         mesh.vertexPatch[vid] = uint32_t(p);
         mesh.vertexUV[vid] = {u, v};
       }

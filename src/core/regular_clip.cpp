@@ -329,41 +329,15 @@ struct ClipCpu {
         val[c] = par.evaluate(site[c]);
       }
       size_t o = out0 + k;
-      double* rec = &R.records[o * SFFD_SUB_STRIDE * 4];
-      auto put = [&](int slot, RVec3<Real> v, Real w) {
-        rec[4 * slot] = v.x, rec[4 * slot + 1] = v.y, rec[4 * slot + 2] = v.z, rec[4 * slot + 3] = w;
+      auto parentEdgeOf = [&](int c, int d) {
+        uint32_t ce = sharedCanonicalEdge(edge[c], step[c], edge[d], step[d]);
+        if (ce >= 3) return -1;
+        int a = S.perm[ce], b = S.perm[(ce + 1) % 3];
+        int le = (b == (a + 1) % 3) ? a : b;
+        Real pe = clipReals[4 * (SFFD_CLIP_REAL_STRIDE * ct + 6 + le)];
+        return pe >= Real(0) ? int(pe) : -1;
       };
-      uint32_t creaseBits = 0;
-      for (int c = 0; c < 3; ++c) {
-        put(SFFD_SUB_LAM + c, val[c].lam, 0);
-        put(SFFD_SUB_XPN + c, val[c].xpn, 0);
-        put(SFFD_SUB_XFLAT + c, val[c].xflat, 0);
-        put(SFFD_SUB_NLIN + c, val[c].nlin, 0);
-        put(SFFD_SUB_NPN + c, val[c].npn, 0);
-        for (int h = 0; h < 2; ++h) {
-          int d = h == 0 ? (c + 2) % 3 : (c + 1) % 3;
-          RVec3<Real> nn = val[c].npn;
-          Real nw = 0;
-          uint32_t ce = sharedCanonicalEdge(edge[c], step[c], edge[d], step[d]);
-          if (ce < 3) {
-            int a = S.perm[ce], b = S.perm[(ce + 1) % 3];
-            int le = (b == (a + 1) % 3) ? a : b;
-            Real pe = clipReals[4 * (SFFD_CLIP_REAL_STRIDE * ct + 6 + le)];
-            if (pe >= Real(0)) {
-              int e = int(pe);
-              auto nb = par.neighbourNormal(e, par.paramOnEdge(site[c], e));
-              if (nb[3] > Real(0.5)) {
-                nn = {nb[0], nb[1], nb[2]};
-                nw = 1;
-                creaseBits |= 1u << (2 * c + h);
-              }
-            }
-          }
-          put(SFFD_SUB_NNBR + 2 * c + h, nn, nw);
-        }
-      }
-      uint32_t* hdr = &R.headers[4 * o];
-      hdr[0] = par.id, hdr[1] = creaseBits, hdr[2] = 0, hdr[3] = 0;
+      storeSubTriangle(par, site, val, parentEdgeOf, &R.records[o * SFFD_SUB_STRIDE * 4], &R.headers[4 * o]);
     }
   }
 };
@@ -548,36 +522,12 @@ SubTriangleRecords recordsCpu(const PreparedMesh& M, const PnOutput& pn, const s
       site[c].lam = RVec3<Real>::from(st.corners[c].lam);
       val[c] = par.evaluate(site[c]);
     }
-    double* r = &R.records[s * SFFD_SUB_STRIDE * 4];
-    auto put = [&](int slot, RVec3<Real> v, Real w) {
-      r[4 * slot] = v.x, r[4 * slot + 1] = v.y, r[4 * slot + 2] = v.z, r[4 * slot + 3] = w;
+    auto parentEdgeOf = [&](int c, int d) {
+      for (int e = 0; e < 3; ++e)
+        if (siteOnEdge(st.corners[c].kind, e) && siteOnEdge(st.corners[d].kind, e)) return e;
+      return -1;
     };
-    uint32_t creaseBits = 0;
-    for (int c = 0; c < 3; ++c) {
-      put(SFFD_SUB_LAM + c, val[c].lam, 0);
-      put(SFFD_SUB_XPN + c, val[c].xpn, 0);
-      put(SFFD_SUB_XFLAT + c, val[c].xflat, 0);
-      put(SFFD_SUB_NLIN + c, val[c].nlin, 0);
-      put(SFFD_SUB_NPN + c, val[c].npn, 0);
-      for (int h = 0; h < 2; ++h) {
-        int d = h == 0 ? (c + 2) % 3 : (c + 1) % 3;
-        RVec3<Real> nn = val[c].npn;
-        Real nw = 0;
-        for (int e = 0; e < 3; ++e) {
-          if (!siteOnEdge(st.corners[c].kind, e) || !siteOnEdge(st.corners[d].kind, e)) continue;
-          auto nb = par.neighbourNormal(e, par.paramOnEdge(site[c], e));
-          if (nb[3] > Real(0.5)) {
-            nn = {nb[0], nb[1], nb[2]};
-            nw = 1;
-            creaseBits |= 1u << (2 * c + h);
-          }
-          break;
-        }
-        put(SFFD_SUB_NNBR + 2 * c + h, nn, nw);
-      }
-    }
-    R.headers[4 * s] = st.parent;
-    R.headers[4 * s + 1] = creaseBits;
+    storeSubTriangle(par, site, val, parentEdgeOf, &R.records[s * SFFD_SUB_STRIDE * 4], &R.headers[4 * s]);
   }
   return R;
 }
