@@ -3,11 +3,20 @@
 #include <cstdio>
 #include <cstring>
 #include <new>
+#include <string>
 
 #include "cli.h"
 #include "error.h"
 
 using namespace sffd;
+
+// Every message is one printable line, whatever a file name or a token in it holds (CONTRACT.md).
+static std::string oneLine(const char* what) {
+  std::string s(what);
+  for (char& c : s)
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+  return s;
+}
 
 static std::vector<cli::CommandSpec> commands() {
   return {cli::deformCommand(), cli::latticeCommand(), cli::devicesCommand(), cli::conformCommand(), cli::clipCommand(),
@@ -38,13 +47,13 @@ int main(int argc, char** argv) {
     }
     throw Error(ErrorKind::Input, std::string("unknown command '") + argv[1] + "' (sffd --help lists them)");
   } catch (const Error& e) {
-    std::fprintf(stderr, "sffd: error: %s\n", e.what());
+    std::fprintf(stderr, "sffd: error: %s\n", oneLine(e.what()).c_str());
     return e.exitStatus();
   } catch (const std::bad_alloc&) {
     std::fprintf(stderr, "sffd: error: out of memory\n");
     return 1;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "sffd: error: %s\n", e.what());
+    std::fprintf(stderr, "sffd: error: %s\n", oneLine(e.what()).c_str());
     return 1;
   }
 }

@@ -112,6 +112,18 @@ struct AxisExtraction {
   std::vector<double> breaks;
   // rows: span*(p+1)+r, columns: original control points
   std::vector<std::vector<double>> matrix;
+  // Per row, the range [first, last) of its non-zero columns (at most p+1), so that a knot box costs
+  // O((p+1)^3) and not O(counts^3): without it a 64^3 lattice took minutes and 256^3 never ended.
+  std::vector<std::pair<int, int>> nonzero;
+  // The union of the ranges of the p+1 rows of each span.
+  std::pair<int, int> spanRange(int span, int p) const {
+    std::pair<int, int> r{nonzero[size_t(span) * (p + 1)]};
+    for (int k = 1; k <= p; ++k) {
+      r.first = std::min(r.first, nonzero[size_t(span) * (p + 1) + k].first);
+      r.second = std::max(r.second, nonzero[size_t(span) * (p + 1) + k].second);
+    }
+    return r;
+  }
 };
 
 AxisExtraction extractAxis(const std::vector<double>& knots, int p, int count) {
@@ -131,6 +143,12 @@ AxisExtraction extractAxis(const std::vector<double>& knots, int p, int count) {
     int i = int(std::upper_bound(U.begin(), U.end(), distinct[sp]) - U.begin()) - 1;
     for (int r = 0; r <= p; ++r) ax.matrix.push_back(P[i - p + r]);
   }
+  for (const auto& row : ax.matrix) {
+    int first = 0, last = int(row.size());
+    while (first < last && row[first] == 0) ++first;
+    while (last > first && row[last - 1] == 0) --last;
+    ax.nonzero.push_back({first, last});
+  }
   return ax;
 }
 
@@ -146,41 +164,48 @@ LatticeBoxForm extractBoxForm(const Lattice& L) {
     F.boxes[a] = int(ax[a].breaks.size()) - 1;
   }
   const int nu = L.degree[0] + 1, nv = L.degree[1] + 1, nw = L.degree[2] + 1;
-  const int cu = L.counts[0], cv = L.counts[1], cw = L.counts[2];
   F.coeffs.assign(size_t(F.boxes[0]) * F.boxes[1] * F.boxes[2] * nu * nv * nw, glm::dvec3(0));
-  // Contract one axis at a time: w, then v, then u.
+  // Contract one axis at a time: w, then v, then u, each over the non-zero columns of its rows only
+  // (the sums run in the same order as over all columns, skipping exact zeros as before: the same bits).
+  std::vector<glm::dvec3> tw, tv;
   for (int bu = 0; bu < F.boxes[0]; ++bu)
     for (int bv = 0; bv < F.boxes[1]; ++bv)
       for (int bw = 0; bw < F.boxes[2]; ++bw) {
-        std::vector<glm::dvec3> tw(size_t(cu) * cv * nw, glm::dvec3(0));
-        for (int i = 0; i < cu; ++i)
-          for (int j = 0; j < cv; ++j)
+        const auto [ia, ib] = ax[0].spanRange(bu, L.degree[0]);
+        const auto [ja, jb] = ax[1].spanRange(bv, L.degree[1]);
+        const int I = ib - ia, J = jb - ja;
+        tw.assign(size_t(I) * J * nw, glm::dvec3(0));
+        for (int i = ia; i < ib; ++i)
+          for (int j = ja; j < jb; ++j)
             for (int r = 0; r < nw; ++r) {
               const auto& row = ax[2].matrix[bw * nw + r];
+              const auto [k0, k1] = ax[2].nonzero[bw * nw + r];
               glm::dvec3 s(0);
-              for (int k = 0; k < cw; ++k)
+              for (int k = k0; k < k1; ++k)
                 if (row[k] != 0) s += row[k] * L.controlPoints[L.index(i, j, k)];
-              tw[(size_t(i) * cv + j) * nw + r] = s;
+              tw[(size_t(i - ia) * J + (j - ja)) * nw + r] = s;
             }
-        std::vector<glm::dvec3> tv(size_t(cu) * nv * nw, glm::dvec3(0));
-        for (int i = 0; i < cu; ++i)
+        tv.assign(size_t(I) * nv * nw, glm::dvec3(0));
+        for (int i = ia; i < ib; ++i)
           for (int q = 0; q < nv; ++q) {
             const auto& row = ax[1].matrix[bv * nv + q];
+            const auto [j0, j1] = ax[1].nonzero[bv * nv + q];
             for (int r = 0; r < nw; ++r) {
               glm::dvec3 s(0);
-              for (int j = 0; j < cv; ++j)
-                if (row[j] != 0) s += row[j] * tw[(size_t(i) * cv + j) * nw + r];
-              tv[(size_t(i) * nv + q) * nw + r] = s;
+              for (int j = j0; j < j1; ++j)
+                if (row[j] != 0) s += row[j] * tw[(size_t(i - ia) * J + (j - ja)) * nw + r];
+              tv[(size_t(i - ia) * nv + q) * nw + r] = s;
             }
           }
         size_t base = ((size_t(bu) * F.boxes[1] + bv) * F.boxes[2] + bw) * F.coeffsPerBox();
         for (int pp = 0; pp < nu; ++pp) {
           const auto& row = ax[0].matrix[bu * nu + pp];
+          const auto [i0, i1] = ax[0].nonzero[bu * nu + pp];
           for (int q = 0; q < nv; ++q)
             for (int r = 0; r < nw; ++r) {
               glm::dvec3 s(0);
-              for (int i = 0; i < cu; ++i)
-                if (row[i] != 0) s += row[i] * tv[(size_t(i) * nv + q) * nw + r];
+              for (int i = i0; i < i1; ++i)
+                if (row[i] != 0) s += row[i] * tv[(size_t(i - ia) * nv + q) * nw + r];
               F.coeffs[base + (size_t(pp) * nv + q) * nw + r] = s;
             }
         }

@@ -19,6 +19,11 @@
 #include "io_util.h"
 #include "mesh_io_internal.h"
 
+// Sanitizer runtimes (ASan, UBSan, libFuzzer's) let a program register a callback run when they report
+// an error; a forked child must not run its parent's (libFuzzer's writes a crash file for the parent's
+// input). Weak: null in an ordinary build.
+extern "C" void __sanitizer_set_death_callback(void (*callback)(void)) __attribute__((weak));
+
 namespace sffd::meshio {
 namespace {
 
@@ -133,6 +138,7 @@ Mesh readOm(const std::string& path, const std::string& text) {
     // The parent's handlers (a sanitizer's, a fuzzer's, a caller's SIGALRM) are not the child's: a
     // crash in OpenMesh just ends the child, and the alarm below really ends it.
     for (int sig : {SIGSEGV, SIGBUS, SIGABRT, SIGFPE, SIGILL, SIGALRM}) ::signal(sig, SIG_DFL);
+    if (__sanitizer_set_death_callback) __sanitizer_set_death_callback(nullptr);
     ::alarm(600);   // a file that sends OpenMesh into a loop
     int rc = 5;
     try {
