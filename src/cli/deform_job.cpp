@@ -33,11 +33,13 @@ DeformRun runClassic(const ParsedArgs& args, Job& job, OpenedBackend& backend) {
 DeformRun runDeformJob(const ParsedArgs& args, Job& job, OpenedBackend& backend) {
   std::string method = args.get("--method", "smooth");
   std::string clip = args.get("--clip", "regular");
-  if (std::string w = foldWarning(checkLatticeFold(packLattice(job.lattice)), job.latticePath); !w.empty())
-    std::fprintf(stderr, "sffd: warning: %s\n", w.c_str());   // shown even with --quiet: it is about the result
+  std::string warning = foldWarning(checkLatticeFold(packLattice(job.lattice)), job.latticePath);
   DeformRun run = method == "classic" ? runClassic(args, job, backend)
                   : method == "accurate" ? runAccurate(args, job, backend)
                                          : runSmooth(args, job, backend);
+  // After the work, so a job that fails prints its one error line only. Shown even with --quiet: it
+  // is about the result.
+  if (!warning.empty()) std::fprintf(stderr, "sffd: warning: %s\n", warning.c_str());
   run.method = method;
   run.clip = method == "accurate" ? "knot-box" : clip;
   return run;
