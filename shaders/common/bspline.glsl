@@ -7,6 +7,27 @@
 layout(std430, SFFD_SET binding = SFFD_BINDING_LATTICE_COEFFS) readonly buffer LatticeCoeffs { real4 latticeCoeffs[]; };
 layout(std430, SFFD_SET binding = SFFD_BINDING_LATTICE_FRAME) readonly buffer LatticeFrame { real latticeFrame[]; };
 
+// Lattice reads go through these two functions: from the deform kernels' parameter block when the
+// host put the lattice there (layout.h, DeformParams), else from the storage buffers above. An `if`
+// rather than a select, so that the storage-buffer read is skipped, not merely discarded.
+#if defined(SFFD_LATTICE_INLINE) && !SFFD_F64
+real latticeFrameAt(uint i) {
+  real v;
+  if (params.lattice.break_offset.w != 0u) v = params.inline_lattice[i >> 2u][i & 3u];
+  else v = latticeFrame[i];
+  return v;
+}
+real3 latticeCoeffAt(uint c) {
+  real3 v;
+  if (params.lattice.break_offset.w != 0u) v = params.inline_lattice[params.lattice.break_offset.w + c].xyz;
+  else v = latticeCoeffs[c].xyz;
+  return v;
+}
+#else
+real latticeFrameAt(uint i) { return latticeFrame[i]; }
+real3 latticeCoeffAt(uint c) { return latticeCoeffs[c].xyz; }
+#endif
+
 // Value and derivative of the B-spline volume at a lattice parameter, plus whether it is inside the box.
 struct LatticeSample {
   real3 value;
@@ -15,14 +36,13 @@ struct LatticeSample {
   bool inside;
 };
 
-// Knot box of parameter t on one axis: the largest i with breaks[i] <= t, clamped to [0, n-1].
+// Knot box of parameter t on one axis: the largest i with breaks[i] <= t, clamped to [0, n-1]. A
+// count over the breaks rather than a bisection: the trip count is the same in every lane (no
+// divergence on SIMD devices such as llvmpipe) and the result is the same integer.
 uint latticeSpan(uint first, uint n, real t) {
-  uint lo = 0u, hi = n - 1u;
-  while (lo < hi) {
-    uint mid = (lo + hi + 1u) / 2u;
-    if (latticeFrame[first + mid] <= t) lo = mid; else hi = mid - 1u;
-  }
-  return lo;
+  uint span = 0u;
+  for (uint i = 1u; i < n; ++i) span += latticeFrameAt(first + i) <= t ? 1u : 0u;
+  return span;
 }
 
 // Bernstein basis of degree n at s and its derivative, by the de Casteljau recurrence.
@@ -52,13 +72,74 @@ void latticeBernstein(uint n, real s, out real b[SFFD_MAX_DEGREE + 1], out real 
   }
 }
 
+// Degree 2 on every axis (the paper's lattices and the default): the operations of latticeBernstein
+// and of the general sum in latticeEvaluate, in the same order, written out so that no local array
+// is indexed by a variable: llvmpipe/lavapipe keep such arrays in memory, which made evaluation
+// about twice as slow. Results are bit-identical to the general path in the strict variant.
+void latticeBernstein2(real s, out real3 b, out real3 db) {
+  P real t = real(1) - s;
+  P real b0 = t * real(1) + s * real(0);   // degree 1
+  P real b1 = t * real(0) + s * real(1);
+  P real d0 = real(2) * (real(0) - b0);    // derivative of degree 2 from the degree-1 basis
+  P real d1 = real(2) * (b0 - b1);
+  P real d2 = real(2) * (b1 - real(0));
+  P real c0 = t * b0 + s * real(0);        // degree 2
+  P real c1 = t * b1 + s * b0;
+  P real c2 = t * real(0) + s * b1;
+  b = real3(c0, c1, c2);
+  db = real3(d0, d1, d2);
+}
+
+// One row of three coefficients along w: the value and the w-derivative sums.
+void latticeRow2(uint c, real3 bw, real3 dbw, out real3 q, out real3 qw) {
+  real3 p0 = latticeCoeffAt(c), p1 = latticeCoeffAt(c + 1u), p2 = latticeCoeffAt(c + 2u);
+  P real3 r = ((real3(0) + p0 * bw.x) + p1 * bw.y) + p2 * bw.z;
+  P real3 rw = ((real3(0) + p0 * dbw.x) + p1 * dbw.y) + p2 * dbw.z;
+  q = r;
+  qw = rw;
+}
+
+// One slab of nine coefficients (fixed u index): sums over v and w.
+void latticeSlab2(uint c, real3 bv, real3 dbv, real3 bw, real3 dbw, out real3 sp, out real3 spv, out real3 spw) {
+  real3 q0, q0w, q1, q1w, q2, q2w;
+  latticeRow2(c, bw, dbw, q0, q0w);
+  latticeRow2(c + 3u, bw, dbw, q1, q1w);
+  latticeRow2(c + 6u, bw, dbw, q2, q2w);
+  P real3 a = ((real3(0) + q0 * bv.x) + q1 * bv.y) + q2 * bv.z;
+  P real3 av = ((real3(0) + q0 * dbv.x) + q1 * dbv.y) + q2 * dbv.z;
+  P real3 aw = ((real3(0) + q0w * bv.x) + q1w * bv.y) + q2w * bv.z;
+  sp = a;
+  spv = av;
+  spw = aw;
+}
+
+// The Bezier volume of one knot box (27 coefficients from `base`) and its derivatives at s.
+void latticeVolume2(uint base, real su, real sv, real sw, out real3 R, out real3 Ru, out real3 Rv, out real3 Rw) {
+  real3 bu, dbu, bv, dbv, bw, dbw;
+  latticeBernstein2(su, bu, dbu);
+  latticeBernstein2(sv, bv, dbv);
+  latticeBernstein2(sw, bw, dbw);
+  real3 s0, s0v, s0w, s1, s1v, s1w, s2, s2v, s2w;
+  latticeSlab2(base, bv, dbv, bw, dbw, s0, s0v, s0w);
+  latticeSlab2(base + 9u, bv, dbv, bw, dbw, s1, s1v, s1w);
+  latticeSlab2(base + 18u, bv, dbv, bw, dbw, s2, s2v, s2w);
+  P real3 r = ((real3(0) + s0 * bu.x) + s1 * bu.y) + s2 * bu.z;
+  P real3 ru = ((real3(0) + s0 * dbu.x) + s1 * dbu.y) + s2 * dbu.z;
+  P real3 rv = ((real3(0) + s0v * bu.x) + s1v * bu.y) + s2v * bu.z;
+  P real3 rw = ((real3(0) + s0w * bu.x) + s1w * bu.y) + s2w * bu.z;
+  R = r;
+  Ru = ru;
+  Rv = rv;
+  Rw = rw;
+}
+
 // Evaluates the volume at world point x: lattice parameter p = A x + c, then the knot box's Bezier volume.
 LatticeSample latticeEvaluate(LatticeParams L, real3 x) {
   LatticeSample S;
   real4 rows[3];
   for (uint r = 0u; r < 3u; ++r)
-    rows[r] = real4(latticeFrame[SFFD_FRAME_AFFINE + 4u * r], latticeFrame[SFFD_FRAME_AFFINE + 4u * r + 1u],
-                    latticeFrame[SFFD_FRAME_AFFINE + 4u * r + 2u], latticeFrame[SFFD_FRAME_AFFINE + 4u * r + 3u]);
+    rows[r] = real4(latticeFrameAt(SFFD_FRAME_AFFINE + 4u * r), latticeFrameAt(SFFD_FRAME_AFFINE + 4u * r + 1u),
+                    latticeFrameAt(SFFD_FRAME_AFFINE + 4u * r + 2u), latticeFrameAt(SFFD_FRAME_AFFINE + 4u * r + 3u));
   P real3 p;
   for (uint r = 0u; r < 3u; ++r) {
     P real xy = rows[r].x * x.x + rows[r].y * x.y;
@@ -71,44 +152,47 @@ LatticeSample latticeEvaluate(LatticeParams L, real3 x) {
   S.inside = true;
   for (uint a = 0u; a < 3u; ++a) {
     uint first = L.break_offset[a], n = L.boxes[a];
-    real lo = latticeFrame[first], hi = latticeFrame[first + n];
+    real lo = latticeFrameAt(first), hi = latticeFrameAt(first + n);
     if (p[a] < lo || p[a] > hi) S.inside = false;
     span[a] = latticeSpan(first, n, p[a]);
-    real k0 = latticeFrame[first + span[a]], k1 = latticeFrame[first + span[a] + 1u];
+    real k0 = latticeFrameAt(first + span[a]), k1 = latticeFrameAt(first + span[a] + 1u);
     P real h = k1 - k0;
     P real sa = (p[a] - k0) / h;
     s[a] = sa;
     S.h[a] = h;
   }
-  real bu[SFFD_MAX_DEGREE + 1], dbu[SFFD_MAX_DEGREE + 1];
-  real bv[SFFD_MAX_DEGREE + 1], dbv[SFFD_MAX_DEGREE + 1];
-  real bw[SFFD_MAX_DEGREE + 1], dbw[SFFD_MAX_DEGREE + 1];
-  latticeBernstein(L.degree.x, s[0], bu, dbu);
-  latticeBernstein(L.degree.y, s[1], bv, dbv);
-  latticeBernstein(L.degree.z, s[2], bw, dbw);
-
   uint box = (span[0] * L.boxes.y + span[1]) * L.boxes.z + span[2];
   uint base = box * L.boxes.w;
   P real3 R = real3(0), Ru = real3(0), Rv = real3(0), Rw = real3(0);
-  uint c = base;
-  for (uint i = 0u; i <= L.degree.x; ++i) {
-    P real3 Sp = real3(0), Spv = real3(0), Spw = real3(0);
-    for (uint j = 0u; j <= L.degree.y; ++j) {
-      P real3 Sq = real3(0), Sqw = real3(0);
-      for (uint k = 0u; k <= L.degree.z; ++k) {
-        real3 cp = latticeCoeffs[c].xyz;
-        ++c;
-        Sq = Sq + cp * bw[k];
-        Sqw = Sqw + cp * dbw[k];
+  if (L.degree.xyz == uvec3(2u)) {
+    latticeVolume2(base, s[0], s[1], s[2], R, Ru, Rv, Rw);
+  } else {
+    real bu[SFFD_MAX_DEGREE + 1], dbu[SFFD_MAX_DEGREE + 1];
+    real bv[SFFD_MAX_DEGREE + 1], dbv[SFFD_MAX_DEGREE + 1];
+    real bw[SFFD_MAX_DEGREE + 1], dbw[SFFD_MAX_DEGREE + 1];
+    latticeBernstein(L.degree.x, s[0], bu, dbu);
+    latticeBernstein(L.degree.y, s[1], bv, dbv);
+    latticeBernstein(L.degree.z, s[2], bw, dbw);
+    uint c = base;
+    for (uint i = 0u; i <= L.degree.x; ++i) {
+      P real3 Sp = real3(0), Spv = real3(0), Spw = real3(0);
+      for (uint j = 0u; j <= L.degree.y; ++j) {
+        P real3 Sq = real3(0), Sqw = real3(0);
+        for (uint k = 0u; k <= L.degree.z; ++k) {
+          real3 cp = latticeCoeffAt(c);
+          ++c;
+          Sq = Sq + cp * bw[k];
+          Sqw = Sqw + cp * dbw[k];
+        }
+        Sp = Sp + Sq * bv[j];
+        Spv = Spv + Sq * dbv[j];
+        Spw = Spw + Sqw * bv[j];
       }
-      Sp = Sp + Sq * bv[j];
-      Spv = Spv + Sq * dbv[j];
-      Spw = Spw + Sqw * bv[j];
+      R = R + Sp * bu[i];
+      Ru = Ru + Sp * dbu[i];
+      Rv = Rv + Spv * bu[i];
+      Rw = Rw + Spw * bu[i];
     }
-    R = R + Sp * bu[i];
-    Ru = Ru + Sp * dbu[i];
-    Rv = Rv + Spv * bu[i];
-    Rw = Rw + Spw * bu[i];
   }
   S.value = R;
   S.du = Ru;
@@ -122,8 +206,8 @@ LatticeSample latticeEvaluate(LatticeParams L, real3 x) {
 real3 latticeCofactorNormal(LatticeSample S, real3 n) {
   P real3 q;
   for (uint r = 0u; r < 3u; ++r) {
-    P real xy = latticeFrame[SFFD_FRAME_COF_AFFINE + 4u * r] * n.x + latticeFrame[SFFD_FRAME_COF_AFFINE + 4u * r + 1u] * n.y;
-    P real xyz = xy + latticeFrame[SFFD_FRAME_COF_AFFINE + 4u * r + 2u] * n.z;
+    P real xy = latticeFrameAt(SFFD_FRAME_COF_AFFINE + 4u * r) * n.x + latticeFrameAt(SFFD_FRAME_COF_AFFINE + 4u * r + 1u) * n.y;
+    P real xyz = xy + latticeFrameAt(SFFD_FRAME_COF_AFFINE + 4u * r + 2u) * n.z;
     q[r] = xyz;
   }
   P real3 cu = scross(S.dv, S.dw) * (S.h.x * q.x);

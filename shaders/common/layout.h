@@ -122,9 +122,17 @@ SFFD_STRUCT_END(ClipParams)
 #define SFFD_BINDING_DEFORM_SAMPLES 8
 #define SFFD_SAMPLE_FIXED 27
 
+// The deform kernels' parameter block also carries the lattice itself (float variants, when it fits):
+// on llvmpipe/lavapipe a uniform-buffer read is a vector load or gather, while every storage-buffer
+// read is a loop over the SIMD lanes, which made lattice evaluation several times slower. 16 KiB in
+// all, the smallest uniform block every GL 4.3 and Vulkan device accepts. lattice.break_offset.w is
+// then the first vec4 of the Bezier coefficients in inline_lattice (the frame reals come first, four
+// to a vec4); 0 means the kernel reads the lattice storage buffers instead (f64, or too large).
+#define SFFD_INLINE_LATTICE_VEC4 1016
 SFFD_STRUCT_BEGIN(DeformParams)
   SFFD_STRUCT_MEMBER(LatticeParams, lattice)
   SFFD_UVEC4 range;    // x: first sub-triangle, y: count, z: interior fitting points, w: tessellation level
+  SFFD_VEC4 inline_lattice[SFFD_INLINE_LATTICE_VEC4];
 SFFD_STRUCT_END(DeformParams)
 
 SFFD_STRUCT_BEGIN(PnParams)

@@ -9,10 +9,11 @@
 #ifndef SFFD_SMOOTH_GLSL
 #define SFFD_SMOOTH_GLSL
 
+// Declared before bspline.glsl, which then reads the lattice from the block when the host put it there.
+layout(std140, SFFD_SET binding = SFFD_BINDING_PARAMS) uniform DeformBlock { DeformParams params; };
+#define SFFD_LATTICE_INLINE 1
 #include "bspline.glsl"
 #include "pn.glsl"
-
-layout(std140, SFFD_SET binding = SFFD_BINDING_PARAMS) uniform DeformBlock { DeformParams params; };
 layout(std430, SFFD_SET binding = SFFD_BINDING_DEFORM_FIT) readonly buffer Fit { real fit[]; };
 layout(std430, SFFD_SET binding = SFFD_BINDING_DEFORM_SUB_HEADERS) readonly buffer SubHeaders { uvec4 subHeaders[]; };
 layout(std430, SFFD_SET binding = SFFD_BINDING_DEFORM_SUB_RECORDS) readonly buffer SubRecords { real4 subRecords[]; };

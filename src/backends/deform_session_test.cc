@@ -132,6 +132,28 @@ TEST_P(DeformSessionTest, ChunkedSplitAndKnotBoxSessionsEqualCpuReference) {
   EXPECT_EQ(vk::validationMessageCount(), 0u);
 }
 
+// A lattice too large for the deform kernels' parameter block is read from the storage buffers:
+// the same bits.
+TEST_P(DeformSessionTest, LatticeTooLargeToInlineGivesTheSameOutput) {
+  OpenedBackend b = open();
+  Mesh m = readMesh(std::string(SFFD_SHARED_DATA) + "/acaffd/sphere.obj");
+  glm::dvec3 lo(1e300), hi(-1e300);
+  for (const glm::dvec3& p : m.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
+  Lattice big = makeIdentityLattice(lo - 0.01, hi + 0.01, {12, 12, 12}, {2, 2, 2});
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-0.03, 0.03);
+  for (auto& p : big.controlPoints) p += glm::dvec3(u(rng), u(rng), u(rng));
+  ASSERT_EQ(deformParamsFor(packLattice(big), false).lattice.break_offset.w, 0u) << "the lattice should not fit inline";
+  DeformSessionOptions o;
+  o.variant = {true, false};
+  o.edgeLength = 0.3;
+  o.level = 3;
+  DeformSession s(*b.gpu, m, big, o);
+  s.deform(big);
+  EXPECT_EQ(s.output().tess, reference(m, big, o).out.tess);
+  EXPECT_EQ(vk::validationMessageCount(), 0u);
+}
+
 TEST_P(DeformSessionTest, RefusesALatticeOfAnotherStructureAndBadOptions) {
   OpenedBackend b = open();
   Mesh m = readMesh(std::string(SFFD_SHARED_DATA) + "/acaffd/cube2.obj");

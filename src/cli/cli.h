@@ -85,5 +85,6 @@ CommandSpec conformCommand();
 CommandSpec clipCommand();
 CommandSpec errorCommand();
 CommandSpec renderCommand();
+CommandSpec benchCommand();
 
 }  // namespace sffd::cli

@@ -31,6 +31,11 @@ DeformRun runClassic(const ParsedArgs& args, Job& job, OpenedBackend& backend);
 DeformRun runSmooth(const ParsedArgs& args, Job& job, OpenedBackend& backend);
 DeformRun runAccurate(const ParsedArgs& args, Job& job, OpenedBackend& backend);
 
+// --tess (default 10) and --edge-length (default: a tenth of the mesh's largest extent, the reference
+// implementation's l = 0.2 for models in [-1, 1]).
+int tessLevel(const ParsedArgs& args);
+double edgeLengthOf(const ParsedArgs& args, const Mesh& mesh);
+
 // Sum of the GPU times of the timings (wall time when the device measured none).
 double stageMs(const std::vector<DispatchTiming>& timings, double wallMs);
 

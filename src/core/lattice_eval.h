@@ -25,13 +25,11 @@ class LatticeEvaluator {
   LatticeEvaluator(const gpu::LatticeParams& params, const std::vector<Real>& frame, const std::vector<Real>& coeffs)
       : L_(params), frame_(frame), coeffs_(coeffs) {}
 
+  // The largest i with breaks[i] <= t, clamped to [0, n-1] (counted, as the kernels do).
   uint32_t span(uint32_t first, uint32_t n, Real t) const {
-    uint32_t lo = 0, hi = n - 1;
-    while (lo < hi) {
-      uint32_t mid = (lo + hi + 1) / 2;
-      if (frame_[first + mid] <= t) lo = mid; else hi = mid - 1;
-    }
-    return lo;
+    uint32_t s = 0;
+    for (uint32_t i = 1; i < n; ++i) s += frame_[first + i] <= t ? 1u : 0u;
+    return s;
   }
 
   static void bernstein(uint32_t n, Real s, Real b[kMax], Real db[kMax]) {

@@ -29,4 +29,20 @@ PackedLattice packLattice(const Lattice& L) {
   return P;
 }
 
+gpu::DeformParams deformParamsFor(const PackedLattice& lattice, bool f64) {
+  gpu::DeformParams d{};
+  d.lattice = lattice.params;
+  d.lattice.break_offset.w = 0;
+  const size_t frameVec4 = (lattice.frame.size() + 3) / 4, coeffVec4 = lattice.coeffs.size() / 4;
+  if (f64 || frameVec4 == 0 || frameVec4 + coeffVec4 > SFFD_INLINE_LATTICE_VEC4) return d;
+  auto put = [&](size_t i, double v) {
+    gpu::Vec4& q = d.inline_lattice[i / 4];
+    (i % 4 == 0 ? q.x : i % 4 == 1 ? q.y : i % 4 == 2 ? q.z : q.w) = float(v);
+  };
+  for (size_t i = 0; i < lattice.frame.size(); ++i) put(i, lattice.frame[i]);
+  for (size_t i = 0; i < lattice.coeffs.size(); ++i) put(4 * frameVec4 + i, lattice.coeffs[i]);
+  d.lattice.break_offset.w = uint32_t(frameVec4);
+  return d;
+}
+
 }  // namespace sffd

@@ -17,6 +17,11 @@ struct PackedLattice {
 
 PackedLattice packLattice(const Lattice& lattice);
 
+// The deform kernels' parameter block for a lattice: its LatticeParams, and in the float variants
+// the lattice itself inline when it fits (layout.h, DeformParams), else break_offset.w = 0 and the
+// kernels read the lattice storage buffers.
+gpu::DeformParams deformParamsFor(const PackedLattice& lattice, bool f64);
+
 template <class Real>
 std::vector<Real> convertReals(const std::vector<double>& v) {
   return std::vector<Real>(v.begin(), v.end());
