@@ -21,7 +21,8 @@ void main() {
   real3 cp[10], ncp[10];
   smoothBoundaryControlPoints(Q, QN, E, EN, cp, ncp);
   P real3 centreN = real3(0);
-  for (uint i = 0u; i < params.range.z; ++i) centreN = centreN + smoothCentreTerm(ncp, smoothInteriorNormal(st, i), i);
+  SubCorners corners = smoothSubCorners(st);
+  for (uint i = 0u; i < params.range.z; ++i) centreN = centreN + smoothCentreTerm(ncp, smoothInteriorNormal(corners, i), i);
   ncp[4] = centreN;
   smoothAdjust(subHeaders[st].y, adj, adjNbr, cp);
 

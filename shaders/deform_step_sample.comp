@@ -24,5 +24,6 @@ void main() {
     samples[b + 12u + e] = real4(EN[e], 0);
     samples[b + 21u + e] = real4(adjNbr[e], 0);
   }
-  for (uint i = 0u; i < params.range.z; ++i) samples[b + SFFD_SAMPLE_FIXED + i] = real4(smoothInteriorNormal(st, i), 0);
+  SubCorners corners = smoothSubCorners(st);
+  for (uint i = 0u; i < params.range.z; ++i) samples[b + SFFD_SAMPLE_FIXED + i] = real4(smoothInteriorNormal(corners, i), 0);
 }

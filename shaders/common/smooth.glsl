@@ -18,8 +18,11 @@ layout(std430, SFFD_SET binding = SFFD_BINDING_DEFORM_FIT) readonly buffer Fit {
 layout(std430, SFFD_SET binding = SFFD_BINDING_DEFORM_SUB_HEADERS) readonly buffer SubHeaders { uvec4 subHeaders[]; };
 layout(std430, SFFD_SET binding = SFFD_BINDING_DEFORM_SUB_RECORDS) readonly buffer SubRecords { real4 subRecords[]; };
 
-const uint kSlotCp[6] = uint[6](2u, 1u, 3u, 7u, 8u, 5u);
-const uint kCornerCp[3] = uint[3](0u, 6u, 9u);
+// Control point of corner slot s (2, 1, 3, 7, 8, 5) and of corner c (0, 6, 9), as 4-bit fields of a
+// constant: a constant array indexed by a variable is copied into local memory at every use in the
+// SPIR-V that glslang emits, which made the Vulkan kernels several times slower than GL on lavapipe.
+uint kSlotCp(uint s) { return (0x587312u >> (4u * s)) & 15u; }
+uint kCornerCp(uint c) { return (0x960u >> (4u * c)) & 15u; }
 
 // a before b in the lexicographic order of their coordinates (a total order both patches agree on).
 bool lexLess(real3 a, real3 b) {
@@ -70,14 +73,30 @@ void smoothEdgeSamples(uint st, out real3 E[6], out real3 EN[6]) {
   }
 }
 
+// The flat-lifted corners and their linear normals of a sub-triangle, read once for every interior
+// sample (each storage-buffer read is costly on SIMD CPU devices).
+struct SubCorners {
+  real3 x0, x1, x2, n0, n1, n2;
+};
+SubCorners smoothSubCorners(uint st) {
+  uint rec = SFFD_SUB_STRIDE * st;
+  SubCorners C;
+  C.x0 = subRecords[rec + SFFD_SUB_XPN].xyz;
+  C.x1 = subRecords[rec + SFFD_SUB_XPN + 1u].xyz;
+  C.x2 = subRecords[rec + SFFD_SUB_XPN + 2u].xyz;
+  C.n0 = subRecords[rec + SFFD_SUB_NLIN].xyz;
+  C.n1 = subRecords[rec + SFFD_SUB_NLIN + 1u].xyz;
+  C.n2 = subRecords[rec + SFFD_SUB_NLIN + 2u].xyz;
+  return C;
+}
+
 // Step 1 inside: the deformed normal at interior fitting point i (the geometry's centre comes from
 // the PN rule after the adjustment, so only the normal patch needs the interior samples).
-real3 smoothInteriorNormal(uint st, uint i) {
-  uint rec = SFFD_SUB_STRIDE * st;
+real3 smoothInteriorNormal(SubCorners C, uint i) {
   uint f = SFFD_FIT_STRIDE * i;
   P real3 lam = real3(fit[f], fit[f + 1u], fit[f + 2u]);
-  P real3 x = (subRecords[rec + SFFD_SUB_XPN].xyz * lam.x + subRecords[rec + SFFD_SUB_XPN + 1u].xyz * lam.y) + subRecords[rec + SFFD_SUB_XPN + 2u].xyz * lam.z;
-  P real3 n = (subRecords[rec + SFFD_SUB_NLIN].xyz * lam.x + subRecords[rec + SFFD_SUB_NLIN + 1u].xyz * lam.y) + subRecords[rec + SFFD_SUB_NLIN + 2u].xyz * lam.z;
+  P real3 x = (C.x0 * lam.x + C.x1 * lam.y) + C.x2 * lam.z;
+  P real3 n = (C.n0 * lam.x + C.n1 * lam.y) + C.n2 * lam.z;
   LatticeSample S = latticeEvaluate(params.lattice, x);
   P real3 r = snormalize(latticeCofactorNormal(S, snormalize(n)));
   return r;
@@ -86,8 +105,8 @@ real3 smoothInteriorNormal(uint st, uint i) {
 // Step 3: boundary control points by the closed form of the constrained fit.
 void smoothBoundaryControlPoints(real3 Q[3], real3 QN[3], real3 E[6], real3 EN[6], out real3 cp[10], out real3 ncp[10]) {
   for (uint c = 0u; c < 3u; ++c) {
-    cp[kCornerCp[c]] = Q[c];
-    ncp[kCornerCp[c]] = QN[c];
+    cp[kCornerCp(c)] = Q[c];
+    ncp[kCornerCp(c)] = QN[c];
   }
   for (uint s = 0u; s < 6u; ++s) {
     uint c = s / 2u;
@@ -95,8 +114,8 @@ void smoothBoundaryControlPoints(real3 Q[3], real3 QN[3], real3 E[6], real3 EN[6
     uint e = (s % 2u == 1u) ? c : o;               // edge index (corner e -> e+1)
     uint nearC = c == e ? 2u * e : 2u * e + 1u;    // the edge sample a third from c
     uint nearO = c == e ? 2u * e + 1u : 2u * e;
-    cp[kSlotCp[s]] = nearControlPoint(Q[c], E[nearC], E[nearO], Q[o]);
-    ncp[kSlotCp[s]] = nearControlPoint(QN[c], EN[nearC], EN[nearO], QN[o]);
+    cp[kSlotCp(s)] = nearControlPoint(Q[c], E[nearC], E[nearO], Q[o]);
+    ncp[kSlotCp(s)] = nearControlPoint(QN[c], EN[nearC], EN[nearO], QN[o]);
   }
   cp[4] = real3(0);
   ncp[4] = real3(0);
@@ -116,8 +135,8 @@ real3 smoothCentreTerm(real3 ncp[10], real3 qn, uint i) {
 void smoothAdjust(uint creaseBits, real3 adj[3], real3 adjNbr[6], inout real3 cp[10]) {
   for (uint s = 0u; s < 6u; ++s) {
     uint c = s / 2u;
-    real3 X = cp[kCornerCp[c]];
-    P real3 b = cp[kSlotCp[s]];
+    real3 X = cp[kCornerCp(c)];
+    P real3 b = cp[kSlotCp(s)];
     P real3 d = b - X;
     bool adjusted = false;
     if (((creaseBits >> s) & 1u) != 0u) {
@@ -132,7 +151,7 @@ void smoothAdjust(uint creaseBits, real3 adj[3], real3 adjNbr[6], inout real3 cp
       }
     }
     if (!adjusted) b = b - adj[c] * sdot(d, adj[c]);
-    cp[kSlotCp[s]] = b;
+    cp[kSlotCp(s)] = b;
   }
   P real3 edgeSum = ((((cp[1] + cp[2]) + cp[3]) + cp[5]) + cp[7]) + cp[8];
   P real3 cornerSum = (cp[0] + cp[6]) + cp[9];
@@ -146,18 +165,18 @@ void smoothTessVertex(real3 cp[10], real3 ncp[10], uint L, uint r, uint t, out r
   uint i = L - r, j = r - t, k = t;
   if (i == L || j == L || k == L) {
     uint c = i == L ? 0u : (j == L ? 1u : 2u);
-    x = cp[kCornerCp[c]];
-    n = snormalize(ncp[kCornerCp[c]]);
+    x = cp[kCornerCp(c)];
+    n = snormalize(ncp[kCornerCp(c)]);
   } else if (i == 0u || j == 0u || k == 0u) {
     // Edge (a, b) = (0,1) when k == 0, (1,2) when i == 0, (2,0) when j == 0; steps from a.
     uint a = k == 0u ? 0u : (i == 0u ? 1u : 2u), b = (a + 1u) % 3u;
     uint stepsFromA = a == 0u ? j : (a == 1u ? k : i);
     uint sa = 2u * a + 1u, sb = 2u * b;   // slots of a and b on edge a
     uint lo = a, hi = b, steps = stepsFromA, slo = sa, shi = sb;
-    if (lexLess(cp[kCornerCp[b]], cp[kCornerCp[a]])) { lo = b; hi = a; steps = L - stepsFromA; slo = sb; shi = sa; }
+    if (lexLess(cp[kCornerCp(b)], cp[kCornerCp(a)])) { lo = b; hi = a; steps = L - stepsFromA; slo = sb; shi = sa; }
     P real u = real(steps) / real(L);
-    x = pnEdgeCurve(cp[kCornerCp[lo]], cp[kSlotCp[slo]], cp[kSlotCp[shi]], cp[kCornerCp[hi]], u);
-    n = snormalize(pnEdgeCurve(ncp[kCornerCp[lo]], ncp[kSlotCp[slo]], ncp[kSlotCp[shi]], ncp[kCornerCp[hi]], u));
+    x = pnEdgeCurve(cp[kCornerCp(lo)], cp[kSlotCp(slo)], cp[kSlotCp(shi)], cp[kCornerCp(hi)], u);
+    n = snormalize(pnEdgeCurve(ncp[kCornerCp(lo)], ncp[kSlotCp(slo)], ncp[kSlotCp(shi)], ncp[kCornerCp(hi)], u));
   } else {
     P real3 lam = real3(real(i), real(j), real(k)) / real(L);
     real w[10];
