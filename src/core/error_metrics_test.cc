@@ -221,7 +221,7 @@ TEST(ErrorMetrics, BptReferenceIsTheExactSurface) {
   o.bptResolution = 20;
   Mesh fine = readMesh(kData + "/acaffd/t.bpt", o);
   const int patch = 5, i = 3, j = 4;
-  const uint32_t tri = uint32_t(patch * 200 + 2 * (i * 10 + j));   // cell (i, j): (i,j) (i+1,j) (i+1,j+1)
+  const uint32_t tri = uint32_t(patch * 200 + 2 * (i * 10 + j));   // cell (i, j): (i,j) (i+1,j) (i,j+1)
   ASSERT_EQ(coarse.vertexUV[coarse.triangles[tri][0]], glm::dvec2(0.3, 0.4));
   glm::dvec3 x, n;
   ref.preImage(tri, glm::dvec3(0.5, 0.5, 0.0), x, n);

@@ -4,7 +4,12 @@
 // Tessellation: each patch is sampled on a uniform (res+1) x (res+1) grid of (u, v) (res =
 // MeshReadOptions::bptResolution): vertex (i, j) of patch p is vertex p*(res+1)^2 + i*(res+1) + j at
 // u = i/res, v = j/res, with vertexPatch = p and vertexUV = (u, v). Each grid cell gives the triangles
-// (i,j)(i+1,j)(i+1,j+1) and (i,j)(i+1,j+1)(i,j+1): counter-clockwise seen from Su x Sv, 2 res^2 a patch.
+// (i,j)(i+1,j)(i,j+1) and (i+1,j)(i+1,j+1)(i,j+1): counter-clockwise seen from Su x Sv, 2 res^2 a patch.
+// The cell is split along its diagonal (i+1,j)-(i,j+1), where u grows as v falls, as the reference
+// implementation's reader does (acaffd mvc_model/model.py, parse_from_bpt: triangles (i1,i2,i3) and
+// (i3,i2,i4)); that diagonal is the same whether or not the patch is transposed (below). The choice
+// matters to the error figures: the reference (u, v) is interpolated linearly over each triangle, and
+// at a collapsed patch edge the fan triangles' apex corner carries the other grid vertex's v.
 // The normal is the exact Su x Sv; where it vanishes (a collapsed patch edge: the lid apex, the bottom
 // centre) it is taken at a parameter nudged toward the patch interior.
 // Orientation: when the tessellation's signed volume (about its box centre) is negative, i.e. Su x Sv
@@ -58,8 +63,8 @@ void tessellate(Mesh& mesh, int res) {
       for (int j = 0; j < res; ++j) {
         uint32_t a = uint32_t(base + size_t(i) * (res + 1) + j);
         uint32_t b = a + uint32_t(res + 1), c = b + 1, d = a + 1;
-        mesh.triangles.push_back({a, b, c});
-        mesh.triangles.push_back({a, c, d});
+        mesh.triangles.push_back({a, b, d});
+        mesh.triangles.push_back({b, c, d});
       }
   }
 }
