@@ -163,20 +163,37 @@ void smoothAdjust(uint creaseBits, real3 adj[3], real3 adjNbr[6], inout real3 cp
 // curve, the rest by the patch.
 void smoothTessVertex(real3 cp[10], real3 ncp[10], uint L, uint r, uint t, out real3 x, out real3 n) {
   uint i = L - r, j = r - t, k = t;
+  // Control points are picked with constant indices in each branch: a local array indexed by a
+  // variable lives in memory on lavapipe (SPIR-V path), three times slower than GL's select chains.
   if (i == L || j == L || k == L) {
-    uint c = i == L ? 0u : (j == L ? 1u : 2u);
-    x = cp[kCornerCp(c)];
-    n = snormalize(ncp[kCornerCp(c)]);
+    real3 xc = cp[9], nc = ncp[9];
+    if (i == L) { xc = cp[0]; nc = ncp[0]; }
+    else if (j == L) { xc = cp[6]; nc = ncp[6]; }
+    x = xc;
+    n = snormalize(nc);
   } else if (i == 0u || j == 0u || k == 0u) {
-    // Edge (a, b) = (0,1) when k == 0, (1,2) when i == 0, (2,0) when j == 0; steps from a.
-    uint a = k == 0u ? 0u : (i == 0u ? 1u : 2u), b = (a + 1u) % 3u;
-    uint stepsFromA = a == 0u ? j : (a == 1u ? k : i);
-    uint sa = 2u * a + 1u, sb = 2u * b;   // slots of a and b on edge a
-    uint lo = a, hi = b, steps = stepsFromA, slo = sa, shi = sb;
-    if (lexLess(cp[kCornerCp(b)], cp[kCornerCp(a)])) { lo = b; hi = a; steps = L - stepsFromA; slo = sb; shi = sa; }
+    // Edge a -> a+1 is (0,1) when k == 0, (1,2) when i == 0, (2,0) when j == 0; its cubic runs through
+    // corner a, the control points of slots 2a+1 and 2a+2, corner a+1 (cp 0,1,3,6 / 6,7,8,9 / 9,5,2,0).
+    uint stepsFromA = i;
+    real3 e0 = cp[9], e1 = cp[5], e2 = cp[2], e3 = cp[0], f0 = ncp[9], f1 = ncp[5], f2 = ncp[2], f3 = ncp[0];
+    if (k == 0u) {
+      stepsFromA = j;
+      e0 = cp[0]; e1 = cp[1]; e2 = cp[3]; e3 = cp[6]; f0 = ncp[0]; f1 = ncp[1]; f2 = ncp[3]; f3 = ncp[6];
+    } else if (i == 0u) {
+      stepsFromA = k;
+      e0 = cp[6]; e1 = cp[7]; e2 = cp[8]; e3 = cp[9]; f0 = ncp[6]; f1 = ncp[7]; f2 = ncp[8]; f3 = ncp[9];
+    }
+    // Evaluated from the lexicographically smaller corner, so both patches of the edge agree bit for bit.
+    uint steps = stepsFromA;
+    if (lexLess(e3, e0)) {
+      steps = L - stepsFromA;
+      real3 t0 = e0, t1 = e1, g0 = f0, g1 = f1;
+      e0 = e3; e1 = e2; e2 = t1; e3 = t0;
+      f0 = f3; f1 = f2; f2 = g1; f3 = g0;
+    }
     P real u = real(steps) / real(L);
-    x = pnEdgeCurve(cp[kCornerCp(lo)], cp[kSlotCp(slo)], cp[kSlotCp(shi)], cp[kCornerCp(hi)], u);
-    n = snormalize(pnEdgeCurve(ncp[kCornerCp(lo)], ncp[kSlotCp(slo)], ncp[kSlotCp(shi)], ncp[kCornerCp(hi)], u));
+    x = pnEdgeCurve(e0, e1, e2, e3, u);
+    n = snormalize(pnEdgeCurve(f0, f1, f2, f3, u));
   } else {
     P real3 lam = real3(real(i), real(j), real(k)) / real(L);
     real w[10];
