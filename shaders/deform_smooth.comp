@@ -16,12 +16,12 @@ void main() {
   if (tid >= params.range.y) return;
   uint st = params.range.x + tid;
   real3 Q[3], QN[3], adj[3], adjNbr[6], E[6], EN[6];
-  smoothCornerSamples(st, Q, QN, adj, adjNbr);
-  smoothEdgeSamples(st, E, EN);
+  SubCorners corners = smoothSubCorners(st);
+  smoothCornerSamples(st, corners, Q, QN, adj, adjNbr);
+  smoothEdgeSamples(corners, E, EN);
   real3 cp[10], ncp[10];
   smoothBoundaryControlPoints(Q, QN, E, EN, cp, ncp);
   P real3 centreN = real3(0);
-  SubCorners corners = smoothSubCorners(st);
   for (uint i = 0u; i < params.range.z; ++i) centreN = centreN + smoothCentreTerm(ncp, smoothInteriorNormal(corners, i), i);
   ncp[4] = centreN;
   smoothAdjust(subHeaders[st].y, adj, adjNbr, cp);

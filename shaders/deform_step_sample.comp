@@ -11,8 +11,9 @@ void main() {
   if (tid >= params.range.y) return;
   uint st = params.range.x + tid;
   real3 Q[3], QN[3], adj[3], adjNbr[6], E[6], EN[6];
-  smoothCornerSamples(st, Q, QN, adj, adjNbr);
-  smoothEdgeSamples(st, E, EN);
+  SubCorners corners = smoothSubCorners(st);
+  smoothCornerSamples(st, corners, Q, QN, adj, adjNbr);
+  smoothEdgeSamples(corners, E, EN);
   uint b = (SFFD_SAMPLE_FIXED + params.range.z) * st;
   for (uint c = 0u; c < 3u; ++c) {
     samples[b + c] = real4(Q[c], 0);
@@ -24,6 +25,5 @@ void main() {
     samples[b + 12u + e] = real4(EN[e], 0);
     samples[b + 21u + e] = real4(adjNbr[e], 0);
   }
-  SubCorners corners = smoothSubCorners(st);
   for (uint i = 0u; i < params.range.z; ++i) samples[b + SFFD_SAMPLE_FIXED + i] = real4(smoothInteriorNormal(corners, i), 0);
 }

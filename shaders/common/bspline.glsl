@@ -134,45 +134,50 @@ void latticeVolume2(uint base, real su, real sv, real sw, out real3 R, out real3
 }
 
 // Evaluates the volume at world point x: lattice parameter p = A x + c, then the knot box's Bezier volume.
+// One axis of latticeEvaluate: the knot box of parameter p, the local coordinate in it and its size.
+void latticeAxis(uint first, uint n, real p, inout bool inside, out uint span, out real s, out real h) {
+  real lo = latticeFrameAt(first), hi = latticeFrameAt(first + n);
+  if (p < lo || p > hi) inside = false;
+  span = latticeSpan(first, n, p);
+  real k0 = latticeFrameAt(first + span), k1 = latticeFrameAt(first + span + 1u);
+  P real hh = k1 - k0;
+  P real sa = (p - k0) / hh;
+  s = sa;
+  h = hh;
+}
+
+// One row of the world -> parameter map: row . (x, 1), in the twin's order.
+real latticeAffineRow(uint r, real3 x) {
+  uint o = SFFD_FRAME_AFFINE + 4u * r;
+  P real xy = latticeFrameAt(o) * x.x + latticeFrameAt(o + 1u) * x.y;
+  P real xyz = xy + latticeFrameAt(o + 2u) * x.z;
+  P real pr = xyz + latticeFrameAt(o + 3u);
+  return pr;
+}
+
+// Evaluates the volume at world point x: lattice parameter p = A x + c, then the knot box's Bezier
+// volume. Per-axis work is written out (no local arrays indexed by the axis: see latticeVolume2).
 LatticeSample latticeEvaluate(LatticeParams L, real3 x) {
   LatticeSample S;
-  real4 rows[3];
-  for (uint r = 0u; r < 3u; ++r)
-    rows[r] = real4(latticeFrameAt(SFFD_FRAME_AFFINE + 4u * r), latticeFrameAt(SFFD_FRAME_AFFINE + 4u * r + 1u),
-                    latticeFrameAt(SFFD_FRAME_AFFINE + 4u * r + 2u), latticeFrameAt(SFFD_FRAME_AFFINE + 4u * r + 3u));
-  P real3 p;
-  for (uint r = 0u; r < 3u; ++r) {
-    P real xy = rows[r].x * x.x + rows[r].y * x.y;
-    P real xyz = xy + rows[r].z * x.z;
-    P real pr = xyz + rows[r].w;
-    p[r] = pr;
-  }
-  uint span[3];
-  real s[3];
   S.inside = true;
-  for (uint a = 0u; a < 3u; ++a) {
-    uint first = L.break_offset[a], n = L.boxes[a];
-    real lo = latticeFrameAt(first), hi = latticeFrameAt(first + n);
-    if (p[a] < lo || p[a] > hi) S.inside = false;
-    span[a] = latticeSpan(first, n, p[a]);
-    real k0 = latticeFrameAt(first + span[a]), k1 = latticeFrameAt(first + span[a] + 1u);
-    P real h = k1 - k0;
-    P real sa = (p[a] - k0) / h;
-    s[a] = sa;
-    S.h[a] = h;
-  }
-  uint box = (span[0] * L.boxes.y + span[1]) * L.boxes.z + span[2];
+  uint span0, span1, span2;
+  real s0, s1, s2, h0, h1, h2;
+  latticeAxis(L.break_offset.x, L.boxes.x, latticeAffineRow(0u, x), S.inside, span0, s0, h0);
+  latticeAxis(L.break_offset.y, L.boxes.y, latticeAffineRow(1u, x), S.inside, span1, s1, h1);
+  latticeAxis(L.break_offset.z, L.boxes.z, latticeAffineRow(2u, x), S.inside, span2, s2, h2);
+  S.h = real3(h0, h1, h2);
+  uint box = (span0 * L.boxes.y + span1) * L.boxes.z + span2;
   uint base = box * L.boxes.w;
   P real3 R = real3(0), Ru = real3(0), Rv = real3(0), Rw = real3(0);
   if (L.degree.xyz == uvec3(2u)) {
-    latticeVolume2(base, s[0], s[1], s[2], R, Ru, Rv, Rw);
+    latticeVolume2(base, s0, s1, s2, R, Ru, Rv, Rw);
   } else {
     real bu[SFFD_MAX_DEGREE + 1], dbu[SFFD_MAX_DEGREE + 1];
     real bv[SFFD_MAX_DEGREE + 1], dbv[SFFD_MAX_DEGREE + 1];
     real bw[SFFD_MAX_DEGREE + 1], dbw[SFFD_MAX_DEGREE + 1];
-    latticeBernstein(L.degree.x, s[0], bu, dbu);
-    latticeBernstein(L.degree.y, s[1], bv, dbv);
-    latticeBernstein(L.degree.z, s[2], bw, dbw);
+    latticeBernstein(L.degree.x, s0, bu, dbu);
+    latticeBernstein(L.degree.y, s1, bv, dbv);
+    latticeBernstein(L.degree.z, s2, bw, dbw);
     uint c = base;
     for (uint i = 0u; i <= L.degree.x; ++i) {
       P real3 Sp = real3(0), Spv = real3(0), Spw = real3(0);
@@ -203,13 +208,15 @@ LatticeSample latticeEvaluate(LatticeParams L, real3 x) {
 
 // Deformed normal direction of a world-space normal n at the sample: cof(J_R) cof(A) n, up to a
 // positive factor (ALGORITHM.md 1.4). Not normalised.
+real latticeCofactorRow(uint r, real3 n) {
+  uint o = SFFD_FRAME_COF_AFFINE + 4u * r;
+  P real xy = latticeFrameAt(o) * n.x + latticeFrameAt(o + 1u) * n.y;
+  P real xyz = xy + latticeFrameAt(o + 2u) * n.z;
+  return xyz;
+}
+
 real3 latticeCofactorNormal(LatticeSample S, real3 n) {
-  P real3 q;
-  for (uint r = 0u; r < 3u; ++r) {
-    P real xy = latticeFrameAt(SFFD_FRAME_COF_AFFINE + 4u * r) * n.x + latticeFrameAt(SFFD_FRAME_COF_AFFINE + 4u * r + 1u) * n.y;
-    P real xyz = xy + latticeFrameAt(SFFD_FRAME_COF_AFFINE + 4u * r + 2u) * n.z;
-    q[r] = xyz;
-  }
+  P real3 q = real3(latticeCofactorRow(0u, n), latticeCofactorRow(1u, n), latticeCofactorRow(2u, n));
   P real3 cu = scross(S.dv, S.dw) * (S.h.x * q.x);
   P real3 cv = scross(S.dw, S.du) * (S.h.y * q.y);
   P real3 cw = scross(S.du, S.dv) * (S.h.z * q.z);

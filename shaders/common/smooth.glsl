@@ -37,42 +37,6 @@ real3 nearControlPoint(real3 q0, real3 q1, real3 q2, real3 q3) {
   return r;
 }
 
-// Steps 1 and 2 at the corners (and step 4, which needs the same Jacobians): the deformed corners,
-// their deformed normals, and the adjusting normals of the corners and of the crease slots.
-void smoothCornerSamples(uint st, out real3 Q[3], out real3 QN[3], out real3 adj[3], out real3 adjNbr[6]) {
-  uint rec = SFFD_SUB_STRIDE * st;
-  uint creaseBits = subHeaders[st].y;
-  for (uint c = 0u; c < 3u; ++c) {
-    LatticeSample S = latticeEvaluate(params.lattice, subRecords[rec + SFFD_SUB_XPN + c].xyz);
-    Q[c] = S.value;
-    QN[c] = snormalize(latticeCofactorNormal(S, subRecords[rec + SFFD_SUB_NLIN + c].xyz));
-    adj[c] = snormalize(latticeCofactorNormal(S, subRecords[rec + SFFD_SUB_NPN + c].xyz));
-    for (uint h = 0u; h < 2u; ++h) {
-      uint s = 2u * c + h;
-      adjNbr[s] = ((creaseBits >> s) & 1u) != 0u ? snormalize(latticeCofactorNormal(S, subRecords[rec + SFFD_SUB_NNBR + s].xyz)) : adj[c];
-    }
-  }
-}
-
-// Step 2 on the edges: samples at one third from each end, E[2e] near corner e, E[2e+1] near e+1.
-void smoothEdgeSamples(uint st, out real3 E[6], out real3 EN[6]) {
-  uint rec = SFFD_SUB_STRIDE * st;
-  P real third = real(1) / real(3);
-  P real twoThirds = real(2) / real(3);
-  for (uint e = 0u; e < 3u; ++e) {
-    uint a = e, b = (e + 1u) % 3u;
-    for (uint h = 0u; h < 2u; ++h) {
-      P real wa = h == 0u ? twoThirds : third;
-      P real wb = h == 0u ? third : twoThirds;
-      P real3 x = subRecords[rec + SFFD_SUB_XPN + a].xyz * wa + subRecords[rec + SFFD_SUB_XPN + b].xyz * wb;
-      P real3 n = subRecords[rec + SFFD_SUB_NLIN + a].xyz * wa + subRecords[rec + SFFD_SUB_NLIN + b].xyz * wb;
-      LatticeSample S = latticeEvaluate(params.lattice, x);
-      E[2u * e + h] = S.value;
-      EN[2u * e + h] = snormalize(latticeCofactorNormal(S, snormalize(n)));
-    }
-  }
-}
-
 // The flat-lifted corners and their linear normals of a sub-triangle, read once for every interior
 // sample (each storage-buffer read is costly on SIMD CPU devices).
 struct SubCorners {
@@ -88,6 +52,64 @@ SubCorners smoothSubCorners(uint st) {
   C.n1 = subRecords[rec + SFFD_SUB_NLIN + 1u].xyz;
   C.n2 = subRecords[rec + SFFD_SUB_NLIN + 2u].xyz;
   return C;
+}
+
+// Steps 1 and 2 at corner c (and step 4, which needs the same Jacobian): the deformed corner, its
+// deformed normal, and the adjusting normals of the corner and of its two slots (crease slots only).
+void smoothCornerSample(uint st, uint c, uint creaseBits, real3 x, real3 nlin, out real3 Q, out real3 QN, out real3 adj,
+                        out real3 adjA, out real3 adjB) {
+  uint rec = SFFD_SUB_STRIDE * st;
+  LatticeSample S = latticeEvaluate(params.lattice, x);
+  Q = S.value;
+  QN = snormalize(latticeCofactorNormal(S, nlin));
+  adj = snormalize(latticeCofactorNormal(S, subRecords[rec + SFFD_SUB_NPN + c].xyz));
+  adjA = adj;
+  adjB = adj;
+  if (((creaseBits >> (2u * c)) & 1u) != 0u) adjA = snormalize(latticeCofactorNormal(S, subRecords[rec + SFFD_SUB_NNBR + 2u * c].xyz));
+  if (((creaseBits >> (2u * c + 1u)) & 1u) != 0u) adjB = snormalize(latticeCofactorNormal(S, subRecords[rec + SFFD_SUB_NNBR + 2u * c + 1u].xyz));
+}
+
+// Corner c's lifted point and linear normal (selects, not an indexed array).
+real3 subCornerX(SubCorners C, uint c) { return c == 0u ? C.x0 : (c == 1u ? C.x1 : C.x2); }
+real3 subCornerN(SubCorners C, uint c) { return c == 0u ? C.n0 : (c == 1u ? C.n1 : C.n2); }
+
+// Loops rather than calls written out: every call inlines a whole lattice evaluation, and the
+// kernels' compile time grows with their number.
+void smoothCornerSamples(uint st, SubCorners C, out real3 Q[3], out real3 QN[3], out real3 adj[3], out real3 adjNbr[6]) {
+  uint creaseBits = subHeaders[st].y;
+  for (uint c = 0u; c < 3u; ++c) {
+    real3 q, qn, ad, a0, a1;
+    smoothCornerSample(st, c, creaseBits, subCornerX(C, c), subCornerN(C, c), q, qn, ad, a0, a1);
+    Q[c] = q;
+    QN[c] = qn;
+    adj[c] = ad;
+    adjNbr[2u * c] = a0;
+    adjNbr[2u * c + 1u] = a1;
+  }
+}
+
+// Step 2 on an edge: the sample at wa * a + wb * b.
+void smoothEdgeSample(real3 xa, real3 xb, real3 na, real3 nb, real wa, real wb, out real3 E, out real3 EN) {
+  P real3 x = xa * wa + xb * wb;
+  P real3 n = na * wa + nb * wb;
+  LatticeSample S = latticeEvaluate(params.lattice, x);
+  E = S.value;
+  EN = snormalize(latticeCofactorNormal(S, snormalize(n)));
+}
+
+// Step 2 on the edges: samples at one third from each end, E[2e] near corner e, E[2e+1] near e+1.
+void smoothEdgeSamples(SubCorners C, out real3 E[6], out real3 EN[6]) {
+  P real third = real(1) / real(3);
+  P real twoThirds = real(2) / real(3);
+  for (uint k = 0u; k < 6u; ++k) {
+    uint e = k / 2u, b = e == 2u ? 0u : e + 1u;
+    P real wa = k % 2u == 0u ? twoThirds : third;
+    P real wb = k % 2u == 0u ? third : twoThirds;
+    real3 x, n;
+    smoothEdgeSample(subCornerX(C, e), subCornerX(C, b), subCornerN(C, e), subCornerN(C, b), wa, wb, x, n);
+    E[k] = x;
+    EN[k] = n;
+  }
 }
 
 // Step 1 inside: the deformed normal at interior fitting point i (the geometry's centre comes from
