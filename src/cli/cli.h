@@ -85,5 +85,6 @@ CommandSpec conformCommand();
 CommandSpec clipCommand();
 CommandSpec errorCommand();
 CommandSpec renderCommand();
+CommandSpec viewCommand();   // cmd_view.cpp (src/view)
 
 }  // namespace sffd::cli
