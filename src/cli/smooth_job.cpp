@@ -2,8 +2,10 @@
 #include <algorithm>
 
 #include "deform_job.h"
+#include "deform_session.h"
 #include "error.h"
 #include "knot_box_clip.h"
+#include "lattice_pack.h"
 #include "mesh_topology.h"
 #include "regular_clip.h"
 #include "smooth_deform.h"
@@ -30,34 +32,49 @@ DeformRun runSmooth(const ParsedArgs& args, Job& job, OpenedBackend& backend) {
   const double l = edgeLengthOf(args, job.mesh);
   checkEdgeLength(job.mesh, l);
   int s = args.getInt("--samples", job.lattice.degree[0] + job.lattice.degree[1] + job.lattice.degree[2]);
-  FitTable fit = makeFitTable(std::max(3, s));
 
-  PreparedMesh prepared = prepareMesh(job.mesh);
-  PackedLattice packed = packLattice(job.lattice);
-  Backend* gpu = backend.gpu.get();
-  PnOutput pn = gpu ? pnTrianglesGpu(*gpu, prepared, run.variant) : pnTrianglesCpu(prepared, run.variant);
-  run.pnMs = stageMs(pn.timings, pn.wallMs);
-  SubTriangleRecords subs;
-  if (args.get("--clip", "regular") == "knot-box") {
-    // The 2015 clipping is the CPU baseline; the deform stage still runs on the chosen backend.
-    subs = recordsFromSubTriangles(prepared, pn, clipAgainstKnotBoxes(job.mesh, job.lattice), run.variant);
-  } else {
-    ClipTriangles C = buildClipTriangles(job.mesh, l, splitPatternTable().nmax());
-    subs = gpu ? regularClipGpu(*gpu, prepared, pn, C, l, run.variant) : regularClipCpu(prepared, pn, C, l, run.variant);
-  }
-  run.clipMs = stageMs(subs.timings, subs.wallMs);
-  run.subTriangles = subs.size();
   bool split = args.has("--split");
-  SmoothOutput out = gpu ? smoothDeformGpu(*gpu, packed, subs, fit, level, run.variant, split)
-                         : smoothDeformCpu(packed, subs, fit, level, run.variant);
-  run.deformMs = stageMs(out.timings, out.wallMs);
-  if (split && gpu) {
-    for (const DispatchTiming& t : out.timings) {
-      auto it = std::find_if(run.stepMs.begin(), run.stepMs.end(), [&](const auto& p) { return p.first == t.label; });
-      if (it == run.stepMs.end()) run.stepMs.push_back({t.label, 0.0}), it = run.stepMs.end() - 1;
-      it->second += std::max(t.gpuMs, 0.0);
+  bool knotBox = args.get("--clip", "regular") == "knot-box";
+  SubTriangleRecords subs;
+  SmoothOutput out;
+  if (Backend* gpu = backend.gpu.get()) {
+    // The device-resident path that `view` and `bench` use: no host round trip between the stages.
+    DeformSessionOptions o;
+    o.variant = run.variant;
+    o.edgeLength = l;
+    o.level = level;
+    o.samples = std::max(3, s);
+    o.knotBoxClip = knotBox;
+    o.split = split;
+    o.creaseAngleDeg = args.getDouble("--crease-angle", 40.0);
+    DeformSession session(*gpu, job.mesh, job.lattice, o);
+    run.pnMs = session.timings().pnMs;
+    run.clipMs = session.timings().clipMs;
+    const SessionTimings& t = session.deform(job.lattice);
+    run.deformMs = t.deformMs;
+    if (split)
+      for (const DispatchTiming& d : t.dispatches) {
+        auto it = std::find_if(run.stepMs.begin(), run.stepMs.end(), [&](const auto& p) { return p.first == d.label; });
+        if (it == run.stepMs.end()) run.stepMs.push_back({d.label, 0.0}), it = run.stepMs.end() - 1;
+        it->second += std::max(d.gpuMs, 0.0);
+      }
+    subs = session.records();
+    out = session.output();
+  } else {
+    PreparedMesh prepared = prepareMesh(job.mesh);
+    PnOutput pn = pnTrianglesCpu(prepared, run.variant);
+    run.pnMs = stageMs(pn.timings, pn.wallMs);
+    if (knotBox) {
+      subs = recordsFromSubTriangles(prepared, pn, clipAgainstKnotBoxes(job.mesh, job.lattice), run.variant);
+    } else {
+      ClipTriangles C = buildClipTriangles(job.mesh, l, splitPatternTable().nmax());
+      subs = regularClipCpu(prepared, pn, C, l, run.variant);
     }
+    run.clipMs = stageMs(subs.timings, subs.wallMs);
+    out = smoothDeformCpu(packLattice(job.lattice), subs, makeFitTable(std::max(3, s)), level, run.variant);
+    run.deformMs = stageMs(out.timings, out.wallMs);
   }
+  run.subTriangles = subs.size();
   run.patches = patchVerticesOf(subs, out);
   run.patchControlPoints = std::move(out.patches);
   run.mesh = weldPatchVertices(*run.patches);

@@ -28,6 +28,7 @@ struct DeformSessionOptions {
   int samples = 0;             // sampling density s; 0: nu + nv + nw of the lattice (at least 3)
   bool knotBoxClip = false;    // the 2015 clipping (computed on the CPU, records uploaded once)
   bool split = false;          // deform as four dispatches (per-step timings) instead of the fused kernel
+  double creaseAngleDeg = 40;  // for a mesh without normals: dihedral angle above which an edge is a crease
 };
 
 // Times of the last precompute() or deform(): GPU time where the device measures it, else wall time.
@@ -49,7 +50,8 @@ class DeformSession {
 
   // Runs the pre-compute stage again (PN triangles and clipping; the records stay on the device).
   const SessionTimings& precompute();
-  // Deforms with the lattice's current control points; an input Error if its structure differs.
+  // Deforms with the lattice's current control points into the chunks' buffers (undefined before the
+  // first call); an input Error if the lattice's structure differs from the session's.
   const SessionTimings& deform(const Lattice& lattice);
   const SessionTimings& timings() const { return timings_; }
 

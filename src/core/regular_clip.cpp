@@ -130,14 +130,7 @@ ClipTriangles buildClipTriangles(const Mesh& mesh, double l, int nmax) {
   return out;
 }
 
-namespace {
-
 // ---------------------------------------------------------------- packed inputs of the clip kernels
-
-struct PackedClip {
-  std::vector<uint32_t> headers;   // 8 per clip triangle
-  std::vector<double> reals;       // 36 per clip triangle
-};
 
 PackedClip packClip(const ClipTriangles& clip) {
   PackedClip P;
@@ -162,11 +155,6 @@ PackedClip packClip(const ClipTriangles& clip) {
   return P;
 }
 
-struct PackedTable {
-  std::vector<uint32_t> words;
-  uint32_t nmax = 0, vertexWord = 0, triangleWord = 0;
-};
-
 const PackedTable& packedTable() {
   static const PackedTable T = [] {
     const SplitPatternTable& S = splitPatternTable();
@@ -189,6 +177,8 @@ const PackedTable& packedTable() {
   }();
   return T;
 }
+
+namespace {
 
 // ---------------------------------------------------------------- the CPU twin of clip_count / clip_write
 

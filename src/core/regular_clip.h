@@ -52,4 +52,17 @@ SubTriangleRecords regularClipGpu(Backend& backend, const PreparedMesh& mesh, co
 SubTriangleRecords recordsFromSubTriangles(const PreparedMesh& mesh, const PnOutput& pn,
                                            const std::vector<SubTriangle>& subs, KernelVariant variant);
 
+// Device inputs of the clip kernels (layout.h): the clip triangles packed as headers (8 uint each) and
+// reals (SFFD_CLIP_REAL_STRIDE real4 each), and the split-pattern table packed into uint words.
+struct PackedClip {
+  std::vector<uint32_t> headers;
+  std::vector<double> reals;
+};
+PackedClip packClip(const ClipTriangles& clip);
+struct PackedTable {
+  std::vector<uint32_t> words;
+  uint32_t nmax = 0, vertexWord = 0, triangleWord = 0;
+};
+const PackedTable& packedTable();
+
 }  // namespace sffd
