@@ -86,7 +86,6 @@ int run(const ParsedArgs& args) {
   }
   if (job.mesh.triangles.empty()) throw Error(ErrorKind::Input, job.meshPath + ": no triangles to draw");
   cfg.sessionMesh = job.mesh;
-  applyCreaseAngle(cfg.sessionMesh, args.getDouble("--crease-angle", 40.0));   // nothing when the file has normals
   const double l = edgeLengthOf(args, cfg.sessionMesh);
   checkEdgeLength(cfg.sessionMesh, l);
   cfg.lattice = job.lattice;
@@ -120,6 +119,7 @@ int run(const ParsedArgs& args) {
     so.level = cfg.level;
     so.samples = args.getInt("--samples", 0);
     so.split = args.has("--split");
+    so.creaseAngleDeg = args.getDouble("--crease-angle", 40.0);
     cfg.session = so;
   }
   const Mesh raw = job.mesh;

@@ -17,7 +17,7 @@ struct ViewConfig {
   Backend* gpu = nullptr;                 // null: the CPU reference
   bool zeroCopy = false;                  // gpu is a GL backend on `window`
   std::string backendLabel;               // for the HUD ("gl-glfw", "vulkan", "cpu")
-  Mesh sessionMesh;                       // the input with creases applied
+  Mesh sessionMesh;                       // the input as loaded (after --normalize)
   HostDeform host;
   std::optional<DeformSessionOptions> session;   // smooth on a GPU: the device-resident path
   int level = 10;

@@ -11,6 +11,7 @@
 #include "error_metrics.h"
 #include "gl/gl_backend.h"
 #include "lattice_pack.h"
+#include "mesh_topology.h"
 
 namespace sffd::view {
 namespace {
@@ -57,15 +58,19 @@ std::vector<float> geometryErrors(const Mesh& input, const Lattice& lattice, con
   return out;
 }
 
-Scene::Scene(gl::Renderer& renderer, Backend* gpu, bool zeroCopy, Mesh sessionMesh, HostDeform host,
+Scene::Scene(gl::Renderer& renderer, Backend* gpu, bool zeroCopy, Mesh mesh, HostDeform host,
              std::optional<DeformSessionOptions> sessionOptions, int level)
     : renderer_(renderer),
       gpu_(gpu),
       zeroCopy_(zeroCopy && gpu),
-      sessionMesh_(std::move(sessionMesh)),
+      sessionMesh_(std::move(mesh)),
       host_(std::move(host)),
       sessionOptions_(std::move(sessionOptions)),
       level_(level) {
+  if (sessionOptions_) {
+    creasedMesh_ = sessionMesh_;
+    applyCreaseAngle(creasedMesh_, sessionOptions_->creaseAngleDeg);   // as the session does
+  }
   glm::dvec3 lo(1e300), hi(-1e300);
   for (const auto& p : sessionMesh_.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
   if (!sessionMesh_.positions.empty()) normalLength_ = float(0.03 * glm::length(hi - lo));
@@ -115,7 +120,7 @@ void Scene::update(const Lattice& lattice, const SceneSettings& settings,
     } else {
       if (!sessionRecords_) sessionRecords_ = session_->records();
       PatchVertices pv = patchVerticesOf(*sessionRecords_, session_->output());
-      drawHost(sessionMesh_, lattice, settings.heatmap ? Mesh{} : weldPatchVertices(pv), pv, settings);
+      drawHost(creasedMesh_, lattice, settings.heatmap ? Mesh{} : weldPatchVertices(pv), pv, settings);
       path_ = "session+copy";
     }
   } else {

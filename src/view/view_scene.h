@@ -43,8 +43,8 @@ struct StageTimes {
 class Scene {
  public:
   // `gpu` may be null (CPU reference). `zeroCopy`: gpu is a GL backend on the renderer's context.
-  // `sessionMesh` is the input with creases applied (what DeformSession and the heat map read).
-  Scene(gl::Renderer& renderer, Backend* gpu, bool zeroCopy, Mesh sessionMesh, HostDeform host,
+  // `mesh` is the input as loaded (DeformSession applies the crease angle of its options itself).
+  Scene(gl::Renderer& renderer, Backend* gpu, bool zeroCopy, Mesh mesh, HostDeform host,
         std::optional<DeformSessionOptions> sessionOptions, int level);
   ~Scene();
 
@@ -76,7 +76,8 @@ class Scene {
   gl::Renderer& renderer_;
   Backend* gpu_;
   bool zeroCopy_;
-  Mesh sessionMesh_;
+  Mesh sessionMesh_;                // as loaded: what DeformSession prepares
+  Mesh creasedMesh_;                // with the crease angle applied: the heat map's pre-images
   HostDeform host_;
   std::optional<DeformSessionOptions> sessionOptions_;
   int level_;
