@@ -56,6 +56,7 @@ Summary summarize(std::vector<double> v) {
 class App {
  public:
   explicit App(ViewConfig& c);
+  ~App();
   int run();
   void execute(const Command& c);
 
@@ -74,6 +75,7 @@ class App {
   void checkFold();
   // input
   static App* of(GLFWwindow* w) { return static_cast<App*>(glfwGetWindowUserPointer(w)); }
+  static void detach(GLFWwindow* w);
   void onKey(int key, int mods);
   void onButton(int button, int action, int mods);
   void onCursor(double x, double y);
@@ -136,6 +138,24 @@ App::App(ViewConfig& c)
     of(w)->execute(c);
   });
   glfwSwapInterval(0);
+}
+
+void App::detach(GLFWwindow* w) {
+  glfwSetFramebufferSizeCallback(w, nullptr);
+  glfwSetKeyCallback(w, nullptr);
+  glfwSetMouseButtonCallback(w, nullptr);
+  glfwSetCursorPosCallback(w, nullptr);
+  glfwSetScrollCallback(w, nullptr);
+  glfwSetWindowUserPointer(w, nullptr);
+}
+
+// The window outlives the App (the context is shared): no callback may reach a destroyed App.
+App::~App() {
+  detach(window_);
+  try {
+    renderer_->context().activate();   // FrameTarget and the overlays delete their GL objects
+  } catch (...) {
+  }
 }
 
 // ---- frame loop ----
