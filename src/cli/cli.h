@@ -86,5 +86,6 @@ CommandSpec clipCommand();
 CommandSpec errorCommand();
 CommandSpec renderCommand();
 CommandSpec benchCommand();
+CommandSpec viewCommand();   // cmd_view.cpp (src/view)
 
 }  // namespace sffd::cli

@@ -21,7 +21,8 @@ static std::string oneLine(const char* what) {
 static std::vector<cli::CommandSpec> commands() {
   return {cli::deformCommand(), cli::latticeCommand(), cli::devicesCommand(), cli::conformCommand(), cli::clipCommand(),
           cli::errorCommand(),
-          cli::renderCommand(), cli::benchCommand()};
+          cli::renderCommand(), cli::benchCommand(),
+          cli::viewCommand()};
 }
 
 static void usage(FILE* f) {

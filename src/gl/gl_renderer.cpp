@@ -382,6 +382,7 @@ glm::vec3 viridis(float t) {
 struct Renderer::GpuMesh {
   GLuint vao = 0, vbo = 0, ebo = 0;
   GLsizei indexCount = 0;
+  std::vector<std::pair<GLuint, GLsizei>> external;   // BufferItem: a VAO over the caller's buffers, index count
   bool hasScalars = false;
   float scalarMin = 0, scalarMax = 0;
   std::vector<glm::vec3> points;   // positions relative to the scene centre (camera fitting)
@@ -468,11 +469,7 @@ Renderer::~Renderer() {
   } catch (...) {
     return;   // the context is gone: so are its objects
   }
-  for (auto& m : meshes_) {
-    glDeleteVertexArrays(1, &m->vao);
-    glDeleteBuffers(1, &m->vbo);
-    glDeleteBuffers(1, &m->ebo);
-  }
+  deleteMeshes();
   releaseTarget();
   glDeleteVertexArrays(1, &emptyVao_);
   glDeleteVertexArrays(1, &overlayVao_);
@@ -508,12 +505,7 @@ void Renderer::setItems(const std::vector<RenderItem>& items) {
   const glm::dvec3 centre = std::isfinite(lo.x) ? (lo + hi) * 0.5 : glm::dvec3(0);
 
   context_->activate();
-  for (auto& m : meshes_) {
-    glDeleteVertexArrays(1, &m->vao);
-    glDeleteBuffers(1, &m->vbo);
-    glDeleteBuffers(1, &m->ebo);
-  }
-  meshes_.clear();
+  deleteMeshes();
   sceneCentre_ = centre;
   for (const RenderItem& it : items) {
     const Mesh& m = *it.mesh;
@@ -572,6 +564,43 @@ void Renderer::setItems(const std::vector<RenderItem>& items) {
     meshes_.push_back(std::move(g));
     checkGl("uploading a mesh");
   }
+}
+
+void Renderer::deleteMeshes() {
+  for (auto& m : meshes_) {
+    glDeleteVertexArrays(1, &m->vao);
+    glDeleteBuffers(1, &m->vbo);
+    glDeleteBuffers(1, &m->ebo);
+    for (auto& e : m->external) glDeleteVertexArrays(1, &e.first);
+  }
+  meshes_.clear();
+}
+
+void Renderer::setBufferItem(const BufferItem& item) {
+  context_->activate();
+  deleteMeshes();
+  sceneCentre_ = glm::dvec3(0);   // the buffers hold world positions
+  auto g = std::make_unique<GpuMesh>();
+  g->caption = item.caption;
+  g->points = item.fitPoints;
+  for (const BufferDraw& d : item.draws) {
+    if (d.indexCount == 0) continue;
+    GLuint vao = 0;
+    glGenVertexArrays(1, &vao);
+    glBindVertexArray(vao);
+    glBindBuffer(GL_ARRAY_BUFFER, d.vertexBuffer);
+    glEnableVertexAttribArray(0);
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 16, reinterpret_cast<void*>(d.positionOffset));
+    glEnableVertexAttribArray(1);
+    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 16, reinterpret_cast<void*>(d.normalOffset));
+    glDisableVertexAttribArray(2);
+    glVertexAttrib1f(2, 0.0f);
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, d.indexBuffer);
+    glBindVertexArray(0);
+    g->external.push_back({vao, static_cast<GLsizei>(d.indexCount)});
+  }
+  meshes_.push_back(std::move(g));
+  checkGl("setting up a buffer item");
 }
 
 namespace {
@@ -634,13 +663,19 @@ Fit fitPoints(const std::vector<const std::vector<glm::vec3>*>& sets, glm::dvec3
 
 }  // namespace
 
-std::vector<SlotCamera> Renderer::draw(const RenderOptions& o, int width, int height) {
-  context_->activate();
-  const Programs& P = *programs_;
+struct Renderer::Frame {
+  float scale = 1, legendW = 0, captionH = 0, sMin = 0, sMax = 1;
+  std::string minLabel, maxLabel;
+  glm::dvec3 camUp{0, 0, 1};
+  std::vector<SlotCamera> cams;
+};
+
+// Layout (a caption band at the top when any item has a caption, a legend panel at the right when any
+// item has scalars, the rest split into equal slots, left to right) and the camera of every slot.
+Renderer::Frame Renderer::frame(const RenderOptions& o, int width, int height) const {
+  Frame fr;
   const float W = static_cast<float>(width), H = static_cast<float>(height);
 
-  // Layout: a caption band at the top when any item has a caption, a legend panel at the right
-  // when any item has scalars, the rest split into equal slots, left to right.
   const float scale = std::max(1.0f, std::round(std::min(W, H) / 280.0f));
   bool anyCaption = false, anyScalars = false;
   float sMin = std::numeric_limits<float>::infinity(), sMax = -sMin;
@@ -664,24 +699,6 @@ std::vector<SlotCamera> Renderer::draw(const RenderOptions& o, int width, int he
   const int areaW = std::max(1, width - static_cast<int>(legendW));
   const int areaH = std::max(1, height - static_cast<int>(captionH));
   const int n = std::max<int>(1, static_cast<int>(meshes_.size()));
-
-  glDisable(GL_BLEND);
-  glDisable(GL_CULL_FACE);
-  glDisable(GL_SCISSOR_TEST);
-  glViewport(0, 0, width, height);
-  glClearColor(1, 1, 1, 1);
-  glClearDepth(1.0);
-  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-
-  // Background
-  glDisable(GL_DEPTH_TEST);
-  glUseProgram(P.background);
-  glm::vec3 top = o.gradientBackground ? glm::vec3(0.97f, 0.97f, 0.98f) : glm::vec3(0.93f, 0.93f, 0.94f);
-  glm::vec3 bottom = o.gradientBackground ? glm::vec3(0.79f, 0.80f, 0.82f) : top;
-  glUniform3fv(P.bgTop, 1, glm::value_ptr(top));
-  glUniform3fv(P.bgBottom, 1, glm::value_ptr(bottom));
-  glBindVertexArray(emptyVao_);
-  glDrawArrays(GL_TRIANGLES, 0, 3);
 
   // Cameras
   const double el = glm::radians(std::clamp(o.elevationDeg, -89.5, 89.5)), az = glm::radians(o.azimuthDeg);
@@ -707,8 +724,17 @@ std::vector<SlotCamera> Renderer::draw(const RenderOptions& o, int width, int he
     cam.height = areaH;
     cam.fovYDeg = glm::degrees(fovY);
     cam.aspect = static_cast<double>(cam.width) / cam.height;
-    fits.push_back(fitPoints({&meshes_[static_cast<size_t>(i)]->points}, right, camUp, front,
-                             tanY * cam.aspect * fill, tanY * fill));
+    if (o.placement) {   // placed by the caller: nothing to fit
+      Fit f;
+      f.target = o.placement->target - sceneCentre_;
+      f.distance = o.placement->distance;
+      f.zNear = o.placement->zNear;
+      f.zFar = o.placement->zFar;
+      fits.push_back(f);
+    } else {
+      fits.push_back(fitPoints({&meshes_[static_cast<size_t>(i)]->points}, right, camUp, front,
+                               tanY * cam.aspect * fill, tanY * fill));
+    }
     shared = std::max(shared, fits.back().distance);
     cams.push_back(cam);
   }
@@ -729,6 +755,51 @@ std::vector<SlotCamera> Renderer::draw(const RenderOptions& o, int width, int he
     cam.view = glm::lookAt(cam.eye, cam.target, camUp);
     cam.projection = glm::perspective(fovY, cam.aspect, cam.zNear, cam.zFar);
   }
+
+  fr.scale = scale;
+  fr.legendW = legendW;
+  fr.captionH = captionH;
+  fr.sMin = sMin;
+  fr.sMax = sMax;
+  fr.minLabel = minLabel;
+  fr.maxLabel = maxLabel;
+  fr.camUp = camUp;
+  fr.cams = std::move(cams);
+  return fr;
+}
+
+std::vector<SlotCamera> Renderer::cameras(const RenderOptions& o, int width, int height) {
+  return frame(o, width, height).cams;
+}
+
+std::vector<SlotCamera> Renderer::draw(const RenderOptions& o, int width, int height) {
+  context_->activate();
+  const Programs& P = *programs_;
+  const float W = static_cast<float>(width), H = static_cast<float>(height);
+  Frame fr = frame(o, width, height);
+  const float scale = fr.scale, legendW = fr.legendW, captionH = fr.captionH, sMin = fr.sMin, sMax = fr.sMax;
+  const std::string& minLabel = fr.minLabel;
+  const std::string& maxLabel = fr.maxLabel;
+  const glm::dvec3 camUp = fr.camUp;
+  std::vector<SlotCamera>& cams = fr.cams;
+
+  glDisable(GL_BLEND);
+  glDisable(GL_CULL_FACE);
+  glDisable(GL_SCISSOR_TEST);
+  glViewport(0, 0, width, height);
+  glClearColor(1, 1, 1, 1);
+  glClearDepth(1.0);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+
+  // Background
+  glDisable(GL_DEPTH_TEST);
+  glUseProgram(P.background);
+  glm::vec3 top = o.gradientBackground ? glm::vec3(0.97f, 0.97f, 0.98f) : glm::vec3(0.93f, 0.93f, 0.94f);
+  glm::vec3 bottom = o.gradientBackground ? glm::vec3(0.79f, 0.80f, 0.82f) : top;
+  glUniform3fv(P.bgTop, 1, glm::value_ptr(top));
+  glUniform3fv(P.bgBottom, 1, glm::value_ptr(bottom));
+  glBindVertexArray(emptyVao_);
+  glDrawArrays(GL_TRIANGLES, 0, 3);
 
   // Meshes
   glEnable(GL_DEPTH_TEST);
@@ -753,6 +824,10 @@ std::vector<SlotCamera> Renderer::draw(const RenderOptions& o, int width, int he
     glUniform1i(P.meshUseScalars, m.hasScalars ? 1 : 0);
     glBindVertexArray(m.vao);
     if (m.indexCount > 0) glDrawElements(GL_TRIANGLES, m.indexCount, GL_UNSIGNED_INT, nullptr);
+    for (const auto& [vao, count] : m.external) {
+      glBindVertexArray(vao);
+      glDrawElements(GL_TRIANGLES, count, GL_UNSIGNED_INT, nullptr);
+    }
   }
 
   // Overlay: captions and legend, in pixels from the top left.
@@ -803,6 +878,36 @@ std::vector<SlotCamera> Renderer::draw(const RenderOptions& o, int width, int he
   glUseProgram(0);
   checkGl("drawing");
   return cams;
+}
+
+int Renderer::drawText(const std::vector<std::string>& lines, int x, int y, int width, int height, glm::vec4 color,
+                       int scale) {
+  if (width < 1 || height < 1 || lines.empty()) return scale;
+  context_->activate();
+  const float W = static_cast<float>(width), H = static_cast<float>(height);
+  if (scale <= 0) scale = static_cast<int>(std::max(1.0f, std::round(std::min(W, H) / 450.0f)));
+  const float s = static_cast<float>(scale), lineH = 10 * s, pad = 3 * s;
+  float textW = 0;
+  for (const std::string& l : lines) textW = std::max(textW, Overlay::textWidth(l, s));
+  Overlay ov;
+  ov.quad(float(x), float(y), float(x) + textW + 2 * pad, float(y) + lines.size() * lineH + 2 * pad - 3 * s,
+          glm::vec4(1.0f, 1.0f, 1.0f, 0.65f));
+  for (size_t i = 0; i < lines.size(); ++i) ov.text(lines[i], float(x) + pad, float(y) + pad + i * lineH, s, color);
+  glViewport(0, 0, width, height);
+  glDisable(GL_DEPTH_TEST);
+  glEnable(GL_BLEND);
+  glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+  glUseProgram(programs_->overlay);
+  glUniform2f(programs_->overlaySize, W, H);
+  glBindVertexArray(overlayVao_);
+  glBindBuffer(GL_ARRAY_BUFFER, overlayVbo_);
+  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(ov.v.size() * sizeof(OverlayVertex)), ov.v.data(), GL_STREAM_DRAW);
+  glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(ov.v.size()));
+  glDisable(GL_BLEND);
+  glBindVertexArray(0);
+  glUseProgram(0);
+  checkGl("drawing text");
+  return scale;
 }
 
 void Renderer::releaseTarget() {

@@ -52,6 +52,27 @@ struct RenderOptions {
   bool legend = true;             // colour bar with the range's ends when an item has scalars
   bool gradientBackground = true; // light grey, lighter at the top; false: flat
   glm::vec3 baseColor{0.80f, 0.79f, 0.76f};           // sRGB albedo where there are no scalars
+  // A placed camera (the viewer's orbit, pan and zoom) instead of one fitted to the meshes: every slot
+  // looks at `target` from `distance` along the view direction above, with these depth planes.
+  struct Placement {
+    glm::dvec3 target{0};
+    double distance = 1, zNear = 0.01, zFar = 100;
+  };
+  std::optional<Placement> placement;
+};
+
+// Geometry already in GL buffers of the renderer's context (the viewer draws the deform kernels'
+// output in place, without a host copy): float vec4 positions and normals read with a 16-byte stride
+// from `vertexBuffer` at the given byte offsets, triangles from the uint32 `indexBuffer`. The caller
+// owns the buffers and keeps them alive while the item is set.
+struct BufferDraw {
+  unsigned vertexBuffer = 0, indexBuffer = 0;
+  size_t positionOffset = 0, normalOffset = 0, indexCount = 0;
+};
+struct BufferItem {
+  std::vector<BufferDraw> draws;      // drawn together, in one slot
+  std::vector<glm::vec3> fitPoints;   // world positions a fitted camera frames (may be empty with a placement)
+  std::string caption;
 };
 
 // The camera of one slot, as used to draw it (for tests and the viewer's picking).
@@ -87,6 +108,8 @@ class Renderer {
   // Uploads the meshes (replacing the previous ones). Throws an input Error for a bad item (scalar
   // count, a triangle index out of range).
   void setItems(const std::vector<RenderItem>& items);
+  // Replaces the items by one item drawn from the caller's GL buffers (see BufferItem).
+  void setBufferItem(const BufferItem& item);
   // Draws the items into an offscreen framebuffer of options.width x options.height and reads it back.
   // Throws an input Error for a size outside 1..maxSize().
   Image render(const RenderOptions& options);
@@ -97,10 +120,20 @@ class Renderer {
   // Draws into the framebuffer bound now (a viewer's window: framebuffer 0) of the given size; returns
   // the slot cameras. options.width/height are ignored.
   std::vector<SlotCamera> draw(const RenderOptions& options, int width, int height);
+  // The cameras draw() would use for a picture of this size, without drawing.
+  std::vector<SlotCamera> cameras(const RenderOptions& options, int width, int height);
+  // Lines of text (the caption font) with their top-left corner at (x, y) pixels from the top left,
+  // over a translucent panel, into the framebuffer bound now of the given size. Returns the scale
+  // used (pixels per font cell; 0 picks one from the size).
+  int drawText(const std::vector<std::string>& lines, int x, int y, int width, int height,
+               glm::vec4 color = {0.1f, 0.1f, 0.12f, 1.0f}, int scale = 0);
 
  private:
   struct GpuMesh;
   struct Programs;
+  struct Frame;
+  Frame frame(const RenderOptions& options, int width, int height) const;
+  void deleteMeshes();
   void ensureTarget(int width, int height, int samples);
   void releaseTarget();
 

@@ -1,0 +1,242 @@
+// End-to-end tests of `sffd view --replay`: a scripted session under an X server (DISPLAY, or
+// xvfb-run when it is installed; skipped otherwise) whose screenshots must match `sffd render` of the
+// saved lattice; undo/redo exactness, a window resized to nothing, a folding lattice, key bindings,
+// and bad script lines (one error line, exit 2, checked before a window is opened).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "gl/gl_renderer.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+const std::string kData = SFFD_SHARED_DATA;
+const std::string kSffd = SFFD_BINARY;
+const std::string kSphere = kData + "/acaffd/sphere.obj";
+
+struct Result {
+  int status = -1;
+  std::string err;
+};
+
+fs::path freshDir(const std::string& name) {
+  fs::path d = fs::temp_directory_path() / ("sffd_view_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+// The X server prefix: none with a DISPLAY, xvfb-run without one; nullopt when neither is there.
+std::optional<std::string> xPrefix() {
+  const char* d = std::getenv("DISPLAY");
+  if (d && *d) return std::string();
+  if (std::system("command -v xvfb-run >/dev/null 2>&1") == 0) return std::string("xvfb-run -a -s '-screen 0 1280x1024x24' ");
+  return std::nullopt;
+}
+
+Result run(const std::string& args, const fs::path& dir, const std::string& prefix = "") {
+  std::string errFile = (dir / "stderr.txt").string();
+  std::string cmd = "LIBGL_ALWAYS_SOFTWARE=1 " + prefix + kSffd + " " + args + " >/dev/null 2>" + errFile;
+  int raw = std::system(cmd.c_str());
+  Result r;
+  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : 128;
+  std::ifstream f(errFile);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  r.err = ss.str();
+  return r;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream f(p);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
+void writeFile(const fs::path& p, const std::string& text) { std::ofstream(p) << text; }
+
+// A bent identity lattice around the sphere (JSON, so render reads it with no conventions).
+fs::path makeLattice(const fs::path& dir) {
+  fs::path l = dir / "start.json";
+  Result r = run("lattice " + kSphere + " -o " + l.string() + " --counts 4,4,4 --preset bend:0.3 --quiet", dir);
+  EXPECT_EQ(r.status, 0) << r.err;
+  return l;
+}
+
+#define NEED_X(prefix)                                                              \
+  auto prefix##Opt = xPrefix();                                                     \
+  if (!prefix##Opt) GTEST_SKIP() << "no DISPLAY and no xvfb-run: the viewer needs an X server"; \
+  const std::string prefix = *prefix##Opt
+
+struct Diff {
+  double meanAbs = 0;     // mean absolute channel difference, in 1/255
+  double farShare = 0;    // share of pixels with a channel differing by more than 16
+};
+Diff compare(const sffd::gl::Image& a, const sffd::gl::Image& b) {
+  Diff d;
+  EXPECT_EQ(a.width, b.width);
+  EXPECT_EQ(a.height, b.height);
+  if (a.rgba.size() != b.rgba.size() || a.rgba.empty()) return {255, 1};
+  size_t far = 0, n = a.rgba.size() / 4;
+  double sum = 0;
+  for (size_t i = 0; i < n; ++i) {
+    int worst = 0;
+    for (int c = 0; c < 3; ++c) {
+      int v = std::abs(int(a.rgba[4 * i + c]) - int(b.rgba[4 * i + c]));
+      sum += v;
+      worst = std::max(worst, v);
+    }
+    far += worst > 16;
+  }
+  d.meanAbs = sum / (3.0 * n);
+  d.farShare = double(far) / n;
+  return d;
+}
+
+TEST(View, ReplayScreenshotsMatchRender) {
+  NEED_X(x);
+  fs::path dir = freshDir("match");
+  fs::path lat = makeLattice(dir);
+  writeFile(dir / "moves.txt",
+            "resize 400 300\n"
+            "set hud off\n"
+            "set lattice off\n"
+            "drag 1 1 3 0 0 0.35\n"
+            "select 2 2 0 2 1 0\n"
+            "move 0.2 0 -0.1\n"
+            "select-box 0 0 400 300   # every point in the window\n"
+            "select none\n"
+            "fit\n"
+            "screenshot smooth.png\n"
+            "save-lattice moved.json\n"
+            "method classic\n"
+            "fit\n"
+            "screenshot classic.png\n");
+  Result r = run("view " + kSphere + " -l " + lat.string() + " --replay " + (dir / "moves.txt").string() + " --out-dir " +
+                     dir.string() + " --width 400 --height 300",
+                 dir, x);
+  ASSERT_EQ(r.status, 0) << r.err;
+  // Smooth on the window's GL context is drawn where the kernels wrote it.
+  EXPECT_NE(r.err.find("smooth.png (smooth, zero-copy)"), std::string::npos) << r.err;
+  for (std::string method : {"smooth", "classic"}) {
+    fs::path ref = dir / ("render_" + method + ".png");
+    Result rr = run("render " + kSphere + " -l " + (dir / "moved.json").string() + " --method " + method +
+                        " --width 400 --height 300 --quiet -o " + ref.string(),
+                    dir);
+    ASSERT_EQ(rr.status, 0) << rr.err;
+    Diff d = compare(sffd::gl::readPng((dir / (method + ".png")).string()), sffd::gl::readPng(ref.string()));
+    std::printf("view %s against render: mean abs diff %.3f/255, %.4f%% of pixels off by more than 16\n", method.c_str(),
+                d.meanAbs, 100 * d.farShare);
+    EXPECT_LT(d.meanAbs, 2.0) << method;
+    EXPECT_LT(d.farShare, 0.01) << method;
+  }
+  // The moves changed the picture: the screenshot differs from a render of the starting lattice.
+  fs::path start = dir / "render_start.png";
+  ASSERT_EQ(run("render " + kSphere + " -l " + lat.string() + " --width 400 --height 300 --quiet -o " + start.string(), dir).status, 0);
+  EXPECT_GT(compare(sffd::gl::readPng((dir / "smooth.png").string()), sffd::gl::readPng(start.string())).farShare, 0.02);
+}
+
+TEST(View, UndoRedoRestoreTheLatticeExactly) {
+  NEED_X(x);
+  fs::path dir = freshDir("undo");
+  fs::path lat = makeLattice(dir);
+  writeFile(dir / "undo.txt",
+            "save-lattice l0.json\n"
+            "drag 1 2 3 0.1 0.2 0.3\n"
+            "select all\n"
+            "move 0.013 -0.7 1e-3\n"
+            "key ctrl+z\n"
+            "drag 0 0 0 -0.3 0 0\n"
+            "save-lattice l2.json\n"
+            "undo\n"
+            "undo\n"
+            "save-lattice u.json\n"
+            "redo\n"
+            "key ctrl+y\n"
+            "save-lattice r.json\n"
+            "undo\nundo\nundo\nundo   # more than there is: a note, not an error\n"
+            "save-lattice u2.json\n");
+  Result r = run("view " + kSphere + " -l " + lat.string() + " --replay " + (dir / "undo.txt").string() + " --out-dir " +
+                     dir.string() + " --width 200 --height 150 --method classic",
+                 dir, x);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(slurp(dir / "u.json"), slurp(dir / "l0.json"));
+  EXPECT_EQ(slurp(dir / "u2.json"), slurp(dir / "l0.json"));
+  EXPECT_EQ(slurp(dir / "r.json"), slurp(dir / "l2.json"));
+  EXPECT_NE(slurp(dir / "l2.json"), slurp(dir / "l0.json"));
+}
+
+TEST(View, ResizeToZeroAndFoldingLatticeKeepRunning) {
+  NEED_X(x);
+  fs::path dir = freshDir("bad_events");
+  fs::path lat = makeLattice(dir);
+  writeFile(dir / "bad.txt",
+            "resize 0 0\n"
+            "drag 1 1 1 0 0 0.1\n"
+            "screenshot none.png   # no pixels: a warning\n"
+            "resize 240 180\n"
+            "drag 1 1 1 3 3 3      # folds the lattice over\n"
+            "toggle heatmap\n"
+            "method accurate\n"
+            "clip knot-box\n"
+            "method smooth\n"
+            "key w\nkey e\nkey n\nkey m\nkey c\nkey f\n"
+            "screenshot folded.png\n"
+            "save-mesh folded.obj\n");
+  Result r = run("view " + kSphere + " -l " + lat.string() + " --replay " + (dir / "bad.txt").string() + " --out-dir " +
+                     dir.string() + " --width 320 --height 240 --edge-length 0.4 --tess 4",
+                 dir, x);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "none.png"));
+  EXPECT_NE(r.err.find("no pixels"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("sffd: warning: "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("folds"), std::string::npos) << r.err;
+  sffd::gl::Image img = sffd::gl::readPng((dir / "folded.png").string());
+  EXPECT_EQ(img.width, 240);
+  EXPECT_EQ(img.height, 180);
+  EXPECT_GT(fs::file_size(dir / "folded.obj"), 1000u);
+}
+
+TEST(View, BadScriptLinesAreOneLineErrors) {
+  // Checked before a window is opened: no X server needed.
+  fs::path dir = freshDir("bad_script");
+  const std::pair<std::string, std::string> cases[] = {
+      {"undo\n\ndrag 1 2\n", ":3: usage: drag"},
+      {"# c\nfrobnicate 1\n", ":2: unknown command 'frobnicate'"},
+      {"zoom -1\n", ":1: zoom: the factor must be positive"},
+      {"toggle everything\n", ":1: usage: toggle"},
+      {"move 1 nan 0\n", ":1: move: 'nan' is not a finite number"},
+      {"key x\n", ":1: key: 'x' is not a bound key"},
+  };
+  for (const auto& [text, what] : cases) {
+    writeFile(dir / "s.txt", text);
+    Result r = run("view " + kSphere + " --replay " + (dir / "s.txt").string(), dir);
+    EXPECT_EQ(r.status, 2) << text << r.err;
+    EXPECT_EQ(r.err.rfind("sffd: error: " + (dir / "s.txt").string() + what, 0), 0u) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  }
+  Result missing = run("view " + kSphere + " --replay " + (dir / "nope.txt").string(), dir);
+  EXPECT_EQ(missing.status, 2) << missing.err;
+}
+
+TEST(View, ScriptErrorsFoundWhileRunningNameTheirLine) {
+  NEED_X(x);
+  fs::path dir = freshDir("run_error");
+  writeFile(dir / "s.txt", "frame\ndrag 9 0 0 1 0 0\n");
+  Result r = run("view " + kSphere + " --replay " + (dir / "s.txt").string() + " --width 160 --height 120 --method classic", dir, x);
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("sffd: error: " + (dir / "s.txt").string() + ":2: drag: point index 9 is outside 0..4"), std::string::npos)
+      << r.err;
+}
+
+}  // namespace
