@@ -105,7 +105,8 @@ BackendResult benchGpu(OpenedBackend& b, const Job& job, const BenchSettings& S)
 BackendResult benchCpu(const Job& job, const BenchSettings& S) {
   BackendResult r;
   r.label = "cpu";
-  r.device = cpuDeviceInfo().name;
+  r.device = std::string("CPU reference, ") + (S.session.variant.f64 ? "double" : "float") + ", " +
+             std::to_string(cpuThreadCount()) + " threads";
   const DeformSessionOptions& o = S.session;
   Mesh mesh = job.mesh;
   if (!mesh.normalsFromFile) applyCreaseAngle(mesh, o.creaseAngleDeg);

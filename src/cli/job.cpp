@@ -22,6 +22,7 @@ std::vector<OptionSpec> jobOptions() {
       {"--split", nullptr, "smooth: run the deform steps as separate dispatches (per-step timings in --stats)"},
       {"--samples", "S", "smooth: sampling density s of the fit (default nu+nv+nw; 6 is the reference implementation's)"},
       {"--crease-angle", "DEG", "crease threshold for meshes without normals (default 40)"},
+      {"--bpt-resolution", "N", ".bpt input: grid segments per patch side (default 10: 200 triangles a patch)"},
       {"--normalize", "S", "center the mesh on its box and scale its largest half-extent to S (.npy: 0.99)"},
       {"--degree", "U,V,W", ".npy lattices: B-spline degree per axis (default 2,2,2)"},
       {"--precision", "NAME", "auto|float|double kernel arithmetic (auto: double for classic where supported)"},
@@ -57,7 +58,12 @@ Job loadJob(const ParsedArgs& args) {
   Job job;
   job.meshPath = args.positional.at(0);
   job.latticePath = args.requireValue("--lattice");
-  job.mesh = readMesh(job.meshPath);
+  MeshReadOptions read;
+  if (args.has("--bpt-resolution")) {
+    read.bptResolution = args.getInt("--bpt-resolution", 10);
+    if (read.bptResolution < 1 || read.bptResolution > 1000) throw Error(ErrorKind::Input, "--bpt-resolution must be 1..1000");
+  }
+  job.mesh = readMesh(job.meshPath, read);
   std::string ext = fs::path(job.latticePath).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
   if (args.has("--normalize")) {

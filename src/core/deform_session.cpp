@@ -228,28 +228,50 @@ const SessionTimings& DeformSession::precompute() {
   }
   subCount_ = offsets.back();
 
-  // (Re)build the chunks: per chunk the sub-triangle records and the deform outputs.
-  for (Chunk& c : chunks_)
-    for (BufferId b : {c.tess, c.patches}) B.destroyBuffer(b), I.owned.erase(std::find(I.owned.begin(), I.owned.end(), b));
-  for (Impl::ChunkBuffers& c : I.chunkBuffers)
-    for (BufferId b : {c.headers, c.records}) B.destroyBuffer(b), I.owned.erase(std::find(I.owned.begin(), I.owned.end(), b));
-  chunks_.clear();
-  I.chunkBuffers.clear();
-  std::vector<uint32_t> chunkOffsets(clipN);
+  // The chunks: per chunk the sub-triangle records and the deform outputs. A clip triangle's
+  // sub-triangles stay in one chunk. The buffers are kept when the layout is the one already there
+  // (a repeated precompute), so that nothing is reallocated.
+  struct Plan { size_t firstClip, clipCount, first, count; };
+  std::vector<Plan> plan;
   for (size_t first = 0; first < clipN;) {
     size_t last = first;
     while (last < clipN && offsets[last + 1] - offsets[first] <= maxSubs) ++last;
-    size_t subs = offsets[last] - offsets[first];
-    Chunk c;
-    c.first = offsets[first];
-    c.count = subs;
-    c.tess = I.make(B, subs * tessBytes);
-    c.patches = I.make(B, subs * patchBytes);
-    Impl::ChunkBuffers cb;
-    cb.headers = I.make(B, subs * 16);
-    cb.records = I.make(B, subs * recordBytes);
-    cb.firstClip = first;
-    cb.clipCount = last - first;
+    plan.push_back({first, last - first, offsets[first], offsets[last] - offsets[first]});
+    first = last;
+  }
+  bool same = plan.size() == chunks_.size();
+  for (size_t i = 0; same && i < plan.size(); ++i)
+    same = plan[i].first == chunks_[i].first && plan[i].count == chunks_[i].count && plan[i].firstClip == I.chunkBuffers[i].firstClip;
+  if (!same) {
+    auto drop = [&](BufferId b) {
+      B.destroyBuffer(b);
+      I.owned.erase(std::find(I.owned.begin(), I.owned.end(), b));
+    };
+    for (Chunk& c : chunks_) drop(c.tess), drop(c.patches);
+    for (Impl::ChunkBuffers& c : I.chunkBuffers) drop(c.headers), drop(c.records);
+    chunks_.clear();
+    I.chunkBuffers.clear();
+    for (const Plan& p : plan) {
+      Chunk c;
+      c.first = p.first;
+      c.count = p.count;
+      c.tess = I.make(B, p.count * tessBytes);
+      c.patches = I.make(B, p.count * patchBytes);
+      Impl::ChunkBuffers cb;
+      cb.headers = I.make(B, p.count * 16);
+      cb.records = I.make(B, p.count * recordBytes);
+      cb.firstClip = p.firstClip;
+      cb.clipCount = p.clipCount;
+      chunks_.push_back(c);
+      I.chunkBuffers.push_back(cb);
+    }
+  }
+  std::vector<uint32_t> chunkOffsets(clipN);
+  for (size_t ci = 0; ci < plan.size(); ++ci) {
+    const Plan& p = plan[ci];
+    const Chunk& c = chunks_[ci];
+    const Impl::ChunkBuffers& cb = I.chunkBuffers[ci];
+    const size_t first = p.firstClip, last = p.firstClip + p.clipCount, subs = p.count;
     if (!options_.knotBoxClip) {
       for (size_t i = first; i < last; ++i) chunkOffsets[i] = uint32_t(offsets[i] - offsets[first]);
       B.upload(I.counts, first * 4, chunkOffsets.data() + first, (last - first) * 4);
@@ -270,9 +292,6 @@ const SessionTimings& DeformSession::precompute() {
       std::vector<unsigned char> b = realBytes(part, options_.variant.f64);
       B.upload(cb.records, 0, b.data(), b.size());
     }
-    chunks_.push_back(c);
-    I.chunkBuffers.push_back(cb);
-    first = last;
   }
   if (options_.split && !chunks_.empty()) {
     size_t largest = 0;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
+#include <thread>
 
 #include "error.h"
 #include "lattice_eval.h"
@@ -170,20 +171,32 @@ void deformOne(const LatticeEvaluator<Real>& L, const std::vector<Real>& fit, in
     }
 }
 
+// The CPU reference runs the sub-triangles on every core (SFFD_CPU_THREADS caps the count): each
+// sub-triangle is independent and writes its own output range, so the result does not depend on the
+// number of threads.
+unsigned cpuThreads(size_t work) { return unsigned(std::min<size_t>(cpuThreadCount(), std::max<size_t>(1, work / 64))); }
+
 template <class Real>
 void deformCpu(const PackedLattice& P, const SubTriangleRecords& subs, const FitTable& F, int level, SmoothOutput& out) {
   std::vector<Real> frame = convertReals<Real>(P.frame), coeffs = convertReals<Real>(P.coeffs);
   std::vector<Real> fit = convertReals<Real>(F.data), recs = convertReals<Real>(subs.records);
   LatticeEvaluator<Real> L(P.params, frame, coeffs);
   const size_t n = subs.size(), nv = size_t(tessVertexCount(level));
-  std::vector<Real> patch(SFFD_PATCH_STRIDE * 4), tess(2 * nv * 4);
   out.patches.resize(n * SFFD_PATCH_STRIDE * 4);
   out.tess.resize(n * 2 * nv * 4);
-  for (size_t s = 0; s < n; ++s) {
-    deformOne<Real>(L, fit, F.points, &subs.headers[4 * s], &recs[s * SFFD_SUB_STRIDE * 4], level, patch.data(), tess.data());
-    std::copy(patch.begin(), patch.end(), out.patches.begin() + s * patch.size());
-    std::copy(tess.begin(), tess.end(), out.tess.begin() + s * tess.size());
-  }
+  auto range = [&](size_t first, size_t last) {
+    std::vector<Real> patch(SFFD_PATCH_STRIDE * 4), tess(2 * nv * 4);
+    for (size_t s = first; s < last; ++s) {
+      deformOne<Real>(L, fit, F.points, &subs.headers[4 * s], &recs[s * SFFD_SUB_STRIDE * 4], level, patch.data(), tess.data());
+      std::copy(patch.begin(), patch.end(), out.patches.begin() + s * patch.size());
+      std::copy(tess.begin(), tess.end(), out.tess.begin() + s * tess.size());
+    }
+  };
+  const unsigned threads = cpuThreads(n);
+  std::vector<std::thread> pool;
+  for (unsigned t = 1; t < threads; ++t) pool.emplace_back(range, n * t / threads, n * (t + 1) / threads);
+  range(0, n / threads);
+  for (std::thread& t : pool) t.join();
 }
 
 template <class Real>
@@ -257,6 +270,12 @@ void deformGpu(Backend& backend, const PackedLattice& P, const SubTriangleRecord
 }
 
 }  // namespace
+
+unsigned cpuThreadCount() {
+  unsigned t = std::max(1u, std::thread::hardware_concurrency());
+  if (const char* env = std::getenv("SFFD_CPU_THREADS")) t = std::max(1u, unsigned(std::strtoul(env, nullptr, 10)));
+  return std::min(t, 256u);
+}
 
 SmoothOutput smoothDeformCpu(const PackedLattice& lattice, const SubTriangleRecords& subs, const FitTable& fit, int level,
                              KernelVariant variant) {

@@ -29,6 +29,9 @@ struct SmoothOutput {
   double wallMs = 0;
 };
 
+// Threads the CPU reference's deform stage uses: every core, or SFFD_CPU_THREADS.
+unsigned cpuThreadCount();
+
 SmoothOutput smoothDeformCpu(const PackedLattice& lattice, const SubTriangleRecords& subs, const FitTable& fit,
                              int level, KernelVariant variant);
 // split: one dispatch per step (deform.sample: steps 1, 2, 4; deform.fit: 3; deform.adjust: 5;

@@ -1,0 +1,158 @@
+// The smooth-FFD pipeline on the CPU reference, stage by stage, on the teapot (t.bpt, 6400
+// triangles) and the rabbit (rabbit_cym.obj), both normalised to a largest half-extent of 1/1.1 and
+// clipped with target edge length l = 0.2 (the call sequence of src/cli/smooth_job.cpp):
+// prepareMesh -> pnTrianglesCpu (K1) -> buildClipTriangles + regularClipCpu (K2) -> smoothDeformCpu
+// (K3, tessellation levels 1, 5, 10) with makeFitTable(6). Each stage is timed alone on the cached
+// output of the previous ones, so a regression points at one stage. Items are triangles for the
+// pre-compute stages and sub-triangles for clip output and deform. smoothDeformCpu runs on a thread
+// pool (SFFD_CPU_THREADS, default all cores), so it is measured in wall time (UseRealTime).
+#include <benchmark/benchmark.h>
+
+#include <map>
+#include <memory>
+#include <tuple>
+
+#include "bench_data.h"
+#include "lattice_pack.h"
+#include "pn_triangles.h"
+#include "prepared_mesh.h"
+#include "regular_clip.h"
+#include "smooth_deform.h"
+#include "split_pattern_table.h"
+
+using namespace sffd;
+
+namespace {
+
+constexpr double kEdgeLength = 0.2;
+const char* const kModels[] = {"t.bpt", "rabbit_cym.obj"};
+
+// Every stage's output for one model and arithmetic, computed once.
+struct Stages {
+  const Mesh* mesh = nullptr;
+  PreparedMesh prepared;
+  PnOutput pn;
+  ClipTriangles clip;
+  SubTriangleRecords subs;
+  PackedLattice lattice;
+  FitTable fit;
+};
+
+const Stages& stages(int model, bool f64) {
+  static std::map<std::pair<int, bool>, std::unique_ptr<Stages>> cache;
+  auto& s = cache[{model, f64}];
+  if (!s) {
+    s = std::make_unique<Stages>();
+    KernelVariant v{false, f64};
+    s->mesh = &bench::model(kModels[model]);
+    s->prepared = prepareMesh(*s->mesh);
+    s->pn = pnTrianglesCpu(s->prepared, v);
+    s->clip = buildClipTriangles(*s->mesh, kEdgeLength, splitPatternTable().nmax());
+    s->subs = regularClipCpu(s->prepared, s->pn, s->clip, kEdgeLength, v);
+    s->lattice = packLattice(bench::deformedLattice(*s->mesh, 5, 2));
+    s->fit = makeFitTable(6);
+  }
+  return *s;
+}
+
+void setModelLabel(benchmark::State& state, int model) { state.SetLabel(kModels[model]); }
+
+// Arg: model (0 teapot, 1 rabbit). Items = triangles.
+void BM_PrepareMesh(benchmark::State& state) {
+  const int model = int(state.range(0));
+  const Mesh& m = bench::model(kModels[model]);
+  for (auto _ : state) {
+    PreparedMesh P = prepareMesh(m);
+    benchmark::DoNotOptimize(P.slotNormals.data());
+  }
+  state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(m.triangles.size()));
+  setModelLabel(state, model);
+}
+BENCHMARK(BM_PrepareMesh)->ArgName("model")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
+// Args: model, f64. Items = triangles.
+void BM_PnTrianglesCpu(benchmark::State& state) {
+  const int model = int(state.range(0));
+  const bool f64 = state.range(1) != 0;
+  const Stages& s = stages(model, f64);
+  for (auto _ : state) {
+    PnOutput pn = pnTrianglesCpu(s.prepared, {false, f64});
+    benchmark::DoNotOptimize(pn.records.data());
+  }
+  state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(s.prepared.triangleCount()));
+  setModelLabel(state, model);
+}
+BENCHMARK(BM_PnTrianglesCpu)->ArgNames({"model", "f64"})->ArgsProduct({{0, 1}, {1, 0}})->Unit(benchmark::kMillisecond);
+
+// Arg: model. The pre-split into clip triangles of at most Nmax segments an edge. Items = triangles.
+void BM_BuildClipTriangles(benchmark::State& state) {
+  const int model = int(state.range(0));
+  const Mesh& m = bench::model(kModels[model]);
+  const int nmax = splitPatternTable().nmax();
+  size_t clipCount = 0;
+  for (auto _ : state) {
+    ClipTriangles C = buildClipTriangles(m, kEdgeLength, nmax);
+    clipCount = C.triangles.size();
+    benchmark::DoNotOptimize(C.triangles.data());
+  }
+  state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(m.triangles.size()));
+  state.counters["clip_tris"] = double(clipCount);
+  setModelLabel(state, model);
+}
+BENCHMARK(BM_BuildClipTriangles)->ArgName("model")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
+// Args: model, f64. Regular clipping by the split-pattern table into sub-triangle records lifted
+// onto the PN surface. Items = sub-triangles written.
+void BM_RegularClipCpu(benchmark::State& state) {
+  const int model = int(state.range(0));
+  const bool f64 = state.range(1) != 0;
+  const Stages& s = stages(model, f64);
+  size_t subs = 0;
+  for (auto _ : state) {
+    SubTriangleRecords R = regularClipCpu(s.prepared, s.pn, s.clip, kEdgeLength, {false, f64});
+    subs = R.size();
+    benchmark::DoNotOptimize(R.records.data());
+  }
+  state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(subs));
+  state.counters["sub_tris"] = double(subs);
+  setModelLabel(state, model);
+}
+BENCHMARK(BM_RegularClipCpu)->ArgNames({"model", "f64"})->ArgsProduct({{0, 1}, {1, 0}})->Unit(benchmark::kMillisecond);
+
+// The sampling-lattice fit table (closed-form constrained least squares), degree s.
+void BM_MakeFitTable(benchmark::State& state) {
+  const int s = int(state.range(0));
+  int points = 0;
+  for (auto _ : state) {
+    FitTable F = makeFitTable(s);
+    points = F.points;
+    benchmark::DoNotOptimize(F.data.data());
+  }
+  state.SetItemsProcessed(int64_t(state.iterations()) * points);
+  state.counters["fit_points"] = points;
+}
+BENCHMARK(BM_MakeFitTable)->ArgName("s")->Arg(6)->Unit(benchmark::kMicrosecond);
+
+// Args: model, tessellation level, f64. The deform stage K3 (sample, fit, adjust, tessellate) with a
+// twisted 5x5x5 degree-2 lattice. Items = sub-triangles (patches).
+void BM_SmoothDeformCpu(benchmark::State& state) {
+  const int model = int(state.range(0));
+  const int level = int(state.range(1));
+  const bool f64 = state.range(2) != 0;
+  const Stages& s = stages(model, f64);
+  for (auto _ : state) {
+    SmoothOutput out = smoothDeformCpu(s.lattice, s.subs, s.fit, level, {false, f64});
+    benchmark::DoNotOptimize(out.tess.data());
+  }
+  state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(s.subs.size()));
+  state.counters["sub_tris"] = double(s.subs.size());
+  setModelLabel(state, model);
+}
+BENCHMARK(BM_SmoothDeformCpu)
+    ->ArgNames({"model", "level", "f64"})
+    ->ArgsProduct({{0}, {1, 5, 10}, {0, 1}})
+    ->Args({1, 5, 1})
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
+
+}  // namespace

@@ -1,0 +1,95 @@
+#!/usr/bin/env bash
+# Regenerates the figures of docs/PERFORMANCE.md with `sffd bench`: the per-stage tables (the paper's
+# Tables 1 and 2) for the benchmark model set on each backend, and the scaling plots (time against
+# faces, against l, against the tessellation level). Needs a built build/sffd; writes the raw JSON to
+# out/perf/ and the plots to docs/figures/perf_*.png; prints the tables as Markdown.
+#   scripts/performance.sh            all of it (about 10 minutes on 2 cores)
+#   REPEAT=5 BACKENDS=vulkan,gl,cpu   the defaults
+set -euo pipefail
+cd "$(dirname "$0")/.."
+SFFD=${SFFD:-build/sffd}
+REPEAT=${REPEAT:-5}
+BACKENDS=${BACKENDS:-vulkan,gl,cpu}
+D=../shared/data/acaffd
+OUT=out/perf
+mkdir -p "$OUT" docs/figures
+
+bench() {  # name mesh lattice normalize l tess [extra...]
+  local name=$1 mesh=$2 lat=$3 norm=$4 l=$5 tess=$6
+  shift 6
+  "$SFFD" bench "$D/$mesh" -l "$D/lattices/$lat" --normalize "$norm" --edge-length "$l" --tess "$tess" \
+    --backends "$BACKENDS" --repeat "$REPEAT" --json --quiet "$@" > "$OUT/$name.json"
+}
+
+# The benchmark model set (docs/PERFORMANCE.md "Models"): 5x5x5 degree-2 lattices, level 10.
+bench teapot t.bpt t_control_points1.npy 0.9090909090909091 0.2 10
+bench teapot_split t.bpt t_control_points1.npy 0.9090909090909091 0.2 10 --split
+bench rabbit rabbit_cym.obj rabbit_cym_control_points0.npy 0.99 0.2 10
+bench sphere sphere.obj sphere_control_points0.npy 0.99 0.2 10
+bench teapot47k t.bpt t_control_points1.npy 0.9090909090909091 0.2 10 --bpt-resolution 26
+
+# Scaling: faces (the teapot at finer grids; l = 0.2 gives one sub-triangle a face), l, level.
+for r in 4 8 16 26 53 118; do bench faces_$r t.bpt t_control_points1.npy 0.9090909090909091 0.2 10 --bpt-resolution $r; done
+for l in 0.4 0.2 0.1 0.05; do bench l_$l t.bpt t_control_points1.npy 0.9090909090909091 $l 10; done
+for n in 1 2 5 10 20 40; do bench tess_$n t.bpt t_control_points1.npy 0.9090909090909091 0.2 $n; done
+
+/usr/bin/python3 - "$OUT" <<'PY'
+import json, os, sys
+import matplotlib
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+out = sys.argv[1]
+load = lambda n: json.load(open(os.path.join(out, n + ".json")))
+med = lambda run, k: run["stages_ms"][k]["median"]
+
+print("| model | input tris | sub-tris | output tris | backend | PN ms | clip ms | deform ms | cold first run ms | peak RSS MiB |")
+print("|---|---|---|---|---|---|---|---|---|---|")
+for n in ["teapot", "rabbit", "sphere", "teapot47k"]:
+    j = load(n)
+    for r in j["runs"]:
+        print("| %s | %d | %d | %d | %s | %.2f | %.2f | %.2f | %.0f | %.0f |" % (
+            n, j["input_triangles"], j["sub_triangles"], j["output_triangles"], r["backend"], med(r, "pn"),
+            med(r, "clip"), med(r, "deform"), r["cold_first_dispatch_ms"], r["peak_rss_mb"]))
+print()
+j = load("teapot_split")
+print("| backend | deform.sample | deform.fit | deform.adjust | deform.tessellate | sum |")
+print("|---|---|---|---|---|---|")
+for r in j["runs"]:
+    steps = [k for k in ["deform.sample", "deform.fit", "deform.adjust", "deform.tessellate"] if k in r["stages_ms"]]
+    if steps:
+        print("| %s | %s | %.2f |" % (r["backend"], " | ".join("%.2f" % med(r, k) for k in steps), med(r, "deform")))
+
+def sweep(names, xkey, xlabel, png, title, logx=True):
+    fig, ax = plt.subplots(1, 2, figsize=(10, 3.6), dpi=100)
+    data = [load(n) for n in names]
+    for b in [r["backend"] for r in data[0]["runs"]]:
+        xs, pre, de = [], [], []
+        for j in data:
+            r = next(r for r in j["runs"] if r["backend"] == b)
+            xs.append(xkey(j)); pre.append(med(r, "pn") + med(r, "clip")); de.append(med(r, "deform"))
+        ax[0].plot(xs, pre, "o-", label=b)
+        ax[1].plot(xs, de, "o-", label=b)
+    for a, t in zip(ax, ["pre-compute (PN + clip)", "deform stage"]):
+        a.set_xlabel(xlabel); a.set_ylabel("ms (median)"); a.set_title(t, fontsize=10)
+        a.set_yscale("log")
+        if logx: a.set_xscale("log")
+        a.grid(True, which="both", alpha=0.3); a.legend(fontsize=8)
+    fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    fig.savefig(png)
+
+sweep(["faces_%d" % r for r in [4, 8, 16, 26, 53, 118]], lambda j: j["input_triangles"], "input triangles (= sub-triangles)",
+      "docs/figures/perf_faces.png", "teapot at finer grids, l = 0.2, level 10")
+sweep(["l_%s" % l for l in ["0.4", "0.2", "0.1", "0.05"]], lambda j: j["sub_triangles"], "sub-triangles (l = 0.4, 0.2, 0.1, 0.05)",
+      "docs/figures/perf_l.png", "teapot, l sweep, level 10")
+sweep(["tess_%d" % n for n in [1, 2, 5, 10, 20, 40]], lambda j: j["output_triangles"], "output triangles (level 1, 2, 5, 10, 20, 40)",
+      "docs/figures/perf_tess.png", "teapot, l = 0.2, tessellation level sweep")
+print()
+print("sweeps (backend: x -> pre-compute ms, deform ms):")
+for group in [["faces_%d" % r for r in [4, 8, 16, 26, 53, 118]], ["l_%s" % l for l in ["0.4", "0.2", "0.1", "0.05"]],
+              ["tess_%d" % n for n in [1, 2, 5, 10, 20, 40]]]:
+    for n in group:
+        j = load(n)
+        print(n, j["input_triangles"], j["sub_triangles"], j["output_triangles"],
+              " ".join("%s %.2f %.2f" % (r["backend"], med(r, "pn") + med(r, "clip"), med(r, "deform")) for r in j["runs"]))
+PY
