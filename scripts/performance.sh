@@ -29,7 +29,7 @@ bench sphere sphere.obj sphere_control_points0.npy 0.99 0.2 10
 bench teapot47k t.bpt t_control_points1.npy 0.9090909090909091 0.2 10 --bpt-resolution 26
 
 # Scaling: faces (the teapot at finer grids; l = 0.2 gives one sub-triangle a face), l, level.
-for r in 4 8 16 26 53 118; do bench faces_$r t.bpt t_control_points1.npy 0.9090909090909091 0.2 10 --bpt-resolution $r; done
+for r in 4 8 16 26 53 80; do bench faces_$r t.bpt t_control_points1.npy 0.9090909090909091 0.2 10 --bpt-resolution $r; done
 for l in 0.4 0.2 0.1 0.05; do bench l_$l t.bpt t_control_points1.npy 0.9090909090909091 $l 10; done
 for n in 1 2 5 10 20 40; do bench tess_$n t.bpt t_control_points1.npy 0.9090909090909091 0.2 $n; done
 
@@ -78,7 +78,7 @@ def sweep(names, xkey, xlabel, png, title, logx=True):
     fig.tight_layout()
     fig.savefig(png)
 
-sweep(["faces_%d" % r for r in [4, 8, 16, 26, 53, 118]], lambda j: j["input_triangles"], "input triangles (= sub-triangles)",
+sweep(["faces_%d" % r for r in [4, 8, 16, 26, 53, 80]], lambda j: j["input_triangles"], "input triangles (l = 0.2: one sub-triangle each, a few more below 5k)",
       "docs/figures/perf_faces.png", "teapot at finer grids, l = 0.2, level 10")
 sweep(["l_%s" % l for l in ["0.4", "0.2", "0.1", "0.05"]], lambda j: j["sub_triangles"], "sub-triangles (l = 0.4, 0.2, 0.1, 0.05)",
       "docs/figures/perf_l.png", "teapot, l sweep, level 10")
@@ -86,7 +86,7 @@ sweep(["tess_%d" % n for n in [1, 2, 5, 10, 20, 40]], lambda j: j["output_triang
       "docs/figures/perf_tess.png", "teapot, l = 0.2, tessellation level sweep")
 print()
 print("sweeps (backend: x -> pre-compute ms, deform ms):")
-for group in [["faces_%d" % r for r in [4, 8, 16, 26, 53, 118]], ["l_%s" % l for l in ["0.4", "0.2", "0.1", "0.05"]],
+for group in [["faces_%d" % r for r in [4, 8, 16, 26, 53, 80]], ["l_%s" % l for l in ["0.4", "0.2", "0.1", "0.05"]],
               ["tess_%d" % n for n in [1, 2, 5, 10, 20, 40]]]:
     for n in group:
         j = load(n)
