@@ -201,7 +201,7 @@ TEST(Cli, ErrorsHaveOneLineAndTheContractStatus) {
 }
 
 TEST(Cli, HelpForEveryCommand) {
-  for (const char* c : {"deform", "lattice", "devices", "conform"}) {
+  for (const char* c : {"deform", "lattice", "devices", "conform", "bench"}) {
     RunResult r = runSffd(std::string(c) + " --help");
     EXPECT_EQ(r.status, 0) << c;
     EXPECT_NE(r.out.find("usage: sffd"), std::string::npos) << c;
@@ -278,3 +278,42 @@ TEST(Cli, RenderColoursByError) {
 }
 
 }  // namespace
+
+// bench --json: the contract's keys, one run per backend asked, stage times from each, the split steps.
+TEST(Cli, BenchJsonHasTheContractKeysOnEveryBackend) {
+  RunResult r = runSffd("bench " + kData + "/acaffd/sphere.obj -l " + kData +
+                        "/acaffd/lattices/sphere_control_points0.npy --normalize 0.99 --edge-length 0.12 --tess 4 "
+                        "--backends vulkan,gl,cpu --repeat 3 --warmup 1 --split --json --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["mesh"], "sphere.obj");
+  EXPECT_EQ(j["method"], "smooth");
+  EXPECT_GT(j["sub_triangles"].get<int>(), 720);
+  EXPECT_EQ(j["output_triangles"].get<int>(), j["sub_triangles"].get<int>() * 16);
+  ASSERT_EQ(j["runs"].size(), 3u);
+  std::vector<std::string> backends;
+  for (const auto& run : j["runs"]) {
+    backends.push_back(run["backend"]);
+    EXPECT_EQ(run["repeat"], 3);
+    EXPECT_GT(run["cold_first_dispatch_ms"].get<double>(), 0.0);
+    EXPECT_GT(run["peak_rss_mb"].get<double>(), 1.0);
+    for (const char* stage : {"pn", "clip", "deform", "total"}) {
+      const auto& st = run["stages_ms"][stage];
+      EXPECT_LE(st["min"].get<double>(), st["median"].get<double>()) << stage;
+      EXPECT_LE(st["median"].get<double>(), st["max"].get<double>()) << stage;
+      EXPECT_GT(st["max"].get<double>(), 0.0) << run["backend"] << " " << stage;
+    }
+    if (run["backend"] != "cpu") EXPECT_TRUE(run["stages_ms"].contains("deform.sample")) << run["backend"];
+  }
+  EXPECT_EQ(backends, (std::vector<std::string>{"vulkan", "gl-egl", "cpu"}));
+}
+
+TEST(Cli, BenchRefusesBadOptions) {
+  const std::string base = "bench " + kData + "/acaffd/sphere.obj -l " + kData + "/acaffd/lattices/sphere_control_points0.npy ";
+  for (const std::string& bad : {std::string("--repeat 0"), std::string("--method classic"), std::string("--backends nope"),
+                                 std::string("--tess 0"), std::string("--edge-length -1")}) {
+    RunResult r = runSffd(base + bad);
+    EXPECT_EQ(r.status, 2) << bad << ": " << r.err;
+    expectOneErrorLine(r);
+  }
+}
