@@ -1,6 +1,9 @@
-// The smooth-FFD pipeline on the CPU reference, stage by stage, on the teapot (t.bpt, 6400
-// triangles) and the rabbit (rabbit_cym.obj), both normalised to a largest half-extent of 1/1.1 and
-// clipped with target edge length l = 0.2 (the call sequence of src/cli/smooth_job.cpp):
+// The smooth-FFD pipeline on the CPU reference, stage by stage, on the teapot (t.bpt, 36 patches,
+// 7200 triangles) and the rabbit (rabbit_cym.obj, 8400 triangles), both normalised to a largest
+// half-extent of 1/1.1 and clipped with target edge length l = 0.2 (the call sequence of
+// src/cli/smooth_job.cpp). At l = 0.2 every edge of both models is shorter than l, so regular
+// clipping yields one sub-triangle per triangle; the `fine` cases use l = 0.02, where the split
+// patterns really subdivide (several segments an edge), to measure clipping and deform at scale:
 // prepareMesh -> pnTrianglesCpu (K1) -> buildClipTriangles + regularClipCpu (K2) -> smoothDeformCpu
 // (K3, tessellation levels 1, 5, 10) with makeFitTable(6). Each stage is timed alone on the cached
 // output of the previous ones, so a regression points at one stage. Items are triangles for the
@@ -24,7 +27,7 @@ using namespace sffd;
 
 namespace {
 
-constexpr double kEdgeLength = 0.2;
+constexpr double kEdgeLengths[] = {0.2, 0.02};   // index = the `fine` argument
 const char* const kModels[] = {"t.bpt", "rabbit_cym.obj"};
 
 // Every stage's output for one model and arithmetic, computed once.
@@ -38,17 +41,18 @@ struct Stages {
   FitTable fit;
 };
 
-const Stages& stages(int model, bool f64) {
-  static std::map<std::pair<int, bool>, std::unique_ptr<Stages>> cache;
-  auto& s = cache[{model, f64}];
+const Stages& stages(int model, bool f64, int fine = 0) {
+  static std::map<std::tuple<int, bool, int>, std::unique_ptr<Stages>> cache;
+  auto& s = cache[{model, f64, fine}];
+  const double l = kEdgeLengths[fine];
   if (!s) {
     s = std::make_unique<Stages>();
     KernelVariant v{false, f64};
     s->mesh = &bench::model(kModels[model]);
     s->prepared = prepareMesh(*s->mesh);
     s->pn = pnTrianglesCpu(s->prepared, v);
-    s->clip = buildClipTriangles(*s->mesh, kEdgeLength, splitPatternTable().nmax());
-    s->subs = regularClipCpu(s->prepared, s->pn, s->clip, kEdgeLength, v);
+    s->clip = buildClipTriangles(*s->mesh, l, splitPatternTable().nmax());
+    s->subs = regularClipCpu(s->prepared, s->pn, s->clip, l, v);
     s->lattice = packLattice(bench::deformedLattice(*s->mesh, 5, 2));
     s->fit = makeFitTable(6);
   }
@@ -84,14 +88,16 @@ void BM_PnTrianglesCpu(benchmark::State& state) {
 }
 BENCHMARK(BM_PnTrianglesCpu)->ArgNames({"model", "f64"})->ArgsProduct({{0, 1}, {1, 0}})->Unit(benchmark::kMillisecond);
 
-// Arg: model. The pre-split into clip triangles of at most Nmax segments an edge. Items = triangles.
+// Args: model, fine. The pre-split into clip triangles of at most Nmax segments an edge. Items =
+// triangles.
 void BM_BuildClipTriangles(benchmark::State& state) {
   const int model = int(state.range(0));
+  const double l = kEdgeLengths[state.range(1)];
   const Mesh& m = bench::model(kModels[model]);
   const int nmax = splitPatternTable().nmax();
   size_t clipCount = 0;
   for (auto _ : state) {
-    ClipTriangles C = buildClipTriangles(m, kEdgeLength, nmax);
+    ClipTriangles C = buildClipTriangles(m, l, nmax);
     clipCount = C.triangles.size();
     benchmark::DoNotOptimize(C.triangles.data());
   }
@@ -99,17 +105,18 @@ void BM_BuildClipTriangles(benchmark::State& state) {
   state.counters["clip_tris"] = double(clipCount);
   setModelLabel(state, model);
 }
-BENCHMARK(BM_BuildClipTriangles)->ArgName("model")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_BuildClipTriangles)->ArgNames({"model", "fine"})->ArgsProduct({{0, 1}, {0, 1}})->Unit(benchmark::kMillisecond);
 
-// Args: model, f64. Regular clipping by the split-pattern table into sub-triangle records lifted
-// onto the PN surface. Items = sub-triangles written.
+// Args: model, f64, fine. Regular clipping by the split-pattern table into sub-triangle records
+// lifted onto the PN surface. Items = sub-triangles written.
 void BM_RegularClipCpu(benchmark::State& state) {
   const int model = int(state.range(0));
   const bool f64 = state.range(1) != 0;
-  const Stages& s = stages(model, f64);
+  const int fine = int(state.range(2));
+  const Stages& s = stages(model, f64, fine);
   size_t subs = 0;
   for (auto _ : state) {
-    SubTriangleRecords R = regularClipCpu(s.prepared, s.pn, s.clip, kEdgeLength, {false, f64});
+    SubTriangleRecords R = regularClipCpu(s.prepared, s.pn, s.clip, kEdgeLengths[fine], {false, f64});
     subs = R.size();
     benchmark::DoNotOptimize(R.records.data());
   }
@@ -117,7 +124,12 @@ void BM_RegularClipCpu(benchmark::State& state) {
   state.counters["sub_tris"] = double(subs);
   setModelLabel(state, model);
 }
-BENCHMARK(BM_RegularClipCpu)->ArgNames({"model", "f64"})->ArgsProduct({{0, 1}, {1, 0}})->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_RegularClipCpu)
+    ->ArgNames({"model", "f64", "fine"})
+    ->ArgsProduct({{0, 1}, {1, 0}, {0}})
+    ->Args({0, 1, 1})
+    ->Args({0, 0, 1})
+    ->Unit(benchmark::kMillisecond);
 
 // The sampling-lattice fit table (closed-form constrained least squares), degree s.
 void BM_MakeFitTable(benchmark::State& state) {
@@ -133,13 +145,13 @@ void BM_MakeFitTable(benchmark::State& state) {
 }
 BENCHMARK(BM_MakeFitTable)->ArgName("s")->Arg(6)->Unit(benchmark::kMicrosecond);
 
-// Args: model, tessellation level, f64. The deform stage K3 (sample, fit, adjust, tessellate) with a
-// twisted 5x5x5 degree-2 lattice. Items = sub-triangles (patches).
+// Args: model, tessellation level, f64, fine. The deform stage K3 (sample, fit, adjust, tessellate)
+// with a twisted 5x5x5 degree-2 lattice. Items = sub-triangles (patches).
 void BM_SmoothDeformCpu(benchmark::State& state) {
   const int model = int(state.range(0));
   const int level = int(state.range(1));
   const bool f64 = state.range(2) != 0;
-  const Stages& s = stages(model, f64);
+  const Stages& s = stages(model, f64, int(state.range(3)));
   for (auto _ : state) {
     SmoothOutput out = smoothDeformCpu(s.lattice, s.subs, s.fit, level, {false, f64});
     benchmark::DoNotOptimize(out.tess.data());
@@ -149,9 +161,10 @@ void BM_SmoothDeformCpu(benchmark::State& state) {
   setModelLabel(state, model);
 }
 BENCHMARK(BM_SmoothDeformCpu)
-    ->ArgNames({"model", "level", "f64"})
-    ->ArgsProduct({{0}, {1, 5, 10}, {0, 1}})
-    ->Args({1, 5, 1})
+    ->ArgNames({"model", "level", "f64", "fine"})
+    ->ArgsProduct({{0}, {1, 5, 10}, {0, 1}, {0}})
+    ->Args({1, 5, 1, 0})
+    ->Args({0, 5, 0, 1})
     ->UseRealTime()
     ->Unit(benchmark::kMillisecond);
 
