@@ -11,6 +11,7 @@
 
 #include "accurate_ffd.h"
 #include "backends/backend_select.h"
+#include "backends/backend_test_support.h"
 #include "buffer_compare.h"
 #include "knot_box_clip.h"
 #include "vk/vk_backend.h"
@@ -21,21 +22,7 @@ namespace {
 
 const std::string kData = SFFD_SHARED_DATA;
 
-std::vector<std::string> requiredBackends() {
-  const char* env = std::getenv("SFFD_REQUIRE_BACKENDS");
-  std::stringstream ss(env ? env : "vulkan,gl-egl,gl-osmesa");
-  std::vector<std::string> names;
-  for (std::string n; std::getline(ss, n, ',');)
-    if (!n.empty()) names.push_back(n);
-  return names;
-}
-
-OpenedBackend open(const std::string& name) {
-  BackendRequest r;
-  r.name = name;
-  r.validation = true;
-  return openBackend(r);
-}
+OpenedBackend open(const std::string& name) { return sffd::testing::openForTest(name); }
 
 Lattice latticeFor(const Mesh& m, std::array<int, 3> counts, std::array<int, 3> degree, double amount, OutsideMode outside,
                    double margin) {
@@ -159,12 +146,8 @@ TEST_P(AccurateConformance, IdentityLatticeReproducesTheFlatMesh) {
   EXPECT_LT(worstNrm, 1e-6);
 }
 
-INSTANTIATE_TEST_SUITE_P(Backends, AccurateConformance, ::testing::ValuesIn(requiredBackends()),
-                         [](const auto& info) {
-                           std::string n = info.param;
-                           for (char& c : n) if (c == '-') c = '_';
-                           return n;
-                         });
+INSTANTIATE_TEST_SUITE_P(Backends, AccurateConformance, ::testing::ValuesIn(sffd::testing::requiredBackends()),
+                         [](const auto& info) { return sffd::testing::backendTestName(info.param); });
 
 }  // namespace
 

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "backends/backend_select.h"
+#include "backends/backend_test_support.h"
 #include "buffer_compare.h"
 #include "classic_ffd.h"
 #include "error.h"
@@ -21,22 +22,7 @@ using namespace sffd;
 
 namespace {
 
-// Backends that must be present: by default every one Debian 12's Mesa gives (SFFD_REQUIRE_BACKENDS overrides).
-std::vector<std::string> requiredBackends() {
-  const char* env = std::getenv("SFFD_REQUIRE_BACKENDS");
-  std::stringstream ss(env ? env : "vulkan,gl-egl,gl-osmesa");
-  std::vector<std::string> names;
-  for (std::string n; std::getline(ss, n, ',');)
-    if (!n.empty()) names.push_back(n);
-  return names;
-}
-
-OpenedBackend open(const std::string& name) {
-  BackendRequest r;
-  r.name = name;
-  r.validation = true;
-  return openBackend(r);
-}
+OpenedBackend open(const std::string& name) { return sffd::testing::openForTest(name); }
 
 // A closed UV sphere with unit normals, partly outside the lattice box when `radius` > box.
 Mesh sphereMesh(int rings, int segments, double radius) {
@@ -200,12 +186,8 @@ TEST_P(ClassicConformance, SmoothDeformKernelAgreesWithCpuReference) {
   EXPECT_EQ(vk::validationMessageCount(), 0u);
 }
 
-INSTANTIATE_TEST_SUITE_P(Backends, ClassicConformance, ::testing::ValuesIn(requiredBackends()),
-                         [](const auto& info) {
-                           std::string n = info.param;
-                           for (char& c : n) if (c == '-') c = '_';
-                           return n;
-                         });
+INSTANTIATE_TEST_SUITE_P(Backends, ClassicConformance, ::testing::ValuesIn(sffd::testing::requiredBackends()),
+                         [](const auto& info) { return sffd::testing::backendTestName(info.param); });
 
 TEST(CrossApi, GlAndVulkanFastKernelsAgreeWithinUlpBound) {
   OpenedBackend vkb = open("vulkan"), glb = open("gl");

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "backends/backend_select.h"
+#include "backends/backend_test_support.h"
 #include "deform_session.h"
 #include "error.h"
 #include "knot_box_clip.h"
@@ -21,15 +22,6 @@
 using namespace sffd;
 
 namespace {
-
-std::vector<std::string> requiredBackends() {
-  const char* env = std::getenv("SFFD_REQUIRE_BACKENDS");
-  std::stringstream ss(env ? env : "vulkan,gl-egl,gl-osmesa");
-  std::vector<std::string> names;
-  for (std::string n; std::getline(ss, n, ',');)
-    if (!n.empty()) names.push_back(n);
-  return names;
-}
 
 Lattice latticeFor(const Mesh& m, unsigned seed, double amount) {
   glm::dvec3 lo(1e300), hi(-1e300);
@@ -59,12 +51,7 @@ Reference reference(const Mesh& m, const Lattice& L, const DeformSessionOptions&
 
 class DeformSessionTest : public ::testing::TestWithParam<std::string> {
  protected:
-  OpenedBackend open() {
-    BackendRequest r;
-    r.name = GetParam();
-    r.validation = true;
-    return openBackend(r);
-  }
+  OpenedBackend open() { return sffd::testing::openForTest(GetParam()); }
 };
 
 TEST_P(DeformSessionTest, StrictSessionEqualsCpuReferenceAcrossRedeforms) {
@@ -174,11 +161,7 @@ TEST_P(DeformSessionTest, RefusesALatticeOfAnotherStructureAndBadOptions) {
   EXPECT_THROW(DeformSession(*b.gpu, m, A, bad), Error);
 }
 
-INSTANTIATE_TEST_SUITE_P(Backends, DeformSessionTest, ::testing::ValuesIn(requiredBackends()), [](const auto& info) {
-  std::string n = info.param;
-  for (char& c : n)
-    if (c == '-') c = '_';
-  return n;
-});
+INSTANTIATE_TEST_SUITE_P(Backends, DeformSessionTest, ::testing::ValuesIn(sffd::testing::requiredBackends()),
+                         [](const auto& info) { return sffd::testing::backendTestName(info.param); });
 
 }  // namespace

@@ -77,6 +77,11 @@ void note(const ParsedArgs& args, const std::string& line);   // stderr unless -
 constexpr double kMaxSubTriangles = 50e6;
 void checkEdgeLength(const Mesh& mesh, double l);
 
+// Picture options shared by render and view (cmd_render.cpp): --width/--height in 16..8192 pixels,
+// --view AZIMUTH,ELEVATION in degrees. Throw an input Error otherwise.
+int sizeOption(const ParsedArgs& args, const char* name, int fallback);
+void parseView(const std::string& text, double& az, double& el);
+
 // The commands, one file each.
 CommandSpec deformCommand();
 CommandSpec latticeCommand();

@@ -17,23 +17,10 @@
 namespace sffd::cli {
 namespace {
 
-// The tessellation with every patch vertex its own vertex, so each can carry its own error.
-Mesh unweldedMesh(const PatchVertices& pv) {
-  Mesh m;
-  const size_t nv = size_t(tessVertexCount(pv.level));
-  std::vector<uint32_t> local = tessTriangles(pv.level);
-  for (size_t v = 0; v < pv.vertexCount(); ++v) {
-    m.positions.push_back({pv.position[3 * v], pv.position[3 * v + 1], pv.position[3 * v + 2]});
-    m.normals.push_back({pv.normal[3 * v], pv.normal[3 * v + 1], pv.normal[3 * v + 2]});
-    m.weldId.push_back(uint32_t(v));
-  }
-  for (size_t p = 0; p < pv.patchCount(); ++p)
-    for (size_t i = 0; i < local.size(); i += 3)
-      m.triangles.push_back({uint32_t(p * nv + local[i]), uint32_t(p * nv + local[i + 1]), uint32_t(p * nv + local[i + 2])});
-  return m;
-}
 
 Error usageError(const std::string& what) { return Error(ErrorKind::Input, what); }
+
+}  // namespace
 
 int sizeOption(const ParsedArgs& args, const char* name, int fallback) {
   int v = args.getInt(name, fallback);
@@ -52,6 +39,8 @@ void parseView(const std::string& text, double& az, double& el) {
     throw usageError("option --view needs AZIMUTH,ELEVATION in degrees like 30,20, not '" + text + "'");
   if (el < -90 || el > 90) throw usageError("--view: elevation must be within -90..90 degrees");
 }
+
+namespace {
 
 std::string upper(std::string s) {
   std::transform(s.begin(), s.end(), s.begin(), ::toupper);
@@ -122,7 +111,7 @@ int run(const ParsedArgs& args) {
       PatchVertices pv = run.patches ? *run.patches : linearPatchVertices(run.mesh, args.getInt("--tess", 10));
       PackedLattice packed = packLattice(job.lattice);
       ExactReference ref(job.mesh, packed);
-      meshes.push_back(unweldedMesh(pv));
+      meshes.push_back(unweldedPatchMesh(pv));
       errorScalars.resize(pv.vertexCount());
       for (size_t v = 0; v < pv.vertexCount(); ++v) {
         glm::dvec3 x, n, xr, nr;

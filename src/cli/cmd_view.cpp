@@ -23,22 +23,7 @@ namespace {
 
 Error usageError(const std::string& what) { return Error(ErrorKind::Input, what); }
 
-int sizeOption(const ParsedArgs& args, const char* name, int fallback) {
-  int v = args.getInt(name, fallback);
-  if (v < 16 || v > 8192) throw usageError(std::string("option ") + name + " must be 16..8192 pixels, not " + std::to_string(v));
-  return v;
-}
 
-void parseView(const std::string& text, double& az, double& el) {
-  size_t comma = text.find(',');
-  auto number = [&](const std::string& s, double& out) {
-    auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), out);
-    return ec == std::errc() && p == s.data() + s.size() && std::isfinite(out);
-  };
-  if (comma == std::string::npos || !number(text.substr(0, comma), az) || !number(text.substr(comma + 1), el))
-    throw usageError("option --view needs AZIMUTH,ELEVATION in degrees like 30,20, not '" + text + "'");
-  if (el < -90 || el > 90) throw usageError("--view: elevation must be within -90..90 degrees");
-}
 
 int run(const ParsedArgs& args) {
   // The request is checked before any work (and before a window is asked for).

@@ -325,31 +325,10 @@ const SessionTimings& DeformSession::deform(const Lattice& lattice) {
     const Chunk& c = chunks_[ci];
     if (!c.count) continue;
     params.range = {0, uint32_t(c.count), uint32_t(I.fit.points), uint32_t(options_.level)};
-    std::vector<BufferBinding> buffers = {
-        {SFFD_BINDING_LATTICE_COEFFS, I.coeffs}, {SFFD_BINDING_LATTICE_FRAME, I.frame}, {SFFD_BINDING_DEFORM_FIT, I.fitBuf},
-        {SFFD_BINDING_DEFORM_SUB_HEADERS, I.chunkBuffers[ci].headers}, {SFFD_BINDING_DEFORM_SUB_RECORDS, I.chunkBuffers[ci].records},
-        {SFFD_BINDING_DEFORM_PATCHES, c.patches}, {SFFD_BINDING_DEFORM_TESS, c.tess}};
-    if (options_.split) buffers.push_back({SFFD_BINDING_DEFORM_SAMPLES, I.samples});
-    auto dispatch = [&](const char* kernel, const char* label) {
-      Dispatch d;
-      d.kernel = kernel;
-      d.label = label;
-      d.variant = options_.variant;
-      d.params = &params;
-      d.paramsSize = sizeof(params);
-      d.buffers = buffers;
-      gridFor(c.count, B.info().limits, d.groups);
-      B.dispatch(d);
-      B.barrier();
-    };
-    if (options_.split) {
-      dispatch("deform_step_sample", "deform.sample");
-      dispatch("deform_step_fit", "deform.fit");
-      dispatch("deform_step_adjust", "deform.adjust");
-      dispatch("deform_step_tessellate", "deform.tessellate");
-    } else {
-      dispatch("deform_smooth", "deform");
-    }
+    dispatchDeform(B, params,
+                   {I.coeffs, I.frame, I.fitBuf, I.chunkBuffers[ci].headers, I.chunkBuffers[ci].records, c.patches, c.tess,
+                    options_.split ? I.samples : 0},
+                   c.count, options_.variant, options_.split);
   }
   B.finish();
   timings_.dispatches = B.takeTimings();

@@ -33,4 +33,8 @@ struct PatchVertices {
 // vertices keep one vertex per normal, with a common weldId).
 Mesh weldPatchVertices(const PatchVertices& patches);
 
+// The tessellation with every patch vertex its own vertex (so each can carry its own value, e.g. an
+// error for colouring).
+Mesh unweldedPatchMesh(const PatchVertices& patches);
+
 }  // namespace sffd

@@ -233,31 +233,7 @@ void deformGpu(Backend& backend, const PackedLattice& P, const SubTriangleRecord
     backend.upload(bHdr, 0, &subs.headers[4 * first], count * 16);
     backend.upload(bRec, 0, rec.data(), count * recReals * sizeof(Real));
     params.range = {0, uint32_t(count), uint32_t(F.points), uint32_t(level)};
-    std::vector<BufferBinding> buffers = {
-        {SFFD_BINDING_LATTICE_COEFFS, bCoeffs}, {SFFD_BINDING_LATTICE_FRAME, bFrame}, {SFFD_BINDING_DEFORM_FIT, bFit},
-        {SFFD_BINDING_DEFORM_SUB_HEADERS, bHdr}, {SFFD_BINDING_DEFORM_SUB_RECORDS, bRec},
-        {SFFD_BINDING_DEFORM_PATCHES, bPatch}, {SFFD_BINDING_DEFORM_TESS, bTess}};
-    if (split) buffers.push_back({SFFD_BINDING_DEFORM_SAMPLES, bSamples});
-    auto dispatch = [&](const char* kernel, const char* label) {
-      Dispatch d;
-      d.kernel = kernel;
-      d.label = label;
-      d.variant = variant;
-      d.params = &params;
-      d.paramsSize = sizeof(params);
-      d.buffers = buffers;
-      gridFor(count, lim, d.groups);
-      backend.dispatch(d);
-      backend.barrier();
-    };
-    if (split) {
-      dispatch("deform_step_sample", "deform.sample");
-      dispatch("deform_step_fit", "deform.fit");
-      dispatch("deform_step_adjust", "deform.adjust");
-      dispatch("deform_step_tessellate", "deform.tessellate");
-    } else {
-      dispatch("deform_smooth", "deform");
-    }
+    dispatchDeform(backend, params, {bCoeffs, bFrame, bFit, bHdr, bRec, bPatch, bTess, bSamples}, count, variant, split);
     backend.download(bPatch, 0, buf.data(), count * patchReals * sizeof(Real));
     std::copy(buf.begin(), buf.begin() + count * patchReals, out.patches.begin() + first * patchReals);
     backend.download(bTess, 0, buf.data(), count * tessReals * sizeof(Real));
@@ -302,6 +278,35 @@ SmoothOutput smoothDeformGpu(Backend& backend, const PackedLattice& lattice, con
   }
   out.wallMs = msSince(t0);
   return out;
+}
+
+void dispatchDeform(Backend& backend, const gpu::DeformParams& params, const DeformBuffers& b, size_t count,
+                    KernelVariant variant, bool split) {
+  std::vector<BufferBinding> buffers = {
+      {SFFD_BINDING_LATTICE_COEFFS, b.coeffs}, {SFFD_BINDING_LATTICE_FRAME, b.frame}, {SFFD_BINDING_DEFORM_FIT, b.fit},
+      {SFFD_BINDING_DEFORM_SUB_HEADERS, b.headers}, {SFFD_BINDING_DEFORM_SUB_RECORDS, b.records},
+      {SFFD_BINDING_DEFORM_PATCHES, b.patches}, {SFFD_BINDING_DEFORM_TESS, b.tess}};
+  if (split) buffers.push_back({SFFD_BINDING_DEFORM_SAMPLES, b.samples});
+  auto dispatch = [&](const char* kernel, const char* label) {
+    Dispatch d;
+    d.kernel = kernel;
+    d.label = label;
+    d.variant = variant;
+    d.params = &params;
+    d.paramsSize = sizeof(params);
+    d.buffers = buffers;
+    gridFor(count, backend.info().limits, d.groups);
+    backend.dispatch(d);
+    backend.barrier();
+  };
+  if (split) {
+    dispatch("deform_step_sample", "deform.sample");
+    dispatch("deform_step_fit", "deform.fit");
+    dispatch("deform_step_adjust", "deform.adjust");
+    dispatch("deform_step_tessellate", "deform.tessellate");
+  } else {
+    dispatch("deform_smooth", "deform");
+  }
 }
 
 PatchVertices patchVerticesOf(const SubTriangleRecords& subs, const SmoothOutput& out) {

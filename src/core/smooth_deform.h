@@ -9,6 +9,7 @@
 #include "lattice_pack.h"
 #include "patch_output.h"
 #include "regular_clip.h"
+#include "shader_layout.h"
 
 namespace sffd {
 
@@ -38,6 +39,15 @@ SmoothOutput smoothDeformCpu(const PackedLattice& lattice, const SubTriangleReco
 // deform.tessellate: 6), for per-step timings; the same output as the fused kernel.
 SmoothOutput smoothDeformGpu(Backend& backend, const PackedLattice& lattice, const SubTriangleRecords& subs,
                              const FitTable& fit, int level, KernelVariant variant, bool split = false);
+
+// The deform stage's dispatches over `count` sub-triangles (params.range set by the caller): the
+// fused kernel, or with `split` the four step kernels (`samples` then holds their intermediate data).
+// Shared by smoothDeformGpu and DeformSession.
+struct DeformBuffers {
+  BufferId coeffs = 0, frame = 0, fit = 0, headers = 0, records = 0, patches = 0, tess = 0, samples = 0;
+};
+void dispatchDeform(Backend& backend, const gpu::DeformParams& params, const DeformBuffers& buffers, size_t count,
+                    KernelVariant variant, bool split);
 
 // The tessellation with each vertex's pre-image in its parent triangle (for the writers and the
 // error analysis).

@@ -27,22 +27,6 @@ double msSince(std::chrono::steady_clock::time_point t0) {
 
 }  // namespace
 
-Mesh unweldedMesh(const PatchVertices& pv) {
-  Mesh m;
-  const size_t nv = size_t(tessVertexCount(pv.level));
-  std::vector<uint32_t> local = tessTriangles(pv.level);
-  m.positions.reserve(pv.vertexCount());
-  m.normals.reserve(pv.vertexCount());
-  for (size_t v = 0; v < pv.vertexCount(); ++v) {
-    m.positions.push_back({pv.position[3 * v], pv.position[3 * v + 1], pv.position[3 * v + 2]});
-    m.normals.push_back({pv.normal[3 * v], pv.normal[3 * v + 1], pv.normal[3 * v + 2]});
-    m.weldId.push_back(uint32_t(v));
-  }
-  for (size_t p = 0; p < pv.patchCount(); ++p)
-    for (size_t i = 0; i < local.size(); i += 3)
-      m.triangles.push_back({uint32_t(p * nv + local[i]), uint32_t(p * nv + local[i + 1]), uint32_t(p * nv + local[i + 2])});
-  return m;
-}
 
 std::vector<float> geometryErrors(const Mesh& input, const Lattice& lattice, const PatchVertices& pv) {
   PackedLattice packed = packLattice(lattice);
@@ -145,7 +129,7 @@ void Scene::drawHost(const Mesh& input, const Lattice& lattice, Mesh mesh, const
     scalars = geometryErrors(input, lattice, hp);
     result_ = patches ? weldPatchVertices(*patches) : mesh;
     if (!patches) uploadTess(linearPatchVertices(mesh, 1));
-    drawn_ = unweldedMesh(hp);
+    drawn_ = unweldedPatchMesh(hp);
   } else {
     if (!patches) uploadTess(linearPatchVertices(mesh, 1));
     result_ = mesh;
