@@ -128,10 +128,13 @@ SFFD_STRUCT_END(ClipParams)
 // all, the smallest uniform block every GL 4.3 and Vulkan device accepts. lattice.break_offset.w is
 // then the first vec4 of the Bezier coefficients in inline_lattice (the frame reals come first, four
 // to a vec4); 0 means the kernel reads the lattice storage buffers instead (f64, or too large).
-#define SFFD_INLINE_LATTICE_VEC4 1016
+// The fit table follows the lattice there when it fits too (inline_fit.x: its first vec4, 0: read
+// the fit buffer).
+#define SFFD_INLINE_LATTICE_VEC4 1015
 SFFD_STRUCT_BEGIN(DeformParams)
   SFFD_STRUCT_MEMBER(LatticeParams, lattice)
   SFFD_UVEC4 range;    // x: first sub-triangle, y: count, z: interior fitting points, w: tessellation level
+  SFFD_UVEC4 inline_fit;
   SFFD_VEC4 inline_lattice[SFFD_INLINE_LATTICE_VEC4];
 SFFD_STRUCT_END(DeformParams)
 

@@ -15,6 +15,18 @@ layout(std140, SFFD_SET binding = SFFD_BINDING_PARAMS) uniform DeformBlock { Def
 #include "bspline.glsl"
 #include "pn.glsl"
 layout(std430, SFFD_SET binding = SFFD_BINDING_DEFORM_FIT) readonly buffer Fit { real fit[]; };
+
+// Fit-table reads: from the parameter block when the host put the table there (layout.h), as the lattice.
+#if !SFFD_F64
+real fitAt(uint i) {
+  real v;
+  if (params.inline_fit.x != 0u) v = params.inline_lattice[params.inline_fit.x + (i >> 2u)][i & 3u];
+  else v = fit[i];
+  return v;
+}
+#else
+real fitAt(uint i) { return fit[i]; }
+#endif
 layout(std430, SFFD_SET binding = SFFD_BINDING_DEFORM_SUB_HEADERS) readonly buffer SubHeaders { uvec4 subHeaders[]; };
 layout(std430, SFFD_SET binding = SFFD_BINDING_DEFORM_SUB_RECORDS) readonly buffer SubRecords { real4 subRecords[]; };
 
@@ -116,7 +128,7 @@ void smoothEdgeSamples(SubCorners C, out real3 E[6], out real3 EN[6]) {
 // the PN rule after the adjustment, so only the normal patch needs the interior samples).
 real3 smoothInteriorNormal(SubCorners C, uint i) {
   uint f = SFFD_FIT_STRIDE * i;
-  P real3 lam = real3(fit[f], fit[f + 1u], fit[f + 2u]);
+  P real3 lam = real3(fitAt(f), fitAt(f + 1u), fitAt(f + 2u));
   P real3 x = (C.x0 * lam.x + C.x1 * lam.y) + C.x2 * lam.z;
   P real3 n = (C.n0 * lam.x + C.n1 * lam.y) + C.n2 * lam.z;
   LatticeSample S = latticeEvaluate(params.lattice, x);
@@ -148,8 +160,8 @@ real3 smoothCentreTerm(real3 ncp[10], real3 qn, uint i) {
   uint f = SFFD_FIT_STRIDE * i;
   P real3 r = qn;
   for (uint k = 0u; k < 10u; ++k)
-    if (k != 4u) r = r - ncp[k] * fit[f + 4u + k];
-  P real3 term = r * fit[f + 3u];
+    if (k != 4u) r = r - ncp[k] * fitAt(f + 4u + k);
+  P real3 term = r * fitAt(f + 3u);
   return term;
 }
 

@@ -320,7 +320,7 @@ const SessionTimings& DeformSession::deform(const Lattice& lattice) {
   PackedLattice packed = packLattice(lattice);
   std::vector<unsigned char> coeffs = realBytes(packed.coeffs, options_.variant.f64);
   B.upload(I.coeffs, 0, coeffs.data(), coeffs.size());
-  gpu::DeformParams params = deformParamsFor(packed, options_.variant.f64);
+  gpu::DeformParams params = deformParamsFor(packed, options_.variant.f64, &I.fit.data);
   for (size_t ci = 0; ci < chunks_.size(); ++ci) {
     const Chunk& c = chunks_[ci];
     if (!c.count) continue;

@@ -29,7 +29,7 @@ PackedLattice packLattice(const Lattice& L) {
   return P;
 }
 
-gpu::DeformParams deformParamsFor(const PackedLattice& lattice, bool f64) {
+gpu::DeformParams deformParamsFor(const PackedLattice& lattice, bool f64, const std::vector<double>* fit) {
   gpu::DeformParams d{};
   d.lattice = lattice.params;
   d.lattice.break_offset.w = 0;
@@ -42,6 +42,11 @@ gpu::DeformParams deformParamsFor(const PackedLattice& lattice, bool f64) {
   for (size_t i = 0; i < lattice.frame.size(); ++i) put(i, lattice.frame[i]);
   for (size_t i = 0; i < lattice.coeffs.size(); ++i) put(4 * frameVec4 + i, lattice.coeffs[i]);
   d.lattice.break_offset.w = uint32_t(frameVec4);
+  const size_t fitFirst = frameVec4 + coeffVec4;
+  if (fit && !fit->empty() && fitFirst + (fit->size() + 3) / 4 <= SFFD_INLINE_LATTICE_VEC4) {
+    for (size_t i = 0; i < fit->size(); ++i) put(4 * fitFirst + i, (*fit)[i]);
+    d.inline_fit.x = uint32_t(fitFirst);
+  }
   return d;
 }
 

@@ -20,7 +20,8 @@ PackedLattice packLattice(const Lattice& lattice);
 // The deform kernels' parameter block for a lattice: its LatticeParams, and in the float variants
 // the lattice itself inline when it fits (layout.h, DeformParams), else break_offset.w = 0 and the
 // kernels read the lattice storage buffers.
-gpu::DeformParams deformParamsFor(const PackedLattice& lattice, bool f64);
+// With `fit`, the fit table follows the lattice there when both fit (inline_fit.x).
+gpu::DeformParams deformParamsFor(const PackedLattice& lattice, bool f64, const std::vector<double>* fit = nullptr);
 
 template <class Real>
 std::vector<Real> convertReals(const std::vector<double>& v) {

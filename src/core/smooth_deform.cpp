@@ -225,7 +225,7 @@ void deformGpu(Backend& backend, const PackedLattice& P, const SubTriangleRecord
   out.patches.resize(n * patchReals);
   out.tess.resize(n * tessReals);
   std::vector<Real> rec(chunk * recReals), buf(chunk * std::max(patchReals, tessReals));
-  gpu::DeformParams params = deformParamsFor(P, variant.f64);
+  gpu::DeformParams params = deformParamsFor(P, variant.f64, &F.data);
   for (size_t first = 0; first < n; first += chunk) {
     size_t count = std::min(chunk, n - first);
     std::transform(subs.records.begin() + first * recReals, subs.records.begin() + (first + count) * recReals, rec.begin(),
