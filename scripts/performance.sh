@@ -5,6 +5,7 @@
 # out/perf/ and the plots to docs/figures/perf_*.png; prints the tables as Markdown.
 #   scripts/performance.sh            all of it (about 10 minutes on 2 cores)
 #   REPEAT=5 BACKENDS=vulkan,gl,cpu   the defaults
+#   ONLY=tess                         rerun one group (models, faces, l, tess), then redo the tables and plots
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SFFD=${SFFD:-build/sffd}
@@ -14,6 +15,8 @@ D=../shared/data/acaffd
 OUT=out/perf
 mkdir -p "$OUT" docs/figures
 
+ONLY=${ONLY:-}
+want() { [ -z "$ONLY" ] || [ "$ONLY" = "$1" ]; }
 bench() {  # name mesh lattice normalize l tess [extra...]
   local name=$1 mesh=$2 lat=$3 norm=$4 l=$5 tess=$6
   shift 6
@@ -22,16 +25,18 @@ bench() {  # name mesh lattice normalize l tess [extra...]
 }
 
 # The benchmark model set (docs/PERFORMANCE.md "Models"): 5x5x5 degree-2 lattices, level 10.
+if want models; then
 bench teapot t.bpt t_control_points1.npy 0.9090909090909091 0.2 10
 bench teapot_split t.bpt t_control_points1.npy 0.9090909090909091 0.2 10 --split
 bench rabbit rabbit_cym.obj rabbit_cym_control_points0.npy 0.99 0.2 10
 bench sphere sphere.obj sphere_control_points0.npy 0.99 0.2 10
 bench teapot47k t.bpt t_control_points1.npy 0.9090909090909091 0.2 10 --bpt-resolution 26
+fi
 
 # Scaling: faces (the teapot at finer grids; l = 0.2 gives one sub-triangle a face), l, level.
-for r in 4 8 16 26 53 80; do bench faces_$r t.bpt t_control_points1.npy 0.9090909090909091 0.2 10 --bpt-resolution $r; done
-for l in 0.4 0.2 0.1 0.05; do bench l_$l t.bpt t_control_points1.npy 0.9090909090909091 $l 10; done
-for n in 1 2 5 10 20 40; do bench tess_$n t.bpt t_control_points1.npy 0.9090909090909091 0.2 $n; done
+want faces && for r in 4 8 16 26 53 80; do bench faces_$r t.bpt t_control_points1.npy 0.9090909090909091 0.2 10 --bpt-resolution $r; done
+want l && for l in 0.4 0.2 0.1 0.05; do bench l_$l t.bpt t_control_points1.npy 0.9090909090909091 $l 10; done
+want tess && for n in 1 2 5 10 20 40; do bench tess_$n t.bpt t_control_points1.npy 0.9090909090909091 0.2 $n; done
 
 /usr/bin/python3 - "$OUT" <<'PY'
 import json, os, sys
