@@ -78,7 +78,7 @@ TEST_P(DeformSessionTest, StrictSessionEqualsCpuReferenceAcrossRedeforms) {
     EXPECT_EQ(s.output().tess, rb.out.tess);
     s.deform(A);
     EXPECT_EQ(s.output().tess, a1.tess);
-    EXPECT_GE(s.timings().deformMs, 0.0);
+    EXPECT_GT(s.timings().deformMs, 0.0);
     s.precompute();   // again: the same records
     EXPECT_EQ(s.records().records, ra.subs.records);
   }

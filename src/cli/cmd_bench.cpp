@@ -25,13 +25,10 @@
 #include "regular_clip.h"
 #include "smooth_deform.h"
 #include "split_pattern_table.h"
+#include "wall_clock.h"
 
 namespace sffd::cli {
 namespace {
-
-double msSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
 
 double peakRssMb() {
   rusage u{};
@@ -85,7 +82,6 @@ BackendResult benchGpu(OpenedBackend& b, const Job& job, const BenchSettings& S)
   r.device = b.info.name;
   auto t0 = std::chrono::steady_clock::now();
   DeformSession session(*b.gpu, job.mesh, job.lattice, S.session);
-  const SessionTimings pre = session.timings();
   session.deform(job.lattice);
   r.coldMs = msSince(t0);
   r.subTriangles = session.subTriangles();

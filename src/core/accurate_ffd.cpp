@@ -10,6 +10,7 @@
 #include "error.h"
 #include "job_budget.h"
 #include "lattice_eval.h"
+#include "wall_clock.h"
 
 namespace sffd {
 
@@ -23,10 +24,6 @@ void triangleMultiIndex(int n, int idx, int& i, int& j, int& k) {
 }
 
 namespace {
-
-double msSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
 
 long double factorialL(int n) {
   long double f = 1;

@@ -6,13 +6,10 @@
 
 #include "error.h"
 #include "lattice_eval.h"
+#include "wall_clock.h"
 
 namespace sffd {
 namespace {
-
-double msSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
 
 template <class Real>
 void classicCpu(const Mesh& mesh, const PackedLattice& P, ClassicOutput& out) {

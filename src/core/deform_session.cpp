@@ -18,13 +18,10 @@
 #include "pn_triangles.h"
 #include "prepared_mesh.h"
 #include "split_pattern_table.h"
+#include "wall_clock.h"
 
 namespace sffd {
 namespace {
-
-double msSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
 
 // The reals of a host array in the kernel's storage type, as bytes.
 std::vector<unsigned char> realBytes(const std::vector<double>& v, bool f64) {
@@ -48,11 +45,6 @@ std::vector<double> doublesOf(const std::vector<unsigned char>& bytes, bool f64)
       out[i] = f;
     }
   return out;
-}
-
-bool sameStructure(const Lattice& a, const Lattice& b) {
-  return a.degree == b.degree && a.counts == b.counts && a.knots == b.knots && a.frameLinear == b.frameLinear &&
-         a.frameOffset == b.frameOffset && a.outside == b.outside && a.controlPoints.size() == b.controlPoints.size();
 }
 
 }  // namespace
@@ -177,6 +169,23 @@ const SessionTimings& DeformSession::precompute() {
     B.dispatch(d);
     B.barrier();
   };
+  // The clip kernels' parameters and bindings (mesh, PN records, clip triangles, counts), for both passes.
+  auto clipParams = [&](size_t first, size_t count) {
+    gpu::ClipParams params;
+    const PackedTable& T = packedTable();
+    params.table = {T.nmax, T.vertexWord, T.triangleWord, 0};
+    params.target = {float(options_.edgeLength), 0, 0, 0};
+    params.range = {uint32_t(first), uint32_t(count), 0, 0};
+    return params;
+  };
+  auto clipBindings = [&](std::vector<BufferBinding> extra) {
+    std::vector<BufferBinding> b = {
+        {SFFD_BINDING_SPLIT_TABLE, I.table}, {SFFD_BINDING_MESH_POSITIONS, I.pos}, {SFFD_BINDING_MESH_NORMALS, I.nrm},
+        {SFFD_BINDING_MESH_TRIANGLES, I.tri}, {SFFD_BINDING_MESH_SLOT_NORMALS, I.slot}, {SFFD_BINDING_PN_OUT, I.pn},
+        {SFFD_BINDING_CLIP_HEADERS, I.clipHdr}, {SFFD_BINDING_CLIP_REALS, I.clipReal}, {SFFD_BINDING_CLIP_COUNTS, I.counts}};
+    b.insert(b.end(), extra.begin(), extra.end());
+    return b;
+  };
   if (nt) {
     gpu::PnParams params;
     params.range = {0, uint32_t(nt), 0, 0};
@@ -198,17 +207,10 @@ const SessionTimings& DeformSession::precompute() {
   size_t clipN = 0;
   if (!options_.knotBoxClip) {
     clipN = I.clip.triangles.size();
-    gpu::ClipParams params;
-    const PackedTable& T = packedTable();
-    params.table = {T.nmax, T.vertexWord, T.triangleWord, 0};
-    params.target = {float(options_.edgeLength), 0, 0, 0};
-    params.range = {0, uint32_t(clipN), 0, 0};
+    gpu::ClipParams params = clipParams(0, clipN);
     std::vector<uint32_t> counts(clipN);
     if (clipN) {
-      dispatch("clip_count", "clip_count", &params, sizeof(params), clipN,
-               {{SFFD_BINDING_SPLIT_TABLE, I.table}, {SFFD_BINDING_MESH_POSITIONS, I.pos}, {SFFD_BINDING_MESH_NORMALS, I.nrm},
-                {SFFD_BINDING_MESH_TRIANGLES, I.tri}, {SFFD_BINDING_MESH_SLOT_NORMALS, I.slot}, {SFFD_BINDING_PN_OUT, I.pn},
-                {SFFD_BINDING_CLIP_HEADERS, I.clipHdr}, {SFFD_BINDING_CLIP_REALS, I.clipReal}, {SFFD_BINDING_CLIP_COUNTS, I.counts}});
+      dispatch("clip_count", "clip_count", &params, sizeof(params), clipN, clipBindings({}));
       B.download(I.counts, 0, counts.data(), clipN * 4);
     }
     offsets.assign(clipN + 1, 0);
@@ -275,16 +277,9 @@ const SessionTimings& DeformSession::precompute() {
     if (!options_.knotBoxClip) {
       for (size_t i = first; i < last; ++i) chunkOffsets[i] = uint32_t(offsets[i] - offsets[first]);
       B.upload(I.counts, first * 4, chunkOffsets.data() + first, (last - first) * 4);
-      gpu::ClipParams params;
-      const PackedTable& T = packedTable();
-      params.table = {T.nmax, T.vertexWord, T.triangleWord, 0};
-      params.target = {float(options_.edgeLength), 0, 0, 0};
-      params.range = {uint32_t(first), uint32_t(last - first), 0, 0};
+      gpu::ClipParams params = clipParams(first, last - first);
       dispatch("clip_write", "clip_write", &params, sizeof(params), last - first,
-               {{SFFD_BINDING_SPLIT_TABLE, I.table}, {SFFD_BINDING_MESH_POSITIONS, I.pos}, {SFFD_BINDING_MESH_NORMALS, I.nrm},
-                {SFFD_BINDING_MESH_TRIANGLES, I.tri}, {SFFD_BINDING_MESH_SLOT_NORMALS, I.slot}, {SFFD_BINDING_PN_OUT, I.pn},
-                {SFFD_BINDING_CLIP_HEADERS, I.clipHdr}, {SFFD_BINDING_CLIP_REALS, I.clipReal}, {SFFD_BINDING_CLIP_COUNTS, I.counts},
-                {SFFD_BINDING_SUB_HEADERS, cb.headers}, {SFFD_BINDING_SUB_RECORDS, cb.records}});
+               clipBindings({{SFFD_BINDING_SUB_HEADERS, cb.headers}, {SFFD_BINDING_SUB_RECORDS, cb.records}}));
     } else if (subs) {
       B.upload(cb.headers, 0, &knotRecords.headers[4 * c.first], subs * 16);
       std::vector<double> part(knotRecords.records.begin() + c.first * SFFD_SUB_STRIDE * 4,
@@ -313,7 +308,7 @@ const SessionTimings& DeformSession::precompute() {
 const SessionTimings& DeformSession::deform(const Lattice& lattice) {
   Impl& I = *impl_;
   Backend& B = backend_;
-  if (!sameStructure(lattice, I.structure))
+  if (!sameLatticeStructure(lattice, I.structure))
     throw Error(ErrorKind::Input, "the lattice's degrees, counts, knots or frame differ from the session's");
   auto t0 = std::chrono::steady_clock::now();
   timings_ = {};

@@ -213,4 +213,9 @@ LatticeBoxForm extractBoxForm(const Lattice& L) {
   return F;
 }
 
+bool sameLatticeStructure(const Lattice& a, const Lattice& b) {
+  return a.degree == b.degree && a.counts == b.counts && a.knots == b.knots && a.frameLinear == b.frameLinear &&
+         a.frameOffset == b.frameOffset && a.outside == b.outside && a.controlPoints.size() == b.controlPoints.size();
+}
+
 }  // namespace sffd

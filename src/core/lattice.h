@@ -42,6 +42,10 @@ std::vector<double> clampedUniformKnots(int count, int degree, double lo, double
 // finite control points and an invertible frame. Throws an input Error naming `source`.
 void validateLattice(const Lattice& lattice, const std::string& source);
 
+// Same degrees, counts, knots, frame and outside rule (only the control points may differ): what a
+// deformation prepared for one lattice may reuse for the other.
+bool sameLatticeStructure(const Lattice& a, const Lattice& b);
+
 // Greville abscissae of one axis: xi_i = (u_{i+1} + ... + u_{i+n}) / n.
 std::vector<double> grevilleAbscissae(const std::vector<double>& knots, int degree);
 

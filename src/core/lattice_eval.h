@@ -63,7 +63,7 @@ class LatticeEvaluator {
       p[r] = xyz + row[3];
     }
     uint32_t sp[3];
-    Real s[3];
+    Real s[3] = {Real(0), Real(0), Real(0)};   // set per axis below; initialised for GCC's flow analysis
     const uint32_t offs[3] = {L_.break_offset.x, L_.break_offset.y, L_.break_offset.z};
     const uint32_t boxes[3] = {L_.boxes.x, L_.boxes.y, L_.boxes.z};
     for (int a = 0; a < 3; ++a) {

@@ -8,13 +8,10 @@
 #include "lattice_pack.h"
 #include "pn_eval.h"
 #include "shader_layout.h"
+#include "wall_clock.h"
 
 namespace sffd {
 namespace {
-
-double msSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
 
 template <class Real>
 void pnCpu(const PreparedMesh& M, PnOutput& out) {

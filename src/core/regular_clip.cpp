@@ -11,13 +11,10 @@
 #include "error.h"
 #include "lattice_pack.h"
 #include "split_pattern_table.h"
+#include "wall_clock.h"
 
 namespace sffd {
 namespace {
-
-double msSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
 
 // ---------------------------------------------------------------- pre-split into clip triangles
 

@@ -9,6 +9,7 @@
 #include "lattice_eval.h"
 #include "pn_eval.h"
 #include "shader_layout.h"
+#include "wall_clock.h"
 
 namespace sffd {
 
@@ -35,10 +36,6 @@ FitTable makeFitTable(int s) {
 }
 
 namespace {
-
-double msSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
 
 constexpr int kCornerCp[3] = {0, 6, 9};
 

@@ -12,21 +12,9 @@
 #include "gl/gl_backend.h"
 #include "lattice_pack.h"
 #include "mesh_topology.h"
+#include "wall_clock.h"
 
 namespace sffd::view {
-namespace {
-
-bool sameStructure(const Lattice& a, const Lattice& b) {
-  return a.degree == b.degree && a.counts == b.counts && a.knots == b.knots && a.frameLinear == b.frameLinear &&
-         a.frameOffset == b.frameOffset && a.outside == b.outside;
-}
-
-double msSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
-
-}  // namespace
-
 
 std::vector<float> geometryErrors(const Mesh& input, const Lattice& lattice, const PatchVertices& pv) {
   PackedLattice packed = packLattice(lattice);
@@ -81,7 +69,7 @@ void Scene::update(const Lattice& lattice, const SceneSettings& settings,
   const auto t0 = std::chrono::steady_clock::now();
   if (sessionUsable(lattice, settings)) {
     const bool knotBox = settings.clip == "knot-box";
-    if (!session_ || knotBox != sessionClipKnotBox_ || !sameStructure(lattice, sessionLattice_)) {
+    if (!session_ || knotBox != sessionClipKnotBox_ || !sameLatticeStructure(lattice, sessionLattice_)) {
       if (progress)
         progress("PREPARING: PN TRIANGLES AND " + std::string(knotBox ? "KNOT-BOX" : "REGULAR") + " CLIPPING OF " +
                  std::to_string(sessionMesh_.triangles.size()) + " TRIANGLES");
