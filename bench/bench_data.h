@@ -7,9 +7,9 @@
 #include <map>
 #include <string>
 
-#include "lattice.h"
-#include "lattice_io.h"
-#include "mesh.h"
+#include "model/lattice.h"
+#include "io/lattice_io.h"
+#include "model/mesh.h"
 
 namespace sffd::bench {
 
@@ -20,7 +20,7 @@ inline void meshBox(const Mesh& m, glm::dvec3& lo, glm::dvec3& hi) {
   for (const auto& p : m.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
 }
 
-// Centred, largest half-extent `scale` (the idea of src/cli/job.cpp normalizeMesh).
+// Centred, largest half-extent `scale` (the idea of apps/sffd/job.cpp normalizeMesh).
 inline void normalize(Mesh& m, double scale) {
   glm::dvec3 lo, hi;
   meshBox(m, lo, hi);

@@ -1,6 +1,6 @@
 // CPU reference of the lattice itself: what it costs to turn a Lattice into the kernels' Bezier box
 // form (packLattice: Boehm knot insertion per knot box, extractBoxForm), to evaluate the trivariate
-// volume and its Jacobian at a point (LatticeEvaluator, the C++ twin of shaders/common/bspline.glsl,
+// volume and its Jacobian at a point (LatticeEvaluator, the C++ twin of kernels/common/lattice_eval.glsl,
 // in double as the oracle and in float in the strict kernels' order), classic FFD of a whole model
 // (classicFfdCpu, rabbit_cym.obj) and the exact reference of the error analysis (ExactReference).
 // These are the innermost loops of every CPU path and of `sffd conform`/`sffd error`, so their
@@ -12,10 +12,10 @@
 #include <vector>
 
 #include "bench_data.h"
-#include "classic_ffd.h"
-#include "error_metrics.h"
-#include "lattice_eval.h"
-#include "lattice_pack.h"
+#include "kernels/classic/classic_ffd.h"
+#include "analysis/error_metrics.h"
+#include "kernels/common/lattice_eval.h"
+#include "model/lattice_pack.h"
 
 using namespace sffd;
 

@@ -1,7 +1,7 @@
 // The smooth-FFD pipeline on the CPU reference, stage by stage, on the teapot (t.bpt, 36 patches,
 // 7200 triangles) and the rabbit (rabbit_cym.obj, 8400 triangles), both normalised to a largest
 // half-extent of 1/1.1 and clipped with target edge length l = 0.2 (the call sequence of
-// src/cli/smooth_job.cpp). At l = 0.2 every edge of both models is shorter than l, so regular
+// apps/sffd/smooth_job.cpp). At l = 0.2 every edge of both models is shorter than l, so regular
 // clipping yields one sub-triangle per triangle; the `fine` cases use l = 0.02, where the split
 // patterns really subdivide (several segments an edge), to measure clipping and deform at scale:
 // prepareMesh -> pnTrianglesCpu (K1) -> buildClipTriangles + regularClipCpu (K2) -> smoothDeformCpu
@@ -16,12 +16,12 @@
 #include <tuple>
 
 #include "bench_data.h"
-#include "lattice_pack.h"
-#include "pn_triangles.h"
-#include "prepared_mesh.h"
-#include "regular_clip.h"
-#include "smooth_deform.h"
-#include "split_pattern_table.h"
+#include "model/lattice_pack.h"
+#include "kernels/pn/pn_triangles.h"
+#include "model/prepared_mesh.h"
+#include "kernels/clip/regular_clip.h"
+#include "kernels/smooth/smooth_deform.h"
+#include "kernels/clip/split_pattern_table.h"
 
 using namespace sffd;
 

@@ -1,4 +1,4 @@
-// The crack-free split-pattern table (src/core/split_pattern_table.h, docs/SPLIT_PATTERNS.md): the
+// The crack-free split-pattern table (kernels/clip/split_pattern_table.h, docs/SPLIT_PATTERNS.md): the
 // cost of generating it and of reading it. The generator (tools/split_pattern_gen.cpp) runs on every
 // clean build and its cost grows roughly as Nmax^5 (Nmax^3 patterns, each a Delaunay + Lloyd
 // triangulation of up to ~Nmax^2 points), which bounds how far SFFD_SPLIT_NMAX can be raised. Its core
@@ -17,7 +17,7 @@
 #include <string>
 #include <unistd.h>
 
-#include "split_pattern_table.h"
+#include "kernels/clip/split_pattern_table.h"
 
 using namespace sffd;
 namespace fs = std::filesystem;

@@ -1,7 +1,7 @@
 # Generates the glad GL 4.5 core loader at build time from python3-glad's bundled specs (no network).
 # Function pointers are loaded per context through OSMesaGetProcAddress, eglGetProcAddress or
 # glfwGetProcAddress, so the binary links no libGL.
-set(SFFD_GLAD_DIR ${CMAKE_BINARY_DIR}/glad)
+set(SFFD_GLAD_DIR ${PROJECT_BINARY_DIR}/glad)
 add_custom_command(
   OUTPUT ${SFFD_GLAD_DIR}/src/gl.c ${SFFD_GLAD_DIR}/include/glad/gl.h
   COMMAND ${GLAD_EXECUTABLE} --quiet --reproducible --api gl:core=4.5

@@ -1,42 +1,47 @@
-# Compiles every kernel in shaders/ to SPIR-V in four variants (strict x f64) with glslangValidator,
-# tracked by depfiles, and embeds them with the include-inlined GLSL into one generated C++ file.
-# Add a kernel by adding its stem to SFFD_KERNELS.
-set(SFFD_KERNELS classic_ffd pn_triangles clip_count clip_write deform_smooth
-    deform_step_sample deform_step_fit deform_step_adjust deform_step_tessellate)
-# accurate FFD (src/core/accurate_ffd.cpp):
-list(APPEND SFFD_KERNELS accurate_patches)
+# Compiles every kernel in kernels/<stage>/ to SPIR-V in four variants (strict x f64) with
+# glslangValidator, tracked by depfiles, and embeds them with the include-inlined GLSL into one
+# generated C++ file (src/core/kernel_registry.h). Add a kernel by adding STAGE/STEM to SFFD_KERNELS;
+# it is registered under its stem.
+set(SFFD_KERNELS
+    classic/classic_ffd
+    pn/pn_triangles
+    clip/clip_count clip/clip_write
+    smooth/deform_smooth
+    smooth/deform_step_sample smooth/deform_step_fit smooth/deform_step_adjust smooth/deform_step_tessellate
+    accurate/accurate_patches)
 
-set(SFFD_SHADER_DIR ${CMAKE_SOURCE_DIR}/shaders)
-set(SFFD_SPV_DIR ${CMAKE_BINARY_DIR}/spv)
+set(SFFD_KERNEL_DIR ${PROJECT_SOURCE_DIR}/kernels)
+set(SFFD_SPV_DIR ${PROJECT_BINARY_DIR}/spv)
 file(MAKE_DIRECTORY ${SFFD_SPV_DIR})
-file(GLOB SFFD_SHADER_COMMON CONFIGURE_DEPENDS ${SFFD_SHADER_DIR}/common/*)
+file(GLOB SFFD_KERNEL_INCLUDES CONFIGURE_DEPENDS ${SFFD_KERNEL_DIR}/*/*.glsl ${SFFD_KERNEL_DIR}/common/layout.h)
 
-add_executable(embed_kernels tools/embed_kernels.cpp)
+add_executable(embed_kernels ${PROJECT_SOURCE_DIR}/tools/embed_kernels.cpp)
 
 set(_spv_outputs)
 foreach(kernel IN LISTS SFFD_KERNELS)
+  get_filename_component(stem ${kernel} NAME)
   foreach(v 0 1 2 3)
     math(EXPR strict "${v} % 2")
     math(EXPR f64 "${v} / 2")
-    set(out ${SFFD_SPV_DIR}/${kernel}.v${v}.spv)
+    set(out ${SFFD_SPV_DIR}/${stem}.v${v}.spv)
     add_custom_command(
       OUTPUT ${out}
       COMMAND Vulkan::glslangValidator -V --target-env vulkan1.1 --quiet
               -DSFFD_STRICT=${strict} -DSFFD_F64=${f64}
-              --depfile ${out}.d -o ${out} ${SFFD_SHADER_DIR}/${kernel}.comp
-      DEPENDS ${SFFD_SHADER_DIR}/${kernel}.comp
+              --depfile ${out}.d -o ${out} ${SFFD_KERNEL_DIR}/${kernel}.comp
+      DEPENDS ${SFFD_KERNEL_DIR}/${kernel}.comp
       DEPFILE ${out}.d
-      COMMENT "glslang: ${kernel} variant ${v}"
+      COMMENT "glslang: ${stem} variant ${v}"
       VERBATIM)
     list(APPEND _spv_outputs ${out})
   endforeach()
 endforeach()
 
-set(SFFD_KERNELS_CPP ${CMAKE_BINARY_DIR}/generated/kernels_embedded.cpp)
+set(SFFD_KERNELS_CPP ${PROJECT_BINARY_DIR}/generated/kernels_embedded.cpp)
 add_custom_command(
   OUTPUT ${SFFD_KERNELS_CPP}
-  COMMAND ${CMAKE_COMMAND} -E make_directory ${CMAKE_BINARY_DIR}/generated
-  COMMAND embed_kernels ${SFFD_KERNELS_CPP} ${SFFD_SHADER_DIR} ${SFFD_SPV_DIR} ${SFFD_KERNELS}
-  DEPENDS embed_kernels ${_spv_outputs} ${SFFD_SHADER_COMMON}
+  COMMAND ${CMAKE_COMMAND} -E make_directory ${PROJECT_BINARY_DIR}/generated
+  COMMAND embed_kernels ${SFFD_KERNELS_CPP} ${SFFD_KERNEL_DIR} ${SFFD_SPV_DIR} ${SFFD_KERNELS}
+  DEPENDS embed_kernels ${_spv_outputs} ${SFFD_KERNEL_INCLUDES}
   COMMENT "Embedding kernels"
   VERBATIM)

@@ -9,8 +9,8 @@
 #include <cstdlib>
 #include <string>
 
-#include "error.h"
-#include "mesh.h"
+#include <sffd/error.h>
+#include "model/mesh.h"
 
 namespace sffd::fuzz {
 

@@ -2,9 +2,9 @@
 // readLatticeBytes as `sffd deform -l FILE` reads them. An accepted lattice must validate, and a small
 // one is packed for the kernels and checked for fold-over, as `sffd deform` does next.
 #include "fuzz_common.h"
-#include "lattice_fold.h"
-#include "lattice_io_internal.h"
-#include "lattice_pack.h"
+#include "model/lattice_fold.h"
+#include "io/lattice_io_internal.h"
+#include "model/lattice_pack.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string bytes(reinterpret_cast<const char*>(data), size);

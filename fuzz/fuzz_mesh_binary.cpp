@@ -3,7 +3,7 @@
 // there is reported as a damaged file); here it runs only for bytes that start with "OM", so that the
 // other readers keep their speed.
 #include "fuzz_common.h"
-#include "mesh_io_internal.h"
+#include "io/mesh_io_internal.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string bytes(reinterpret_cast<const char*>(data), size);

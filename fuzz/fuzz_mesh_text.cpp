@@ -1,7 +1,7 @@
 // libFuzzer target: the text mesh readers (.obj, .off, .bpt, ASCII .ply and .stl) on the same bytes,
 // through readMeshBytes, i.e. exactly as `sffd deform FILE` reads a file of that extension.
 #include "fuzz_common.h"
-#include "mesh_io_internal.h"
+#include "io/mesh_io_internal.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string bytes(reinterpret_cast<const char*>(data), size);

@@ -12,7 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "mesh.h"
+#include "model/mesh.h"
 
 namespace fs = std::filesystem;
 

@@ -19,13 +19,13 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include "error.h"
-#include "job_budget.h"
-#include "lattice.h"
-#include "lattice_fold.h"
-#include "lattice_io.h"
-#include "lattice_pack.h"
-#include "mesh.h"
+#include <sffd/error.h>
+#include "core/job_budget.h"
+#include "model/lattice.h"
+#include "model/lattice_fold.h"
+#include "io/lattice_io.h"
+#include "model/lattice_pack.h"
+#include "model/mesh.h"
 
 namespace fs = std::filesystem;
 

@@ -13,7 +13,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include "gl/gl_renderer.h"
+#include "apps/render/gl_renderer.h"
 
 namespace fs = std::filesystem;
 

@@ -1,5 +1,5 @@
-// Conformance of the accurate FFD kernel (shaders/accurate_patches.comp) on every GPU backend against
-// its C++ twin (src/core/accurate_ffd.cpp): strict variants bit-identical, fast variants within the
+// Conformance of the accurate FFD kernel (kernels/accurate/accurate_patches.comp) on every GPU backend against
+// its C++ twin (kernels/accurate/accurate_patches.cpp): strict variants bit-identical, fast variants within the
 // tolerances of docs/CONFORMANCE.md; chunked jobs equal one dispatch; the identity lattice reproduces
 // the flat mesh; the largest patch degree (5,5,5 -> n = 15) runs.
 #include <gtest/gtest.h>
@@ -9,12 +9,12 @@
 #include <random>
 #include <sstream>
 
-#include "accurate_ffd.h"
+#include "kernels/accurate/accurate_patches.h"
 #include "backends/backend_select.h"
 #include "backends/backend_test_support.h"
-#include "buffer_compare.h"
-#include "knot_box_clip.h"
-#include "vk/vk_backend.h"
+#include "analysis/buffer_compare.h"
+#include "kernels/clip/knot_box_clip.h"
+#include "backends/vulkan/vk_backend.h"
 
 using namespace sffd;
 

@@ -2,9 +2,9 @@
 
 #include <thread>
 
-#include "error.h"
-#include "gl/gl_backend.h"
-#include "vk/vk_backend.h"
+#include <sffd/error.h>
+#include "backends/opengl/gl_backend.h"
+#include "backends/vulkan/vk_backend.h"
 
 namespace sffd {
 

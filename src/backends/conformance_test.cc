@@ -9,14 +9,14 @@
 
 #include "backends/backend_select.h"
 #include "backends/backend_test_support.h"
-#include "buffer_compare.h"
-#include "classic_ffd.h"
-#include "error.h"
-#include "pn_triangles.h"
-#include "regular_clip.h"
-#include "smooth_deform.h"
-#include "split_pattern_table.h"
-#include "vk/vk_backend.h"
+#include "analysis/buffer_compare.h"
+#include "kernels/classic/classic_ffd.h"
+#include <sffd/error.h>
+#include "kernels/pn/pn_triangles.h"
+#include "kernels/clip/regular_clip.h"
+#include "kernels/smooth/smooth_deform.h"
+#include "kernels/clip/split_pattern_table.h"
+#include "backends/vulkan/vk_backend.h"
 
 using namespace sffd;
 

@@ -11,7 +11,7 @@
 
 namespace sffd {
 
-// Arithmetic variant of a kernel (see shaders/common/prelude.glsl).
+// Arithmetic variant of a kernel (see kernels/common/prelude.glsl).
 struct KernelVariant {
   bool strict = false;   // every operation precise, fixed order: bit-identical across APIs
   bool f64 = false;      // double-precision arithmetic and storage
@@ -37,7 +37,7 @@ struct DeviceInfo {
 
 using BufferId = uint32_t;
 
-// A storage buffer range bound at a binding slot of the kernel (slot numbers from shaders/common/layout.h).
+// A storage buffer range bound at a binding slot of the kernel (slot numbers from kernels/common/layout.h).
 struct BufferBinding {
   uint32_t slot = 0;
   BufferId buffer = 0;

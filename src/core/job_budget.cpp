@@ -1,4 +1,4 @@
-#include "job_budget.h"
+#include "core/job_budget.h"
 
 #include <algorithm>
 #include <charconv>
@@ -9,8 +9,8 @@
 #include <fstream>
 #include <unistd.h>
 
-#include "error.h"
-#include "shader_layout.h"
+#include <sffd/error.h>
+#include "kernels/common/shader_layout.h"
 
 namespace sffd {
 

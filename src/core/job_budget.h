@@ -7,9 +7,9 @@
 #include <optional>
 #include <string>
 
-#include "backend.h"
-#include "lattice_pack.h"
-#include "mesh.h"
+#include "core/backend.h"
+#include "model/lattice_pack.h"
+#include "model/mesh.h"
 
 namespace sffd {
 

@@ -1,8 +1,8 @@
-#include "kernel_registry.h"
+#include "core/kernel_registry.h"
 
 #include <algorithm>
 
-#include "shader_layout.h"
+#include "kernels/common/shader_layout.h"
 
 namespace sffd {
 

@@ -8,7 +8,7 @@
 #include <string>
 #include <string_view>
 
-#include "backend.h"
+#include "core/backend.h"
 
 namespace sffd {
 

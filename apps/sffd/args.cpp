@@ -1,0 +1,137 @@
+#include <charconv>
+#include <cmath>
+#include <sstream>
+
+#include "apps/sffd/cli.h"
+#include <sffd/error.h>
+
+namespace sffd::cli {
+namespace {
+
+Error usage(const std::string& what) { return Error(ErrorKind::Input, what); }
+
+// Canonical long name and aliases of an option spec ("--output|-o").
+std::vector<std::string> namesOf(const OptionSpec& o) {
+  std::vector<std::string> names;
+  std::stringstream ss(o.name);
+  std::string n;
+  while (std::getline(ss, n, '|')) names.push_back(n);
+  return names;
+}
+
+const OptionSpec* findOption(const CommandSpec& spec, const std::string& arg, std::string& canonical) {
+  for (const OptionSpec& o : spec.options) {
+    auto names = namesOf(o);
+    for (const std::string& n : names)
+      if (n == arg) {
+        canonical = names.front();
+        return &o;
+      }
+  }
+  return nullptr;
+}
+
+}  // namespace
+
+ParsedArgs parseArgs(const CommandSpec& spec, int argc, char** argv) {
+  ParsedArgs a;
+  a.command = &spec;
+  for (int i = 0; i < argc; ++i) {
+    std::string arg = argv[i];
+    if (arg.size() > 1 && arg[0] == '-' && !(arg.size() > 1 && (std::isdigit(arg[1]) || arg[1] == '.'))) {
+      std::string value;
+      size_t eq = arg.find('=');
+      bool inlineValue = arg.rfind("--", 0) == 0 && eq != std::string::npos;
+      if (inlineValue) {
+        value = arg.substr(eq + 1);
+        arg = arg.substr(0, eq);
+      }
+      std::string canonical;
+      const OptionSpec* o = findOption(spec, arg, canonical);
+      if (!o) throw usage("unknown option '" + arg + "' for 'sffd " + spec.name + "' (see sffd " + spec.name + " --help)");
+      if (o->value) {
+        if (!inlineValue) {
+          if (i + 1 >= argc) throw usage("option " + canonical + " needs a value (" + o->value + ")");
+          value = argv[++i];
+        }
+        a.values[canonical] = value;
+      } else {
+        if (inlineValue) throw usage("option " + canonical + " takes no value");
+        a.values[canonical] = "1";
+      }
+    } else {
+      a.positional.push_back(arg);
+    }
+  }
+  if (a.has("--help")) return a;
+  if (a.positional.size() < spec.minPositional || a.positional.size() > spec.maxPositional)
+    throw usage(std::string("usage: sffd ") + spec.name + " " + spec.usage);
+  return a;
+}
+
+std::string ParsedArgs::get(const std::string& name, const std::string& fallback) const {
+  auto it = values.find(name);
+  return it == values.end() ? fallback : it->second;
+}
+
+std::string ParsedArgs::requireValue(const std::string& name) const {
+  auto it = values.find(name);
+  if (it == values.end()) throw usage("option " + name + " is required (usage: sffd " + command->name + " " + command->usage + ")");
+  return it->second;
+}
+
+double ParsedArgs::getDouble(const std::string& name, double fallback) const {
+  auto it = values.find(name);
+  if (it == values.end()) return fallback;
+  const std::string& s = it->second;
+  double v = 0;
+  auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (ec != std::errc() || p != s.data() + s.size() || !std::isfinite(v))
+    throw usage("option " + name + " needs a finite number, not '" + s + "'");
+  return v;
+}
+
+int ParsedArgs::getInt(const std::string& name, int fallback) const {
+  auto it = values.find(name);
+  if (it == values.end()) return fallback;
+  const std::string& s = it->second;
+  int v = 0;
+  auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (ec != std::errc() || p != s.data() + s.size()) throw usage("option " + name + " needs an integer, not '" + s + "'");
+  return v;
+}
+
+std::array<int, 3> ParsedArgs::getTriple(const std::string& name, std::array<int, 3> fallback) const {
+  auto it = values.find(name);
+  if (it == values.end()) return fallback;
+  std::array<int, 3> r{};
+  std::stringstream ss(it->second);
+  std::string part;
+  int n = 0;
+  while (std::getline(ss, part, ',')) {
+    int v = 0;
+    auto [p, ec] = std::from_chars(part.data(), part.data() + part.size(), v);
+    if (n >= 3 || ec != std::errc() || p != part.data() + part.size())
+      throw usage("option " + name + " needs three integers like 5,5,5, not '" + it->second + "'");
+    r[n++] = v;
+  }
+  if (n == 1) r = {r[0], r[0], r[0]};
+  else if (n != 3) throw usage("option " + name + " needs three integers like 5,5,5, not '" + it->second + "'");
+  return r;
+}
+
+std::string helpText(const CommandSpec& spec) {
+  std::ostringstream o;
+  o << "usage: sffd " << spec.name << " " << spec.usage << "\n" << spec.summary << "\n\noptions:\n";
+  for (const OptionSpec& opt : spec.options) {
+    std::string left = std::string("  ") + opt.name + (opt.value ? std::string(" ") + opt.value : "");
+    o << left << std::string(left.size() < 30 ? 30 - left.size() : 1, ' ') << opt.help << "\n";
+  }
+  return o.str();
+}
+
+void note(const ParsedArgs& args, const std::string& line) {
+  if (!args.has("--quiet")) fprintf(stderr, "sffd: %s\n", line.c_str());
+}
+
+}  // namespace sffd::cli

@@ -1,0 +1,96 @@
+// The command-line layer: each command is one CommandSpec (its options documented in one line
+// each) in its own file, registered in main.cpp.
+#pragma once
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "backends/backend_select.h"
+#include "model/lattice.h"
+#include "model/mesh.h"
+
+namespace sffd::cli {
+
+struct OptionSpec {
+  const char* name;    // "--backend" (a short alias follows after '|': "--output|-o")
+  const char* value;   // placeholder of its value, nullptr for a flag
+  const char* help;    // one line
+};
+
+struct ParsedArgs;
+
+struct CommandSpec {
+  const char* name;
+  const char* usage;     // after "sffd NAME "
+  const char* summary;   // one line
+  std::vector<OptionSpec> options;
+  int (*run)(const ParsedArgs& args);
+  size_t minPositional = 0, maxPositional = 1;
+};
+
+struct ParsedArgs {
+  const CommandSpec* command = nullptr;
+  std::vector<std::string> positional;
+  std::map<std::string, std::string> values;   // by canonical long name
+  bool has(const std::string& name) const { return values.count(name) > 0; }
+  std::string get(const std::string& name, const std::string& fallback = "") const;
+  double getDouble(const std::string& name, double fallback) const;
+  int getInt(const std::string& name, int fallback) const;
+  std::array<int, 3> getTriple(const std::string& name, std::array<int, 3> fallback) const;
+  std::string requireValue(const std::string& name) const;
+};
+
+// Throws an input Error for unknown options, missing values and wrong positional counts.
+ParsedArgs parseArgs(const CommandSpec& spec, int argc, char** argv);
+std::string helpText(const CommandSpec& spec);
+
+// Options shared by the commands that run a job, as OptionSpecs to splice into a command's list.
+std::vector<OptionSpec> jobOptions();
+
+// A mesh and lattice loaded as the options say (--normalize, .npy conventions, --degree).
+struct Job {
+  std::string meshPath, latticePath;
+  Mesh mesh;
+  Lattice lattice;
+  std::optional<double> normalizedTo;   // the --normalize scale applied to the mesh
+};
+Job loadJob(const ParsedArgs& args);
+
+// Centers the mesh on its bounding box and scales it so its largest half-extent is `scale`.
+void normalizeMesh(Mesh& mesh, double scale);
+void meshBounds(const Mesh& mesh, glm::dvec3& lo, glm::dvec3& hi);
+
+// Refuses an output path that is one of the inputs (nothing is ever written over an input).
+void checkOutputPath(const std::string& out, const std::vector<std::string>& inputs);
+
+// Opens the backend the options ask for, printing fallback notes unless --quiet.
+OpenedBackend openBackendFromArgs(const ParsedArgs& args);
+
+// --precision auto|float|double resolved for a backend (auto: double where the device has it).
+bool wantDouble(const ParsedArgs& args, const DeviceInfo& info, bool autoDouble);
+
+void note(const ParsedArgs& args, const std::string& line);   // stderr unless --quiet
+
+// Refuses a target edge length that is not positive, or so small that the sub-triangles would
+// exceed kMaxSubTriangles (the message gives the estimate).
+constexpr double kMaxSubTriangles = 50e6;
+void checkEdgeLength(const Mesh& mesh, double l);
+
+// Picture options shared by render and view (cmd_render.cpp): --width/--height in 16..8192 pixels,
+// --view AZIMUTH,ELEVATION in degrees. Throw an input Error otherwise.
+int sizeOption(const ParsedArgs& args, const char* name, int fallback);
+void parseView(const std::string& text, double& az, double& el);
+
+// The commands, one file each.
+CommandSpec deformCommand();
+CommandSpec latticeCommand();
+CommandSpec devicesCommand();
+CommandSpec conformCommand();
+CommandSpec clipCommand();
+CommandSpec errorCommand();
+CommandSpec renderCommand();
+CommandSpec benchCommand();
+CommandSpec viewCommand();   // cmd_view.cpp (src/view)
+
+}  // namespace sffd::cli

@@ -1,0 +1,250 @@
+// sffd bench MESH -l LATTICE: per-stage times of smooth FFD (the paper's Tables 1 and 2) on each
+// backend asked. GPU backends run the device-resident DeformSession, the path `view` uses: the
+// pre-compute (PN + clip) and the deform stage are timed apart, from GPU timestamps (Vulkan
+// timestamp queries, GL timestamp pairs) with the host wall time beside them; the first,
+// cold run (kernel compilation) is reported apart; then --warmup runs, then --repeat timed runs.
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <map>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "apps/sffd/cli.h"
+#include "apps/sffd/deform_job.h"
+#include "pipelines/deform_session.h"
+#include <sffd/error.h>
+#include "kernels/clip/knot_box_clip.h"
+#include "model/lattice_pack.h"
+#include "model/mesh_topology.h"
+#include "pipelines/patch_output.h"
+#include "kernels/pn/pn_triangles.h"
+#include "kernels/clip/regular_clip.h"
+#include "kernels/smooth/smooth_deform.h"
+#include "kernels/clip/split_pattern_table.h"
+#include "core/wall_clock.h"
+
+namespace sffd::cli {
+namespace {
+
+double peakRssMb() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return double(u.ru_maxrss) / 1024.0;   // KiB on Linux
+}
+
+// Samples of one named quantity over the timed runs.
+struct Series {
+  std::map<std::string, std::vector<double>> values;
+  std::vector<std::string> order;   // first-seen order, for the output
+  void add(const std::string& key, double ms) {
+    if (!values.count(key)) order.push_back(key);
+    values[key].push_back(ms);
+  }
+};
+
+nlohmann::ordered_json summary(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  double median = v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+  return {{"median", median}, {"min", v.front()}, {"max", v.back()}};
+}
+
+struct BenchSettings {
+  DeformSessionOptions session;
+  int warmup = 2, repeat = 20;
+};
+
+struct BackendResult {
+  std::string label, device;
+  double coldMs = 0;          // first pre-compute + deform, compilation included
+  Series stages, host;        // GPU (or CPU) stage times; host wall times
+  size_t subTriangles = 0;
+  double peakRss = 0;
+};
+
+void addStages(Series& s, const SessionTimings& pre, const SessionTimings& def) {
+  s.add("pn", pre.pnMs);
+  s.add("clip", pre.clipMs);
+  s.add("deform", def.deformMs);
+  s.add("total", pre.pnMs + pre.clipMs + def.deformMs);
+  std::map<std::string, double> steps;
+  for (const DispatchTiming& d : def.dispatches)
+    if (d.label.find('.') != std::string::npos) steps[d.label] += std::max(d.gpuMs, 0.0);
+  for (const auto& [k, v] : steps) s.add(k, v);
+}
+
+BackendResult benchGpu(OpenedBackend& b, const Job& job, const BenchSettings& S) {
+  BackendResult r;
+  r.label = b.label;
+  r.device = b.info.name;
+  auto t0 = std::chrono::steady_clock::now();
+  DeformSession session(*b.gpu, job.mesh, job.lattice, S.session);
+  session.deform(job.lattice);
+  r.coldMs = msSince(t0);
+  r.subTriangles = session.subTriangles();
+  for (int i = 0; i < S.warmup + S.repeat; ++i) {
+    SessionTimings p = session.precompute();
+    SessionTimings d = session.deform(job.lattice);
+    if (i < S.warmup) continue;
+    addStages(r.stages, p, d);
+    r.host.add("precompute", p.wallMs);
+    r.host.add("deform", d.wallMs);
+  }
+  r.peakRss = peakRssMb();
+  return r;
+}
+
+// The CPU reference (one thread, double or the strict float order), timed by wall clock.
+BackendResult benchCpu(const Job& job, const BenchSettings& S) {
+  BackendResult r;
+  r.label = "cpu";
+  r.device = std::string("CPU reference, ") + (S.session.variant.f64 ? "double" : "float") + ", " +
+             std::to_string(cpuThreadCount()) + " threads";
+  const DeformSessionOptions& o = S.session;
+  Mesh mesh = job.mesh;
+  if (!mesh.normalsFromFile) applyCreaseAngle(mesh, o.creaseAngleDeg);
+  PreparedMesh prepared = prepareMesh(mesh);
+  ClipTriangles clip = o.knotBoxClip ? ClipTriangles{} : buildClipTriangles(mesh, o.edgeLength, splitPatternTable().nmax());
+  std::vector<SubTriangle> knotBox = o.knotBoxClip ? clipAgainstKnotBoxes(mesh, job.lattice) : std::vector<SubTriangle>{};
+  FitTable fit = makeFitTable(o.samples);
+  auto once = [&](bool record) {
+    auto t0 = std::chrono::steady_clock::now();
+    PnOutput pn = pnTrianglesCpu(prepared, o.variant);
+    SubTriangleRecords subs = o.knotBoxClip ? recordsFromSubTriangles(prepared, pn, knotBox, o.variant)
+                                            : regularClipCpu(prepared, pn, clip, o.edgeLength, o.variant);
+    double preMs = msSince(t0);
+    SmoothOutput out = smoothDeformCpu(packLattice(job.lattice), subs, fit, o.level, o.variant);
+    r.subTriangles = subs.size();
+    if (!record) return;
+    r.stages.add("pn", pn.wallMs);
+    r.stages.add("clip", subs.wallMs);
+    r.stages.add("deform", out.wallMs);
+    r.stages.add("total", pn.wallMs + subs.wallMs + out.wallMs);
+    r.host.add("precompute", preMs);
+    r.host.add("deform", out.wallMs);
+  };
+  auto t0 = std::chrono::steady_clock::now();
+  once(false);
+  r.coldMs = msSince(t0);
+  for (int i = 0; i < S.warmup + S.repeat; ++i) once(i >= S.warmup);
+  r.peakRss = peakRssMb();
+  return r;
+}
+
+int run(const ParsedArgs& args) {
+  args.requireValue("--lattice");
+  if (args.get("--method", "smooth") != "smooth")
+    throw Error(ErrorKind::Input, "bench measures --method smooth (the stages pn, clip, deform)");
+  std::string clipName = args.get("--clip", "regular");
+  if (clipName != "regular" && clipName != "knot-box") throw Error(ErrorKind::Input, "--clip must be regular or knot-box");
+  BenchSettings S;
+  S.repeat = args.getInt("--repeat", 20);
+  S.warmup = args.getInt("--warmup", 2);
+  if (S.repeat < 1 || S.repeat > 100000) throw Error(ErrorKind::Input, "--repeat must be 1..100000");
+  if (S.warmup < 0 || S.warmup > 100000) throw Error(ErrorKind::Input, "--warmup must be 0..100000");
+  Job job = loadJob(args);
+  DeformSessionOptions& o = S.session;
+  o.variant.strict = args.has("--strict");
+  o.level = tessLevel(args);
+  if (o.level < 1 || o.level > 64) throw Error(ErrorKind::Input, "--tess must be 1..64");
+  o.edgeLength = edgeLengthOf(args, job.mesh);
+  checkEdgeLength(job.mesh, o.edgeLength);
+  o.samples = std::max(3, args.getInt("--samples", job.lattice.degree[0] + job.lattice.degree[1] + job.lattice.degree[2]));
+  o.knotBoxClip = clipName == "knot-box";
+  o.split = args.has("--split");
+  o.creaseAngleDeg = args.getDouble("--crease-angle", 40.0);
+  if (args.get("--precision", "float") == "double") o.variant.f64 = true;
+  else if (args.get("--precision", "float") != "float") throw Error(ErrorKind::Input, "--precision must be float or double");
+
+  std::vector<std::string> names;
+  std::stringstream ss(args.get("--backends", "vulkan,gl"));
+  for (std::string n; std::getline(ss, n, ',');)
+    if (!n.empty()) names.push_back(n);
+  if (names.empty()) throw Error(ErrorKind::Input, "--backends names no backend");
+
+  std::vector<BackendResult> results;
+  for (const std::string& name : names) {
+    if (name == "cpu") {
+      results.push_back(benchCpu(job, S));
+      continue;
+    }
+    BackendRequest req;
+    req.name = name;
+    req.device = args.get("--device");
+    std::vector<std::string> notes;
+    OpenedBackend b = openBackend(req, &notes);
+    if (!b.gpu) throw Error(ErrorKind::Device, "backend '" + name + "' gave no GPU device");
+    results.push_back(benchGpu(b, job, S));
+  }
+
+  const size_t subs = results.empty() ? 0 : results.front().subTriangles;
+  std::string meshName = job.meshPath.substr(job.meshPath.find_last_of('/') + 1);
+  if (args.has("--json")) {
+    nlohmann::ordered_json j = {{"mesh", meshName},
+                                {"method", "smooth"},
+                                {"clip", clipName},
+                                {"edge_length", o.edgeLength},
+                                {"tess", o.level},
+                                {"input_triangles", job.mesh.triangles.size()},
+                                {"sub_triangles", subs},
+                                {"output_triangles", subs * size_t(tessTriangleCount(o.level))},
+                                {"runs", nlohmann::ordered_json::array()}};
+    for (const BackendResult& r : results) {
+      nlohmann::ordered_json run = {{"backend", r.label}, {"device", r.device}, {"repeat", S.repeat},
+                                    {"cold_first_dispatch_ms", r.coldMs}};
+      nlohmann::ordered_json stages = nlohmann::ordered_json::object(), host = nlohmann::ordered_json::object();
+      for (const std::string& k : r.stages.order) stages[k] = summary(r.stages.values.at(k));
+      for (const std::string& k : r.host.order) host[k] = summary(r.host.values.at(k));
+      run["stages_ms"] = stages;
+      run["host_wall_ms"] = host;
+      run["peak_rss_mb"] = r.peakRss;
+      j["runs"].push_back(run);
+    }
+    std::printf("%s\n", j.dump(1).c_str());
+    return 0;
+  }
+  std::printf("%s: smooth FFD, %zu triangles -> %zu sub-triangles (l = %g, %s clipping) -> %zu output triangles (level %d)\n",
+              meshName.c_str(), job.mesh.triangles.size(), subs, o.edgeLength, clipName.c_str(),
+              subs * size_t(tessTriangleCount(o.level)), o.level);
+  std::printf("median of %d runs after %d warm-up, min..max in brackets; GPU timestamps (cpu: wall clock)\n", S.repeat, S.warmup);
+  for (const BackendResult& r : results) {
+    std::printf("%-10s %s\n", r.label.c_str(), r.device.c_str());
+    auto line = [&](const Series& s, const std::string& k) {
+      nlohmann::ordered_json m = summary(s.values.at(k));
+      std::printf("  %-20s %9.3f ms  [%.3f .. %.3f]\n", k.c_str(), m["median"].get<double>(), m["min"].get<double>(),
+                  m["max"].get<double>());
+    };
+    for (const std::string& k : r.stages.order) line(r.stages, k);
+    for (const std::string& k : r.host.order) {
+      nlohmann::ordered_json m = summary(r.host.values.at(k));
+      std::printf("  host %-15s %9.3f ms  [%.3f .. %.3f]\n", k.c_str(), m["median"].get<double>(), m["min"].get<double>(),
+                  m["max"].get<double>());
+    }
+    std::printf("  cold first run       %9.3f ms   peak RSS %.1f MiB\n", r.coldMs, r.peakRss);
+  }
+  return 0;
+}
+
+}  // namespace
+
+CommandSpec benchCommand() {
+  std::vector<OptionSpec> options;
+  for (const OptionSpec& o : jobOptions()) {
+    std::string n = o.name;
+    if (n == "--backend" || n == "--stats" || n == "--method" || n.rfind("--precision", 0) == 0) continue;
+    options.push_back(o);
+  }
+  options.insert(options.begin() + 1, {"--backends", "LIST", "comma-separated backends to time: vulkan, gl, gl-egl, gl-osmesa, cpu (default vulkan,gl)"});
+  options.insert(options.begin() + 2, {"--repeat", "N", "timed runs per backend (default 20); the median, min and max are reported"});
+  options.insert(options.begin() + 3, {"--warmup", "N", "untimed runs after the cold first run (default 2)"});
+  options.insert(options.begin() + 4, {"--json", nullptr, "print the results as JSON (CONTRACT.md) instead of a table"});
+  options.insert(options.begin() + 5, {"--method", "NAME", "smooth (the only method with the pn, clip and deform stages)"});
+  options.insert(options.begin() + 6, {"--precision", "NAME", "float (default) or double kernels"});
+  return CommandSpec{"bench", "MESH -l LATTICE [--backends LIST] [--repeat N] [--json]",
+                     "Times the stages of smooth FFD (pn, clip, deform) on each backend asked.", options, run, 1, 1};
+}
+
+}  // namespace sffd::cli

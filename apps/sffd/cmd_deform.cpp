@@ -1,0 +1,96 @@
+// sffd deform MESH -l LATTICE -o OUT: deforms a mesh and writes the result with vertex normals.
+#include <chrono>
+#include <cstdio>
+#include <optional>
+
+#include <nlohmann/json.hpp>
+
+#include "io/atomic_file.h"
+#include "kernels/classic/classic_ffd.h"
+#include "apps/sffd/cli.h"
+#include <sffd/error.h>
+#include "apps/sffd/deform_job.h"
+#include "core/job_budget.h"
+
+namespace sffd::cli {
+namespace {
+
+// The patch file (docs/CLI.md "Patch files"): a header line, then per patch its parent triangle and
+// 10 geometry and 10 normal control points of the cubic triangular Bezier patch, one per line.
+void writePatchFile(const std::string& path, const DeformRun& run) {
+  const size_t n = run.patches->patchCount();
+  writeFileAtomically(path, [&](std::ostream& o) {
+    char line[128];
+    o << "sffd-patches 1 " << n << " 3\n";
+    for (size_t p = 0; p < n; ++p) {
+      o << "patch " << run.patches->parent[p] << "\n";
+      for (int k = 0; k < 20; ++k) {
+        const double* c = &run.patchControlPoints[(p * 20 + k) * 4];
+        int digits = run.variant.f64 ? 17 : 9;
+        std::snprintf(line, sizeof line, "%.*g %.*g %.*g\n", digits, c[0], digits, c[1], digits, c[2]);
+        o << line;
+      }
+    }
+  });
+}
+
+int run(const ParsedArgs& args) {
+  std::string out = args.requireValue("--output");
+  args.requireValue("--lattice");
+  std::string method = args.get("--method", "smooth");
+  if (method != "smooth" && method != "accurate" && method != "classic")
+    throw Error(ErrorKind::Input, "--method must be smooth, accurate or classic, not '" + method + "'");
+  std::string clip = args.get("--clip", "regular");
+  if (clip != "regular" && clip != "knot-box") throw Error(ErrorKind::Input, "--clip must be regular or knot-box");
+  auto opt = [&](const char* o) { return args.has(o) ? std::optional<std::string>(args.get(o)) : std::nullopt; };
+  checkSizeOptions(opt("--edge-length"), opt("--tess"));   // docs/ROBUSTNESS.md "Limits"
+  checkOutputPath(out, {args.positional[0], args.get("--lattice")});
+  if (args.has("--stats")) checkOutputPath(args.get("--stats"), {args.positional[0], args.get("--lattice"), out});
+  if (args.has("--patches")) checkOutputPath(args.get("--patches"), {args.positional[0], args.get("--lattice"), out});
+
+  auto t0 = std::chrono::steady_clock::now();
+  Job job = loadJob(args);
+  OpenedBackend backend = openBackendFromArgs(args);
+  DeformRun run = runDeformJob(args, job, backend);
+  Mesh& deformed = run.mesh;
+  writeMesh(out, deformed, run.variant.f64 ? 17 : 9);
+  if (args.has("--patches")) {
+    if (run.patchControlPoints.empty()) throw Error(ErrorKind::Input, "--patches needs --method smooth");
+    writePatchFile(args.get("--patches"), run);
+  }
+  double totalMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+
+  if (args.has("--stats")) {
+    nlohmann::ordered_json j = {
+        {"backend", backend.label},
+        {"device", backend.info.name},
+        {"method", run.method},
+        {"clip", run.clip},
+        {"precision", run.variant.f64 ? "double" : "float"},
+        {"strict", run.variant.strict},
+        {"input", {{"vertices", job.mesh.positions.size()}, {"triangles", job.mesh.triangles.size()}}},
+        {"sub_triangles", run.subTriangles},
+        {"output", {{"vertices", deformed.positions.size()}, {"triangles", deformed.triangles.size()}}},
+        {"timings_ms", {{"pn", run.pnMs}, {"clip", run.clipMs}, {"deform", run.deformMs}, {"total", totalMs}}},
+    };
+    for (const auto& [step, ms] : run.stepMs) j["timings_ms"][step] = ms;
+    std::string text = j.dump(1) + "\n";
+    writeFileAtomically(args.get("--stats"), [&](std::ostream& o) { o << text; });
+  }
+  note(args, "wrote " + out + " (" + std::to_string(deformed.triangles.size()) + " triangles, " + backend.label + ", " +
+                 backend.info.name + ")");
+  return 0;
+}
+
+}  // namespace
+
+CommandSpec deformCommand() {
+  CommandSpec c{"deform", "MESH -l LATTICE -o OUT [options]",
+                "Deforms a mesh by a lattice and writes the result (.obj .ply .off .stl) with vertex normals.",
+                jobOptions(), run, 1, 1};
+  c.options.insert(c.options.begin() + 1, {"--output|-o", "FILE", "output mesh (.obj .ply .off .stl)"});
+  c.options.insert(c.options.begin() + 2, {"--patches", "FILE", "smooth: also write the Bezier patches (docs/CLI.md)"});
+  return c;
+}
+
+}  // namespace sffd::cli

@@ -1,0 +1,83 @@
+// sffd error MESH -l LATTICE [--json]: geometry, normal and volume error of a method against the exact
+// FFD of the same surface points (src/analysis/error_metrics.h, docs/ACCURACY.md "Error metrics").
+#include <cstdio>
+#include <optional>
+
+#include <nlohmann/json.hpp>
+
+#include "apps/sffd/cli.h"
+#include "apps/sffd/deform_job.h"
+#include <sffd/error.h>
+#include "analysis/error_metrics.h"
+#include "core/job_budget.h"
+
+namespace sffd::cli {
+namespace {
+
+nlohmann::ordered_json statsJson(const ErrorStats& s) { return {{"avg", s.avg}, {"max", s.max}, {"std", s.std}}; }
+
+int run(const ParsedArgs& args) {
+  args.requireValue("--lattice");
+  std::string method = args.get("--method", "smooth");
+  if (method != "smooth" && method != "accurate" && method != "classic")
+    throw Error(ErrorKind::Input, "--method must be smooth, accurate or classic, not '" + method + "'");
+  std::string clip = args.get("--clip", "regular");
+  if (clip != "regular" && clip != "knot-box") throw Error(ErrorKind::Input, "--clip must be regular or knot-box");
+  auto opt = [&](const char* o) { return args.has(o) ? std::optional<std::string>(args.get(o)) : std::nullopt; };
+  checkSizeOptions(opt("--edge-length"), opt("--tess"));
+
+  Job job = loadJob(args);
+  OpenedBackend backend = openBackendFromArgs(args);
+  DeformRun run = runDeformJob(args, job, backend);
+  // job.mesh as the method used it (its triangles are the patches' parents).
+  PackedLattice packed = packLattice(job.lattice);
+  PatchVertices classicTess;
+  const PatchVertices* samples = run.patches ? &*run.patches : nullptr;
+  if (!samples) {
+    classicTess = linearPatchVertices(run.mesh, args.getInt("--tess", 10));
+    samples = &classicTess;
+  }
+  ErrorReport rep = measureErrors(job.mesh, packed, *samples);
+  rep.volume = measureVolume(job.mesh, job.lattice, run.mesh);
+
+  if (args.has("--json")) {
+    nlohmann::ordered_json j = {
+        {"method", run.method},
+        {"clip", run.clip},
+        {"vertices", rep.vertices},
+        {"geometry", statsJson(rep.geometry)},
+        {"normal_deg", statsJson(rep.normalDeg)},
+        {"volume", rep.volume ? nlohmann::ordered_json{{"reference", rep.volume->reference},
+                                                       {"result", rep.volume->result},
+                                                       {"rel_error", rep.volume->relError}}
+                              : nlohmann::ordered_json(nullptr)},
+        {"sub_triangles", run.subTriangles},
+        {"backend", backend.label},
+        {"precision", run.variant.f64 ? "double" : "float"},
+    };
+    std::printf("%s\n", j.dump(1).c_str());
+  } else {
+    std::printf("%s FFD (%s clipping) against exact FFD, %zu tessellation vertices (%s, %s)\n", run.method.c_str(),
+                run.method == "classic" ? "no" : run.clip.c_str(), rep.vertices, backend.label.c_str(),
+                run.variant.f64 ? "double" : "float");
+    std::printf("  geometry    avg %.6g  max %.6g  std %.6g\n", rep.geometry.avg, rep.geometry.max, rep.geometry.std);
+    std::printf("  normal deg  avg %.6g  max %.6g  std %.6g\n", rep.normalDeg.avg, rep.normalDeg.max, rep.normalDeg.std);
+    if (rep.volume)
+      std::printf("  volume      reference %.10g  result %.10g  rel_error %.6g\n", rep.volume->reference, rep.volume->result,
+                  rep.volume->relError);
+    else
+      std::printf("  volume      none (the mesh is open)\n");
+  }
+  return 0;
+}
+
+}  // namespace
+
+CommandSpec errorCommand() {
+  CommandSpec c{"error", "MESH -l LATTICE [--json] [options]",
+                "Geometry, normal and volume error of a method against the exact (accurate) FFD.", jobOptions(), run, 1, 1};
+  c.options.insert(c.options.begin() + 1, {"--json", nullptr, "print the result as JSON"});
+  return c;
+}
+
+}  // namespace sffd::cli

@@ -1,0 +1,142 @@
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include "apps/sffd/cli.h"
+#include <sffd/error.h>
+#include "io/lattice_io.h"
+
+namespace sffd::cli {
+namespace fs = std::filesystem;
+
+std::vector<OptionSpec> jobOptions() {
+  return {
+      {"--lattice|-l", "FILE", "lattice: .json (native), .prm (PyGeM) or .npy (reference implementation)"},
+      {"--backend", "NAME", "auto|vulkan|gl|gl-egl|gl-osmesa|gl-glfw|cpu (auto: Vulkan, then GL, then CPU)"},
+      {"--device", "SUBSTRING", "use the first device whose name contains SUBSTRING"},
+      {"--method", "NAME", "smooth|accurate|classic (default smooth)"},
+      {"--clip", "NAME", "regular|knot-box sub-triangle clipping (default regular)"},
+      {"--edge-length", "L", "target sub-triangle edge length l, in model units"},
+      {"--tess", "N", "tessellation level of each patch (default 10)"},
+      {"--split", nullptr, "smooth: run the deform steps as separate dispatches (per-step timings in --stats)"},
+      {"--samples", "S", "smooth: sampling density s of the fit (default nu+nv+nw; 6 is the reference implementation's)"},
+      {"--crease-angle", "DEG", "crease threshold for meshes without normals (default 40)"},
+      {"--bpt-resolution", "N", ".bpt input: grid segments per patch side (default 10: 200 triangles a patch)"},
+      {"--normalize", "S", "center the mesh on its box and scale its largest half-extent to S (.npy: 0.99)"},
+      {"--degree", "U,V,W", ".npy lattices: B-spline degree per axis (default 2,2,2)"},
+      {"--precision", "NAME", "auto|float|double kernel arithmetic (auto: double for classic where supported)"},
+      {"--strict", nullptr, "strict kernels: bit-identical across GL, Vulkan and the CPU reference"},
+      {"--stats", "FILE", "write run statistics as JSON"},
+      {"--quiet", nullptr, "no notes on stderr"},
+      {"--help|-h", nullptr, "show this help"},
+  };
+}
+
+void meshBounds(const Mesh& mesh, glm::dvec3& lo, glm::dvec3& hi) {
+  lo = glm::dvec3(std::numeric_limits<double>::infinity());
+  hi = -lo;
+  for (const auto& p : mesh.positions) {
+    lo = glm::min(lo, p);
+    hi = glm::max(hi, p);
+  }
+}
+
+void normalizeMesh(Mesh& mesh, double scale) {
+  if (mesh.positions.empty()) return;
+  glm::dvec3 lo, hi;
+  meshBounds(mesh, lo, hi);
+  glm::dvec3 c = (lo + hi) * 0.5;
+  double half = std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z}) * 0.5;
+  double f = half > 0 ? scale / half : 1.0;
+  for (auto& p : mesh.positions) p = (p - c) * f;
+  for (auto& patch : mesh.patches)
+    for (auto& p : patch.points) p = (p - c) * f;
+}
+
+Job loadJob(const ParsedArgs& args) {
+  Job job;
+  job.meshPath = args.positional.at(0);
+  job.latticePath = args.requireValue("--lattice");
+  MeshReadOptions read;
+  if (args.has("--bpt-resolution")) {
+    read.bptResolution = args.getInt("--bpt-resolution", 10);
+    if (read.bptResolution < 1 || read.bptResolution > 1000) throw Error(ErrorKind::Input, "--bpt-resolution must be 1..1000");
+  }
+  job.mesh = readMesh(job.meshPath, read);
+  std::string ext = fs::path(job.latticePath).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
+  if (args.has("--normalize")) {
+    double s = args.getDouble("--normalize", 1.0);
+    if (!(s > 0)) throw Error(ErrorKind::Input, "--normalize needs a positive scale");
+    job.normalizedTo = s;
+  } else if (ext == ".npy") {
+    job.normalizedTo = 0.99;   // the reference implementation's convention
+  }
+  if (job.normalizedTo) normalizeMesh(job.mesh, *job.normalizedTo);
+  LatticeReadOptions lo;
+  lo.npyDegree = args.getTriple("--degree", {2, 2, 2});
+  meshBounds(job.mesh, lo.meshBoxLo, lo.meshBoxHi);
+  // .npy (reference implementation): the body box is the model's box normalised into [-1,1]^3 and
+  // the model itself sits at the --normalize scale inside it (0.99: strictly inside). The shared
+  // identity lattice t_control_points0.npy is exactly the Greville lattice of that box.
+  if (ext == ".npy" && job.normalizedTo) {
+    lo.meshBoxLo /= *job.normalizedTo;
+    lo.meshBoxHi /= *job.normalizedTo;
+  }
+  lo.haveMeshBox = !job.mesh.positions.empty();
+  job.lattice = readLattice(job.latticePath, lo);
+  return job;
+}
+
+void checkOutputPath(const std::string& out, const std::vector<std::string>& inputs) {
+  std::error_code ec;
+  // Fail before any work when the output cannot be written where asked.
+  fs::path dir = fs::path(out).parent_path();
+  if (dir.empty()) dir = ".";
+  if (!fs::is_directory(dir, ec)) throw Error(ErrorKind::Input, out + ": cannot write: no such directory");
+  if (fs::is_directory(out, ec)) throw Error(ErrorKind::Input, out + ": cannot write: is a directory");
+  for (const std::string& in : inputs) {
+    if (in.empty()) continue;
+    if (fs::weakly_canonical(out, ec) == fs::weakly_canonical(in, ec) || (fs::exists(out) && fs::equivalent(out, in, ec)))
+      throw Error(ErrorKind::Input, out + ": output path is an input file; refusing to overwrite it");
+  }
+}
+
+OpenedBackend openBackendFromArgs(const ParsedArgs& args) {
+  BackendRequest r;
+  r.name = args.get("--backend", "auto");
+  r.device = args.get("--device");
+  std::vector<std::string> notes;
+  OpenedBackend b = openBackend(r, &notes);
+  for (const std::string& n : notes) note(args, n);
+  return b;
+}
+
+void checkEdgeLength(const Mesh& mesh, double l) {
+  if (!(l > 0) || !std::isfinite(l)) throw Error(ErrorKind::Input, "--edge-length must be a positive number");
+  // A near-regular split gives about area / (sqrt(3)/4 l^2) sub-triangles, and at least one a triangle.
+  double area = 0;
+  for (const auto& t : mesh.triangles)
+    area += 0.5 * glm::length(glm::cross(mesh.positions[t[1]] - mesh.positions[t[0]], mesh.positions[t[2]] - mesh.positions[t[0]]));
+  double estimate = area / (std::sqrt(3.0) / 4 * l * l) + double(mesh.triangles.size());
+  if (estimate > kMaxSubTriangles) {
+    char buf[200];
+    std::snprintf(buf, sizeof buf, "--edge-length %g would make about %.3g sub-triangles, above the limit of %.3g", l,
+                  estimate, kMaxSubTriangles);
+    throw Error(ErrorKind::Input, buf);
+  }
+}
+
+bool wantDouble(const ParsedArgs& args, const DeviceInfo& info, bool autoDouble) {
+  std::string p = args.get("--precision", "auto");
+  if (p == "float") return false;
+  if (p == "double") {
+    if (!info.limits.float64) throw deviceError(info.name + " has no double-precision shader support");
+    return true;
+  }
+  if (p != "auto") throw Error(ErrorKind::Input, "--precision must be auto, float or double");
+  return autoDouble && info.limits.float64;
+}
+
+}  // namespace sffd::cli

@@ -1,0 +1,60 @@
+// sffd: smooth free-form deformation on any GPU. Dispatches to the commands and turns every failure
+// into one "sffd: error: ..." line and the documented exit status (CONTRACT.md).
+#include <cstdio>
+#include <cstring>
+#include <new>
+#include <string>
+
+#include "apps/sffd/cli.h"
+#include <sffd/error.h>
+
+using namespace sffd;
+
+// Every message is one printable line, whatever a file name or a token in it holds (CONTRACT.md).
+static std::string oneLine(const char* what) {
+  std::string s(what);
+  for (char& c : s)
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+  return s;
+}
+
+static std::vector<cli::CommandSpec> commands() {
+  return {cli::deformCommand(), cli::latticeCommand(), cli::devicesCommand(), cli::conformCommand(), cli::clipCommand(),
+          cli::errorCommand(),
+          cli::renderCommand(), cli::benchCommand(),
+          cli::viewCommand()};
+}
+
+static void usage(FILE* f) {
+  std::fprintf(f, "usage: sffd <command> [options]   (sffd <command> --help for its options)\n\ncommands:\n");
+  for (const auto& c : commands()) std::fprintf(f, "  %-9s %s\n", c.name, c.summary);
+}
+
+int main(int argc, char** argv) {
+  try {
+    if (argc < 2) throw Error(ErrorKind::Input, "no command given (sffd --help lists them)");
+    if (!std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h")) {
+      usage(stdout);
+      return 0;
+    }
+    for (const auto& c : commands()) {
+      if (c.name != std::string(argv[1])) continue;
+      cli::ParsedArgs args = cli::parseArgs(c, argc - 2, argv + 2);
+      if (args.has("--help")) {
+        std::fputs(cli::helpText(c).c_str(), stdout);
+        return 0;
+      }
+      return c.run(args);
+    }
+    throw Error(ErrorKind::Input, std::string("unknown command '") + argv[1] + "' (sffd --help lists them)");
+  } catch (const Error& e) {
+    std::fprintf(stderr, "sffd: error: %s\n", oneLine(e.what()).c_str());
+    return e.exitStatus();
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "sffd: error: out of memory\n");
+    return 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "sffd: error: %s\n", oneLine(e.what()).c_str());
+    return 1;
+  }
+}

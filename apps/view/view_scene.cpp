@@ -1,0 +1,216 @@
+// Scene (view_scene.h): the deformation paths of the viewer and what each gives the renderer.
+#include "apps/view/view_scene.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include <glad/gl.h>
+
+#include <sffd/error.h>
+#include "analysis/error_metrics.h"
+#include "backends/opengl/gl_backend.h"
+#include "model/lattice_pack.h"
+#include "model/mesh_topology.h"
+#include "core/wall_clock.h"
+
+namespace sffd::view {
+
+std::vector<float> geometryErrors(const Mesh& input, const Lattice& lattice, const PatchVertices& pv) {
+  PackedLattice packed = packLattice(lattice);
+  ExactReference ref(input, packed);
+  std::vector<float> out(pv.vertexCount());
+  const size_t nv = size_t(tessVertexCount(pv.level));
+  for (size_t v = 0; v < pv.vertexCount(); ++v) {
+    glm::dvec3 x, n, xr, nr;
+    ref.preImage(pv.parent[v / nv], glm::dvec3(pv.lamParent[3 * v], pv.lamParent[3 * v + 1], pv.lamParent[3 * v + 2]), x, n);
+    ref.deform(x, n, xr, nr);
+    out[v] = float(glm::length(glm::dvec3(pv.position[3 * v], pv.position[3 * v + 1], pv.position[3 * v + 2]) - xr));
+  }
+  return out;
+}
+
+Scene::Scene(gl::Renderer& renderer, Backend* gpu, bool zeroCopy, Mesh mesh, HostDeform host,
+             std::optional<DeformSessionOptions> sessionOptions, int level)
+    : renderer_(renderer),
+      gpu_(gpu),
+      zeroCopy_(zeroCopy && gpu),
+      sessionMesh_(std::move(mesh)),
+      host_(std::move(host)),
+      sessionOptions_(std::move(sessionOptions)),
+      level_(level) {
+  if (sessionOptions_) {
+    creasedMesh_ = sessionMesh_;
+    applyCreaseAngle(creasedMesh_, sessionOptions_->creaseAngleDeg);   // as the session does
+  }
+  glm::dvec3 lo(1e300), hi(-1e300);
+  for (const auto& p : sessionMesh_.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
+  if (!sessionMesh_.positions.empty()) normalLength_ = float(0.03 * glm::length(hi - lo));
+}
+
+Scene::~Scene() {
+  session_.reset();
+  try {
+    renderer_.context().activate();
+    if (hostTess_) glDeleteBuffers(1, &hostTess_);
+    if (sessionIndex_) glDeleteBuffers(1, &sessionIndex_);
+  } catch (...) {
+  }
+}
+
+std::string Scene::path() const { return path_; }
+
+bool Scene::sessionUsable(const Lattice&, const SceneSettings& s) const {
+  return s.method == "smooth" && sessionOptions_ && gpu_;
+}
+
+void Scene::update(const Lattice& lattice, const SceneSettings& settings,
+                   const std::function<void(const std::string&)>& progress) {
+  const auto t0 = std::chrono::steady_clock::now();
+  if (sessionUsable(lattice, settings)) {
+    const bool knotBox = settings.clip == "knot-box";
+    if (!session_ || knotBox != sessionClipKnotBox_ || !sameLatticeStructure(lattice, sessionLattice_)) {
+      if (progress)
+        progress("PREPARING: PN TRIANGLES AND " + std::string(knotBox ? "KNOT-BOX" : "REGULAR") + " CLIPPING OF " +
+                 std::to_string(sessionMesh_.triangles.size()) + " TRIANGLES");
+      session_.reset();
+      sessionRecords_.reset();
+      DeformSessionOptions o = *sessionOptions_;
+      o.knotBoxClip = knotBox;
+      session_ = std::make_unique<DeformSession>(*gpu_, sessionMesh_, lattice, o);
+      sessionLattice_ = lattice;
+      sessionClipKnotBox_ = knotBox;
+      times_.pnMs = session_->timings().pnMs;
+      times_.clipMs = session_->timings().clipMs;
+    }
+    const SessionTimings& t = session_->deform(lattice);
+    times_.deformMs = t.deformMs;
+    subTriangles_ = session_->subTriangles();
+    if (zeroCopy_ && !settings.heatmap) {
+      drawSession({});
+      path_ = "zero-copy";
+    } else {
+      if (!sessionRecords_) sessionRecords_ = session_->records();
+      PatchVertices pv = patchVerticesOf(*sessionRecords_, session_->output());
+      drawHost(creasedMesh_, lattice, settings.heatmap ? Mesh{} : weldPatchVertices(pv), pv, settings);
+      path_ = "session+copy";
+    }
+  } else {
+    if (progress && !drawn_.positions.size()) progress("PREPARING: " + settings.method + " FFD");
+    HostResult r = host_(lattice, settings.method, settings.clip);
+    times_.pnMs = r.pnMs;
+    times_.clipMs = r.clipMs;
+    times_.deformMs = r.deformMs;
+    subTriangles_ = r.patches ? r.patches->patchCount() : 0;
+    drawHost(r.input, lattice, std::move(r.mesh), r.patches, settings);
+    path_ = "host";
+  }
+  times_.updateMs = msSince(t0);
+}
+
+void Scene::drawHost(const Mesh& input, const Lattice& lattice, Mesh mesh, const std::optional<PatchVertices>& patches,
+                     const SceneSettings& settings) {
+  drawingSession_ = false;
+  std::vector<float> scalars;
+  if (settings.heatmap) {
+    PatchVertices hp = patches ? *patches : linearPatchVertices(mesh, level_);
+    scalars = geometryErrors(input, lattice, hp);
+    result_ = patches ? weldPatchVertices(*patches) : mesh;
+    if (!patches) uploadTess(linearPatchVertices(mesh, 1));
+    drawn_ = unweldedPatchMesh(hp);
+  } else {
+    if (!patches) uploadTess(linearPatchVertices(mesh, 1));
+    result_ = mesh;
+    drawn_ = std::move(mesh);
+  }
+  if (patches) uploadTess(*patches);
+  renderer_.setItems({{&drawn_, scalars, ""}});
+  outputTriangles_ = drawn_.triangles.size();
+}
+
+void Scene::uploadTess(const PatchVertices& pv) {
+  renderer_.context().activate();
+  const size_t nv = size_t(tessVertexCount(pv.level));
+  std::vector<float> data(pv.patchCount() * 2 * nv * 4, 0.0f);
+  for (size_t p = 0; p < pv.patchCount(); ++p)
+    for (size_t v = 0; v < nv; ++v) {
+      const size_t src = 3 * (p * nv + v);
+      float* pos = &data[(2 * nv * p + v) * 4];
+      float* nor = &data[(2 * nv * p + nv + v) * 4];
+      for (int c = 0; c < 3; ++c) pos[c] = float(pv.position[src + c]), nor[c] = float(pv.normal[src + c]);
+    }
+  if (!hostTess_) glGenBuffers(1, &hostTess_);
+  glBindBuffer(GL_ARRAY_BUFFER, hostTess_);
+  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(data.size() * sizeof(float)), data.data(), GL_DYNAMIC_DRAW);
+  glBindBuffer(GL_ARRAY_BUFFER, 0);
+  tess_ = {{hostTess_, pv.patchCount(), pv.level}};
+}
+
+void Scene::drawSession(std::vector<glm::vec3> fitPoints) {
+  renderer_.context().activate();
+  // The deform kernel wrote the buffers as storage; they are read as vertex attributes next.
+  glMemoryBarrier(GL_VERTEX_ATTRIB_ARRAY_BARRIER_BIT | GL_ELEMENT_ARRAY_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+  const auto& chunks = session_->chunks();
+  const int L = session_->level();
+  const size_t nv = size_t(tessVertexCount(L)), nt = size_t(tessTriangleCount(L));
+  size_t maxCount = 0;
+  for (const auto& c : chunks) maxCount = std::max(maxCount, c.count);
+  if (maxCount > sessionIndexPatches_) {
+    // One index list for every chunk: patch p's triangles at vertex offset 2 * nv * p.
+    std::vector<uint32_t> local = tessTriangles(L), all;
+    all.reserve(maxCount * local.size());
+    for (size_t p = 0; p < maxCount; ++p)
+      for (uint32_t i : local) all.push_back(uint32_t(2 * nv * p + i));
+    if (!sessionIndex_) glGenBuffers(1, &sessionIndex_);
+    glBindBuffer(GL_ARRAY_BUFFER, sessionIndex_);
+    glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(all.size() * 4), all.data(), GL_STATIC_DRAW);
+    glBindBuffer(GL_ARRAY_BUFFER, 0);
+    sessionIndexPatches_ = maxCount;
+  }
+  gl::BufferItem item;
+  item.fitPoints = std::move(fitPoints);
+  tess_.clear();
+  outputTriangles_ = 0;
+  for (const auto& c : chunks) {
+    const unsigned buffer = gl::glBufferObject(*gpu_, c.tess);
+    if (!buffer) throw Error(ErrorKind::Internal, "view: the session's buffer is not a GL buffer of the window");
+    item.draws.push_back({buffer, sessionIndex_, 0, nv * 16, c.count * nt * 3});
+    tess_.push_back({buffer, c.count, L});
+    outputTriangles_ += c.count * nt;
+  }
+  renderer_.setBufferItem(item);
+  drawingSession_ = true;
+}
+
+std::vector<glm::vec3> Scene::resultPoints() {
+  std::vector<glm::vec3> pts;
+  if (drawingSession_) {
+    SmoothOutput out = session_->output();
+    const size_t nv = size_t(tessVertexCount(out.level));
+    const size_t patches = out.tess.size() / (2 * nv * 4);
+    pts.reserve(patches * nv);
+    for (size_t p = 0; p < patches; ++p)
+      for (size_t v = 0; v < nv; ++v) {
+        const double* x = &out.tess[(2 * nv * p + v) * 4];
+        pts.push_back(glm::vec3(float(x[0]), float(x[1]), float(x[2])));
+      }
+  } else {
+    pts.reserve(drawn_.positions.size());
+    for (const auto& p : drawn_.positions) pts.push_back(glm::vec3(p));
+  }
+  return pts;
+}
+
+void Scene::prepareFit() {
+  if (drawingSession_) drawSession(resultPoints());
+}
+
+Mesh Scene::resultMesh() {
+  if (drawingSession_) {
+    if (!sessionRecords_) sessionRecords_ = session_->records();
+    return weldPatchVertices(patchVerticesOf(*sessionRecords_, session_->output()));
+  }
+  return result_;
+}
+
+}  // namespace sffd::view

@@ -1,0 +1,382 @@
+#include "kernels/accurate/accurate_patches.h"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <mutex>
+
+#include <sffd/error.h>
+#include "core/job_budget.h"
+#include "kernels/common/lattice_eval.h"
+#include "core/wall_clock.h"
+
+namespace sffd {
+
+void triangleMultiIndex(int n, int idx, int& i, int& j, int& k) {
+  int r = 0;
+  while ((r + 1) * (r + 2) / 2 <= idx) ++r;
+  int t = idx - r * (r + 1) / 2;
+  i = n - r;
+  j = r - t;
+  k = t;
+}
+
+namespace {
+
+long double factorialL(int n) {
+  long double f = 1;
+  for (int i = 2; i <= n; ++i) f *= i;
+  return f;
+}
+
+long double powL(long double x, int e) {
+  long double r = 1;
+  for (int i = 0; i < e; ++i) r *= x;
+  return r;
+}
+
+// B^n_{ijk} at the barycentrics (a, b, c) / d, in long double.
+long double bernsteinAtLattice(int n, int i, int j, int k, int a, int b, int c, int d) {
+  long double coef = factorialL(n) / (factorialL(i) * factorialL(j) * factorialL(k));
+  return coef * powL((long double)a / d, i) * powL((long double)b / d, j) * powL((long double)c / d, k);
+}
+
+std::vector<long double> interpolationMatrixL(int n) {
+  const int m = triangleControlPoints(n);
+  std::vector<long double> A(size_t(m) * m);
+  for (int l = 0; l < m; ++l) {
+    int a, b, c;
+    triangleMultiIndex(n, l, a, b, c);
+    for (int k = 0; k < m; ++k) {
+      int i, j, kk;
+      triangleMultiIndex(n, k, i, j, kk);
+      A[size_t(l) * m + k] = bernsteinAtLattice(n, i, j, kk, a, b, c, n);
+    }
+  }
+  return A;
+}
+
+// Gauss-Jordan elimination with partial pivoting, in long double.
+std::vector<double> invert(std::vector<long double> A, int m) {
+  std::vector<long double> X(size_t(m) * m, 0.0L);
+  for (int i = 0; i < m; ++i) X[size_t(i) * m + i] = 1;
+  for (int col = 0; col < m; ++col) {
+    int piv = col;
+    for (int r = col + 1; r < m; ++r)
+      if (std::fabs(A[size_t(r) * m + col]) > std::fabs(A[size_t(piv) * m + col])) piv = r;
+    if (A[size_t(piv) * m + col] == 0) throw Error(ErrorKind::Internal, "interpolation matrix is singular");
+    if (piv != col)
+      for (int c = 0; c < m; ++c) {
+        std::swap(A[size_t(piv) * m + c], A[size_t(col) * m + c]);
+        std::swap(X[size_t(piv) * m + c], X[size_t(col) * m + c]);
+      }
+    long double inv = 1 / A[size_t(col) * m + col];
+    for (int c = 0; c < m; ++c) {
+      A[size_t(col) * m + c] *= inv;
+      X[size_t(col) * m + c] *= inv;
+    }
+    for (int r = 0; r < m; ++r) {
+      if (r == col) continue;
+      long double f = A[size_t(r) * m + col];
+      if (f == 0) continue;
+      for (int c = 0; c < m; ++c) {
+        A[size_t(r) * m + c] -= f * A[size_t(col) * m + c];
+        X[size_t(r) * m + c] -= f * X[size_t(col) * m + c];
+      }
+    }
+  }
+  return std::vector<double>(X.begin(), X.end());
+}
+
+}  // namespace
+
+double triangleBernstein(int n, int i, int j, int k, const glm::dvec3& lambda) {
+  double coef = double(factorialL(n) / (factorialL(i) * factorialL(j) * factorialL(k)));
+  return coef * std::pow(lambda.x, i) * std::pow(lambda.y, j) * std::pow(lambda.z, k);
+}
+
+std::vector<double> interpolationMatrix(int n) {
+  std::vector<long double> A = interpolationMatrixL(n);
+  return std::vector<double>(A.begin(), A.end());
+}
+
+const std::vector<double>& interpolationInverse(int n) {
+  if (n < 1 || n > SFFD_ACC_MAX_DEGREE)
+    throw Error(ErrorKind::Input, "accurate FFD: patch degree " + std::to_string(n) + " is outside 1.." +
+                                      std::to_string(SFFD_ACC_MAX_DEGREE));
+  static std::array<std::vector<double>, SFFD_ACC_MAX_DEGREE + 1> cache;
+  static std::array<std::once_flag, SFFD_ACC_MAX_DEGREE + 1> once;
+  std::call_once(once[n], [n] { cache[n] = invert(interpolationMatrixL(n), triangleControlPoints(n)); });
+  return cache[n];
+}
+
+std::vector<double> tessellationBasis(int n, int L) {
+  const int m = triangleControlPoints(n);
+  std::vector<double> B;
+  B.reserve(size_t(tessVertexCount(L)) * m);
+  for (int r = 0; r <= L; ++r)
+    for (int q = 0; q <= r; ++q)
+      for (int kappa = 0; kappa < m; ++kappa) {
+        int i, j, k;
+        triangleMultiIndex(n, kappa, i, j, k);
+        B.push_back(double(bernsteinAtLattice(n, i, j, k, L - r, r - q, q, L)));
+      }
+  return B;
+}
+
+AccurateJob makeAccurateJob(const Mesh& mesh, const Lattice& lattice, std::vector<SubTriangle> subs, int level) {
+  AccurateJob job;
+  job.degree = lattice.degree[0] + lattice.degree[1] + lattice.degree[2];
+  if (job.degree > SFFD_ACC_MAX_DEGREE)
+    throw Error(ErrorKind::Input, "accurate FFD: patch degree " + std::to_string(job.degree) + " exceeds " +
+                                      std::to_string(SFFD_ACC_MAX_DEGREE));
+  if (level < 1 || level > kMaxTessLevel)
+    throw Error(ErrorKind::Input, "--tess must be an integer 1.." + std::to_string(kMaxTessLevel));
+  job.level = level;
+  job.subs = std::move(subs);
+  constexpr int stride = 4 * SFFD_ACC_CORNER_STRIDE;
+  job.corners.resize(job.subs.size() * stride);
+  for (size_t s = 0; s < job.subs.size(); ++s) {
+    const SubTriangle& T = job.subs[s];
+    const auto& tri = mesh.triangles[T.parent];
+    glm::dvec3 nf = glm::cross(mesh.positions[tri[1]] - mesh.positions[tri[0]], mesh.positions[tri[2]] - mesh.positions[tri[0]]);
+    double len = glm::length(nf);
+    nf = len > 0 ? nf / len : glm::dvec3(0, 0, 1);
+    double* o = &job.corners[stride * s + 12];
+    o[0] = nf.x, o[1] = nf.y, o[2] = nf.z, o[3] = 0;
+    for (int c = 0; c < 3; ++c) {
+      const glm::dvec3& l = T.corners[c].lam;
+      // On a parent edge one weight is 0 and the sum is the same bits from both triangles of the edge
+      // (addition commutes); + 0.0 turns a -0 into +0 so that no coordinate differs only in its sign.
+      glm::dvec3 x = (l.x * mesh.positions[tri[0]] + l.y * mesh.positions[tri[1]]) + l.z * mesh.positions[tri[2]];
+      double* o = &job.corners[stride * s + 4 * c];
+      o[0] = x.x + 0.0, o[1] = x.y + 0.0, o[2] = x.z + 0.0, o[3] = 0;
+    }
+  }
+  return job;
+}
+
+namespace {
+
+// The C++ twin of kernels/accurate/accurate_patches.comp. Keep the two in step, operation for operation.
+template <class Real>
+struct AccurateTwin {
+  const LatticeEvaluator<Real>& eval;
+  const gpu::LatticeParams& L;
+
+  static RVec3<Real> flatPoint(RVec3<Real> c0, RVec3<Real> c1, RVec3<Real> c2, uint32_t i, uint32_t j, uint32_t k, uint32_t d) {
+    Real l0 = Real(i) / Real(d);
+    Real l1 = Real(j) / Real(d);
+    Real l2 = Real(k) / Real(d);
+    return (c0 * l0 + c1 * l1) + c2 * l2;
+  }
+
+  RVec3<Real> latticeValue(RVec3<Real> x) const {
+    LatticeSampleT<Real> S = eval.evaluate(x);
+    if (!S.inside && L.degree.w == SFFD_OUTSIDE_KEEP) return x;
+    return S.value;
+  }
+
+  // One sub-triangle: control points (m), positions and normals (nv) as 4 reals each.
+  void run(const Real* corners, uint32_t n, uint32_t m, uint32_t Lv, const std::vector<Real>& matrix,
+           const std::vector<Real>& basis, double* cpOut, double* posOut, double* nrmOut) const {
+    RVec3<Real> c0{corners[0], corners[1], corners[2]}, c1{corners[4], corners[5], corners[6]},
+        c2{corners[8], corners[9], corners[10]}, nf{corners[12], corners[13], corners[14]};
+    RVec3<Real> cp[SFFD_ACC_MAX_CP];
+    for (uint32_t k = 0; k < m; ++k) cp[k] = RVec3<Real>{};
+    uint32_t l = 0;
+    for (uint32_t r = 0; r <= n; ++r)
+      for (uint32_t q = 0; q <= r; ++q) {
+        RVec3<Real> S = latticeValue(flatPoint(c0, c1, c2, n - r, r - q, q, n));
+        size_t row = size_t(l) * m;
+        for (uint32_t k = 0; k < m; ++k) cp[k] = cp[k] + S * matrix[row + k];
+        ++l;
+      }
+    for (uint32_t k = 0; k < m; ++k) cpOut[4 * k] = cp[k].x, cpOut[4 * k + 1] = cp[k].y, cpOut[4 * k + 2] = cp[k].z, cpOut[4 * k + 3] = 0;
+
+    for (uint32_t r = 0; r <= Lv; ++r)
+      for (uint32_t q = 0; q <= r; ++q) {
+        uint32_t v = r * (r + 1) / 2 + q;
+        uint32_t i = Lv - r, j = r - q, k = q;
+        RVec3<Real> x = flatPoint(c0, c1, c2, i, j, k, Lv);
+        LatticeSampleT<Real> S = eval.evaluate(x);
+        bool keep = !S.inside && L.degree.w == SFFD_OUTSIDE_KEEP;
+        RVec3<Real> pos;
+        if (i == 0 || j == 0 || k == 0) {
+          pos = keep ? x : S.value;
+        } else {
+          size_t b = size_t(v) * m;
+          for (uint32_t kk = 0; kk < m; ++kk) pos = pos + cp[kk] * basis[b + kk];
+        }
+        RVec3<Real> nrm = keep ? nf : eval.cofactorNormal(S, nf);
+        if (!(sdot(nrm, nrm) > Real(0))) nrm = nf;
+        RVec3<Real> un = snormalize(nrm);
+        double* p = posOut + 4 * size_t(v);
+        double* o = nrmOut + 4 * size_t(v);
+        p[0] = pos.x, p[1] = pos.y, p[2] = pos.z, p[3] = 0;
+        o[0] = un.x, o[1] = un.y, o[2] = un.z, o[3] = 0;
+      }
+  }
+};
+
+// A_n^{-1} transposed (sample-major), as the kernel reads it.
+template <class Real>
+std::vector<Real> kernelMatrix(int n) {
+  const std::vector<double>& inv = interpolationInverse(n);
+  const int m = triangleControlPoints(n);
+  std::vector<Real> t(size_t(m) * m);
+  for (int k = 0; k < m; ++k)
+    for (int l = 0; l < m; ++l) t[size_t(l) * m + k] = Real(inv[size_t(k) * m + l]);
+  return t;
+}
+
+template <class Real>
+void accurateCpu(const AccurateJob& job, const PackedLattice& P, AccurateOutput& out) {
+  std::vector<Real> frame = convertReals<Real>(P.frame), coeffs = convertReals<Real>(P.coeffs);
+  LatticeEvaluator<Real> eval(P.params, frame, coeffs);
+  AccurateTwin<Real> twin{eval, P.params};
+  const uint32_t n = uint32_t(job.degree), m = uint32_t(triangleControlPoints(job.degree));
+  const uint32_t Lv = uint32_t(job.level), nv = uint32_t(tessVertexCount(job.level));
+  std::vector<Real> matrix = kernelMatrix<Real>(job.degree);
+  std::vector<Real> basis = convertReals<Real>(tessellationBasis(job.degree, job.level));
+  std::vector<Real> corners = convertReals<Real>(job.corners);
+  const size_t ns = job.count();
+  out.controlPoints.resize(ns * m * 4);
+  out.positions.resize(ns * nv * 4);
+  out.normals.resize(ns * nv * 4);
+  for (size_t s = 0; s < ns; ++s)
+    twin.run(&corners[4 * SFFD_ACC_CORNER_STRIDE * s], n, m, Lv, matrix, basis, &out.controlPoints[4 * m * s], &out.positions[4 * nv * s],
+             &out.normals[4 * nv * s]);
+}
+
+template <class Real>
+void accurateGpu(Backend& backend, const AccurateJob& job, const PackedLattice& P, KernelVariant variant, AccurateOutput& out) {
+  const DeviceLimits& lim = backend.info().limits;
+  const uint32_t n = uint32_t(job.degree), m = uint32_t(triangleControlPoints(job.degree));
+  const uint32_t nv = uint32_t(tessVertexCount(job.level));
+  const size_t ns = job.count();
+  const size_t r4 = 4 * sizeof(Real);
+  // The largest per-sub-triangle binding decides the chunk (positions and normals: nv real4 each).
+  const size_t perSub = std::max<size_t>({SFFD_ACC_CORNER_STRIDE, m, nv}) * r4;
+  size_t chunk = size_t(lim.maxStorageBufferRange / perSub);
+  chunk = std::min<size_t>(chunk, size_t(lim.maxWorkGroupCount[0]) * lim.maxWorkGroupCount[1] * SFFD_LOCAL_SIZE / std::max(m, nv));
+  chunk = std::min<size_t>(chunk, size_t(UINT32_MAX) / std::max(m, nv));   // thread indices are 32-bit
+  if (const char* forced = std::getenv("SFFD_MAX_CHUNK_PATCHES")) chunk = std::min<size_t>(chunk, std::strtoull(forced, nullptr, 10));
+  chunk = std::max<size_t>(1, std::min(chunk, std::max<size_t>(ns, 1)));
+
+  std::vector<Real> frame = convertReals<Real>(P.frame), coeffs = convertReals<Real>(P.coeffs);
+  std::vector<Real> matrix = kernelMatrix<Real>(job.degree);
+  std::vector<Real> basis = convertReals<Real>(tessellationBasis(job.degree, job.level));
+  for (const auto* v : {&coeffs, &matrix, &basis})
+    if (v->size() * sizeof(Real) > lim.maxStorageBufferRange)
+      throw Error(ErrorKind::Input, "accurate FFD: a lattice or patch table does not fit one storage binding on this device");
+  auto upload = [&](const std::vector<Real>& v) {
+    BufferId b = backend.createBuffer(std::max<size_t>(v.size(), 1) * sizeof(Real));
+    if (!v.empty()) backend.upload(b, 0, v.data(), v.size() * sizeof(Real));
+    return b;
+  };
+  BufferId bFrame = upload(frame), bCoeffs = upload(coeffs), bMatrix = upload(matrix), bBasis = upload(basis);
+  BufferId bCorners = backend.createBuffer(chunk * SFFD_ACC_CORNER_STRIDE * r4);
+  BufferId bSamples = backend.createBuffer(chunk * m * r4);
+  BufferId bPatches = backend.createBuffer(chunk * m * r4);
+  BufferId bPos = backend.createBuffer(chunk * nv * r4);
+  BufferId bNrm = backend.createBuffer(chunk * nv * r4);
+
+  out.controlPoints.resize(ns * m * 4);
+  out.positions.resize(ns * nv * 4);
+  out.normals.resize(ns * nv * 4);
+  std::vector<Real> corners(chunk * 4 * SFFD_ACC_CORNER_STRIDE), cps(chunk * m * 4), pos(chunk * nv * 4), nrm(chunk * nv * 4);
+  for (size_t first = 0; first < ns; first += chunk) {
+    const size_t count = std::min(chunk, ns - first);
+    const size_t cw = 4 * SFFD_ACC_CORNER_STRIDE;
+    for (size_t i = 0; i < cw * count; ++i) corners[i] = Real(job.corners[cw * first + i]);
+    backend.upload(bCorners, 0, corners.data(), count * SFFD_ACC_CORNER_STRIDE * r4);
+    // Samples, then control points, then the tessellation: three dispatches, a barrier between each.
+    for (uint32_t stage : {SFFD_ACC_STAGE_SAMPLES, SFFD_ACC_STAGE_PATCHES, SFFD_ACC_STAGE_TESSELLATE}) {
+      gpu::AccurateParams params;
+      params.lattice = P.params;
+      params.range = {0, uint32_t(count), stage, 0};
+      params.shape = {n, m, uint32_t(job.level), nv};
+      Dispatch d;
+      d.kernel = "accurate_patches";
+      d.variant = variant;
+      d.params = &params;
+      d.paramsSize = sizeof(params);
+      d.label = stage == SFFD_ACC_STAGE_SAMPLES ? "accurate_samples" : stage == SFFD_ACC_STAGE_PATCHES ? "accurate_patches" : "accurate_tessellate";
+      d.buffers = {{SFFD_BINDING_LATTICE_COEFFS, bCoeffs},  {SFFD_BINDING_LATTICE_FRAME, bFrame},
+                   {SFFD_BINDING_ACC_MATRIX, bMatrix},      {SFFD_BINDING_ACC_TESS_BASIS, bBasis},
+                   {SFFD_BINDING_ACC_CORNERS, bCorners},    {SFFD_BINDING_ACC_PATCHES, bPatches},
+                   {SFFD_BINDING_ACC_POSITIONS, bPos},      {SFFD_BINDING_ACC_NORMALS, bNrm},
+                   {SFFD_BINDING_ACC_SAMPLES, bSamples}};
+      gridFor(uint64_t(count) * (stage == SFFD_ACC_STAGE_TESSELLATE ? nv : m), lim, d.groups);
+      backend.dispatch(d);
+      backend.barrier();
+    }
+    backend.download(bPatches, 0, cps.data(), count * m * r4);
+    backend.download(bPos, 0, pos.data(), count * nv * r4);
+    backend.download(bNrm, 0, nrm.data(), count * nv * r4);
+    std::copy(cps.begin(), cps.begin() + count * m * 4, out.controlPoints.begin() + first * m * 4);
+    std::copy(pos.begin(), pos.begin() + count * nv * 4, out.positions.begin() + first * nv * 4);
+    std::copy(nrm.begin(), nrm.begin() + count * nv * 4, out.normals.begin() + first * nv * 4);
+  }
+  backend.finish();
+  for (BufferId b : {bFrame, bCoeffs, bMatrix, bBasis, bCorners, bSamples, bPatches, bPos, bNrm}) backend.destroyBuffer(b);
+  out.timings = backend.takeTimings();
+}
+
+}  // namespace
+
+AccurateOutput accurateFfdCpu(const AccurateJob& job, const PackedLattice& lattice, KernelVariant variant) {
+  AccurateOutput out;
+  auto t0 = std::chrono::steady_clock::now();
+  if (variant.f64) accurateCpu<double>(job, lattice, out);
+  else accurateCpu<float>(job, lattice, out);
+  out.wallMs = msSince(t0);
+  out.timings.push_back({"accurate_patches", out.wallMs});
+  return out;
+}
+
+AccurateOutput accurateFfdGpu(Backend& backend, const AccurateJob& job, const PackedLattice& lattice, KernelVariant variant) {
+  if (variant.f64 && !backend.info().limits.float64)
+    throw deviceError(backend.info().name + " has no double-precision shader support; use --precision float");
+  AccurateOutput out;
+  auto t0 = std::chrono::steady_clock::now();
+  if (job.count() > 0) {
+    if (variant.f64) accurateGpu<double>(backend, job, lattice, variant, out);
+    else accurateGpu<float>(backend, job, lattice, variant, out);
+  }
+  out.wallMs = msSince(t0);
+  return out;
+}
+
+PatchVertices accuratePatchVertices(const AccurateJob& job, const AccurateOutput& out) {
+  PatchVertices pv;
+  pv.level = job.level;
+  const int L = job.level, nv = tessVertexCount(L);
+  const size_t ns = job.count();
+  pv.parent.resize(ns);
+  pv.lamParent.resize(ns * nv * 3);
+  pv.position.resize(ns * nv * 3);
+  pv.normal.resize(ns * nv * 3);
+  for (size_t s = 0; s < ns; ++s) {
+    const SubTriangle& T = job.subs[s];
+    pv.parent[s] = T.parent;
+    for (int r = 0; r <= L; ++r)
+      for (int q = 0; q <= r; ++q) {
+        const int v = r * (r + 1) / 2 + q;
+        const double l0 = double(L - r) / L, l1 = double(r - q) / L, l2 = double(q) / L;
+        glm::dvec3 lam = (l0 * T.corners[0].lam + l1 * T.corners[1].lam) + l2 * T.corners[2].lam;
+        const size_t g = s * nv + v;
+        for (int a = 0; a < 3; ++a) {
+          pv.lamParent[3 * g + a] = lam[a];
+          pv.position[3 * g + a] = out.positions[4 * g + a] + 0.0;   // -0 -> +0: welding compares bits
+          pv.normal[3 * g + a] = out.normals[4 * g + a] + 0.0;
+        }
+      }
+  }
+  return pv;
+}
+
+}  // namespace sffd

@@ -1,0 +1,87 @@
+// Accurate FFD (Feng, Heng & Wong 1998; Feng & Peng 2000; ALGORITHM.md 2): the reference method.
+// Every triangle is clipped against the knot boxes (knot_box_clip.h); on each knot-box sub-triangle the
+// lattice volume composed with the flat sub-triangle is a polynomial of total degree n = nu+nv+nw, so it
+// is exactly a triangular Bezier patch of degree n, found by interpolation at the principal lattice:
+// P = A_n^{-1} S, A_n[l][k] = B^n_k(l/n) (linear index order of ALGORITHM.md 0). Each patch is then
+// tessellated at level L (patch_output.h).
+//
+// Runs on a GPU backend (kernel kernels/accurate/accurate_patches.comp, three dispatches per chunk: a thread per
+// sample, per control point and per tessellation vertex, because llvmpipe ends an invocation after
+// 65535 loop iterations in all, which one thread per patch exceeds at --tess 38) or on the CPU reference (the same operations in C++, templated on the arithmetic type: double is the oracle,
+// float in the strict kernels' order matches the strict kernels bit for bit).
+//
+// Tessellation: interior vertices are B^n(lambda)·P. Boundary vertices are R(x_flat(lambda)), the
+// value the patch interpolates exactly there, computed from bits both sub-triangles of a shared edge
+// have, so neighbouring patches share bit-identical boundary vertices and a closed input welds into a
+// closed output. Normals are the patch's geometric normal P_l1 x P_l2, normalised, computed through
+// the identity P_l1 x P_l2 = cof(J) ((c1 - c0) x (c2 - c0)) with the parent's unit face normal (the
+// sub-triangle lies in the parent's plane): differencing the control points of the slivers that
+// knot-box clipping makes would lose all float precision (0.5 degree on sphere.obj in float). The
+// normal keeps the parent's orientation, also where det J < 0. It jumps across sub-triangle edges:
+// accurate FFD shades unsmoothly, which is what smooth FFD is for (ALGORITHM.md 2.2).
+//
+// Exactness: the composition is a polynomial only where the map is one. With OutsideMode::Keep (PyGeM
+// lattices), a sub-triangle that straddles the lattice box is not, and there the patch interpolates
+// the unmoved/moved samples instead of reproducing the map.
+#pragma once
+#include <vector>
+
+#include "core/backend.h"
+#include "model/lattice.h"
+#include "model/lattice_pack.h"
+#include "model/mesh.h"
+#include "pipelines/patch_output.h"
+#include "model/sub_triangles.h"
+
+namespace sffd {
+
+// Number of control points of a triangular Bezier patch of degree n: (n+1)(n+2)/2.
+inline int triangleControlPoints(int n) { return (n + 1) * (n + 2) / 2; }
+// Multi-index (i, j, k) of linear index `idx` in degree n (ALGORITHM.md 0: i = n..0, then j = n-i..0).
+void triangleMultiIndex(int n, int idx, int& i, int& j, int& k);
+// B^n_{ijk}(lambda) = n!/(i!j!k!) l0^i l1^j l2^k.
+double triangleBernstein(int n, int i, int j, int k, const glm::dvec3& lambda);
+
+// A_n, row-major m x m: A[l][k] = B^n_k(l/n), l and k in linear index order.
+std::vector<double> interpolationMatrix(int n);
+// A_n^{-1}, row-major: computed once per n (n = 1..SFFD_ACC_MAX_DEGREE) by Gauss-Jordan elimination
+// with partial pivoting in long double, rounded to double, and cached. Thread-safe.
+const std::vector<double>& interpolationInverse(int n);
+// B^n_k(lambda_v) for every tessellation vertex v of level L (rows of m), in double.
+std::vector<double> tessellationBasis(int n, int level);
+
+// The input of the accurate kernel.
+struct AccurateJob {
+  int degree = 0;                     // patch degree n = nu+nv+nw
+  int level = 10;                     // tessellation level L
+  std::vector<SubTriangle> subs;      // knot-box sub-triangles, each in one knot box
+  // Per sub-triangle SFFD_ACC_CORNER_STRIDE x 4 values: the flat corners sum_i lam_i V_i (x, y, z, 0),
+  // then the parent's unit face normal.
+  std::vector<double> corners;
+  size_t count() const { return subs.size(); }
+};
+
+// Builds the job from sub-triangles (clipAgainstKnotBoxes(mesh, lattice)); throws an input Error when
+// the patch degree exceeds SFFD_ACC_MAX_DEGREE or the level is outside 1..kMaxTessLevel.
+AccurateJob makeAccurateJob(const Mesh& mesh, const Lattice& lattice, std::vector<SubTriangle> subs, int level);
+
+// Kernel outputs, widened to double, 4 values per element (x, y, z, 0).
+struct AccurateOutput {
+  std::vector<double> controlPoints;   // m per sub-triangle
+  std::vector<double> positions;       // (L+1)(L+2)/2 per sub-triangle
+  std::vector<double> normals;         // the same, unit
+  std::vector<DispatchTiming> timings;
+  double wallMs = 0;
+};
+
+// The CPU reference: double arithmetic when variant.f64, else float in the strict kernels' order.
+AccurateOutput accurateFfdCpu(const AccurateJob& job, const PackedLattice& lattice, KernelVariant variant);
+// The GPU kernel, chunked within the device's binding and group-count limits
+// (SFFD_MAX_CHUNK_PATCHES forces smaller chunks, for tests).
+AccurateOutput accurateFfdGpu(Backend& backend, const AccurateJob& job, const PackedLattice& lattice, KernelVariant variant);
+
+// Per patch its parent, per tessellation vertex its pre-image barycentrics in the parent
+// (sum_i lambda_i lam_i), its position and normal.
+PatchVertices accuratePatchVertices(const AccurateJob& job, const AccurateOutput& out);
+
+}  // namespace sffd

@@ -1,0 +1,137 @@
+#include "kernels/classic/classic_ffd.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdlib>
+
+#include <sffd/error.h>
+#include "kernels/common/lattice_eval.h"
+#include "core/wall_clock.h"
+
+namespace sffd {
+namespace {
+
+template <class Real>
+void classicCpu(const Mesh& mesh, const PackedLattice& P, ClassicOutput& out) {
+  std::vector<Real> frame = convertReals<Real>(P.frame), coeffs = convertReals<Real>(P.coeffs);
+  LatticeEvaluator<Real> eval(P.params, frame, coeffs);
+  size_t n = mesh.positions.size();
+  out.positions.resize(4 * n);
+  out.normals.resize(4 * n);
+  for (size_t v = 0; v < n; ++v) {
+    RVec3<Real> x{Real(mesh.positions[v].x), Real(mesh.positions[v].y), Real(mesh.positions[v].z)};
+    RVec3<Real> nr{Real(mesh.normals[v].x), Real(mesh.normals[v].y), Real(mesh.normals[v].z)};
+    LatticeSampleT<Real> S = eval.evaluate(x);
+    RVec3<Real> px = x, pn = nr;
+    Real inside = 0;
+    if (S.inside || P.params.degree.w != SFFD_OUTSIDE_KEEP) {
+      px = S.value;
+      pn = snormalize(eval.cofactorNormal(S, nr));
+      inside = S.inside ? 1 : 0;
+    }
+    double* po = &out.positions[4 * v];
+    double* no = &out.normals[4 * v];
+    po[0] = px.x, po[1] = px.y, po[2] = px.z, po[3] = inside;
+    no[0] = pn.x, no[1] = pn.y, no[2] = pn.z, no[3] = 0;
+  }
+}
+
+template <class Real>
+void classicGpu(Backend& backend, const Mesh& mesh, const PackedLattice& P, KernelVariant variant, ClassicOutput& out) {
+  const DeviceLimits& lim = backend.info().limits;
+  const size_t n = mesh.positions.size();
+  const size_t vertexBytes = 4 * sizeof(Real);
+  // Every binding of a chunk stays within the device's storage range and group-count limits.
+  size_t maxByRange = size_t(lim.maxStorageBufferRange / vertexBytes);
+  size_t maxByGroups = size_t(lim.maxWorkGroupCount[0]) * lim.maxWorkGroupCount[1] * SFFD_LOCAL_SIZE;
+  size_t chunk = std::max<size_t>(1, std::min({maxByRange, maxByGroups, std::max<size_t>(n, 1)}));
+  if (const char* forced = std::getenv("SFFD_MAX_CHUNK_VERTICES")) chunk = std::max<size_t>(1, std::min<size_t>(chunk, std::strtoull(forced, nullptr, 10)));
+
+  std::vector<Real> frame = convertReals<Real>(P.frame), coeffs = convertReals<Real>(P.coeffs);
+  if (coeffs.size() * sizeof(Real) > lim.maxStorageBufferRange)
+    throw Error(ErrorKind::Input, "lattice has too many knot boxes for one storage binding on this device");
+  BufferId bFrame = backend.createBuffer(frame.size() * sizeof(Real));
+  BufferId bCoeffs = backend.createBuffer(coeffs.size() * sizeof(Real));
+  backend.upload(bFrame, 0, frame.data(), frame.size() * sizeof(Real));
+  backend.upload(bCoeffs, 0, coeffs.data(), coeffs.size() * sizeof(Real));
+  BufferId io[4];
+  for (BufferId& b : io) b = backend.createBuffer(chunk * vertexBytes);
+
+  out.positions.resize(4 * n);
+  out.normals.resize(4 * n);
+  std::vector<Real> pos(4 * chunk), nrm(4 * chunk);
+  for (size_t first = 0; first < n; first += chunk) {
+    size_t count = std::min(chunk, n - first);
+    for (size_t i = 0; i < count; ++i) {
+      const glm::dvec3 &x = mesh.positions[first + i], &nn = mesh.normals[first + i];
+      Real* p = &pos[4 * i];
+      Real* q = &nrm[4 * i];
+      p[0] = Real(x.x), p[1] = Real(x.y), p[2] = Real(x.z), p[3] = 1;
+      q[0] = Real(nn.x), q[1] = Real(nn.y), q[2] = Real(nn.z), q[3] = 0;
+    }
+    backend.upload(io[0], 0, pos.data(), count * vertexBytes);
+    backend.upload(io[1], 0, nrm.data(), count * vertexBytes);
+    gpu::ClassicParams params;
+    params.lattice = P.params;
+    params.range = {0, uint32_t(count), 0, 0};
+    Dispatch d;
+    d.kernel = "classic_ffd";
+    d.variant = variant;
+    d.params = &params;
+    d.paramsSize = sizeof(params);
+    d.buffers = {{SFFD_BINDING_LATTICE_COEFFS, bCoeffs}, {SFFD_BINDING_LATTICE_FRAME, bFrame},
+                 {SFFD_BINDING_CLASSIC_POS_IN, io[0]}, {SFFD_BINDING_CLASSIC_NRM_IN, io[1]},
+                 {SFFD_BINDING_CLASSIC_POS_OUT, io[2]}, {SFFD_BINDING_CLASSIC_NRM_OUT, io[3]}};
+    gridFor(count, lim, d.groups);
+    backend.dispatch(d);
+    backend.barrier();
+    backend.download(io[2], 0, pos.data(), count * vertexBytes);
+    backend.download(io[3], 0, nrm.data(), count * vertexBytes);
+    for (size_t i = 0; i < 4 * count; ++i) {
+      out.positions[4 * first + i] = pos[i];
+      out.normals[4 * first + i] = nrm[i];
+    }
+  }
+  backend.finish();
+  for (BufferId b : io) backend.destroyBuffer(b);
+  backend.destroyBuffer(bFrame);
+  backend.destroyBuffer(bCoeffs);
+  out.timings = backend.takeTimings();
+}
+
+}  // namespace
+
+ClassicOutput classicFfdCpu(const Mesh& mesh, const PackedLattice& lattice, KernelVariant variant) {
+  ClassicOutput out;
+  auto t0 = std::chrono::steady_clock::now();
+  if (variant.f64) classicCpu<double>(mesh, lattice, out);
+  else classicCpu<float>(mesh, lattice, out);
+  out.wallMs = msSince(t0);
+  out.timings.push_back({"classic_ffd", out.wallMs});
+  return out;
+}
+
+ClassicOutput classicFfdGpu(Backend& backend, const Mesh& mesh, const PackedLattice& lattice, KernelVariant variant) {
+  if (variant.f64 && !backend.info().limits.float64)
+    throw deviceError(backend.info().name + " has no double-precision shader support; use --precision float");
+  ClassicOutput out;
+  auto t0 = std::chrono::steady_clock::now();
+  if (variant.f64) classicGpu<double>(backend, mesh, lattice, variant, out);
+  else classicGpu<float>(backend, mesh, lattice, variant, out);
+  out.wallMs = msSince(t0);
+  return out;
+}
+
+Mesh applyClassicOutput(const Mesh& input, const ClassicOutput& out) {
+  Mesh m = input;
+  for (size_t v = 0; v < m.positions.size(); ++v) {
+    m.positions[v] = {out.positions[4 * v], out.positions[4 * v + 1], out.positions[4 * v + 2]};
+    m.normals[v] = {out.normals[4 * v], out.normals[4 * v + 1], out.normals[4 * v + 2]};
+  }
+  m.patches.clear();
+  m.vertexPatch.clear();
+  m.vertexUV.clear();
+  return m;
+}
+
+}  // namespace sffd

@@ -1,0 +1,30 @@
+// Classic FFD (Sederberg & Parry 1986; PyGeM, Blender): every vertex and its normal through the lattice
+// volume, nothing else (ALGORITHM.md 6). Runs on a GPU backend (kernel kernels/classic/classic_ffd.comp) or on
+// the CPU reference (lattice_eval.h) with the same inputs and output layout.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "core/backend.h"
+#include "model/lattice_pack.h"
+#include "model/mesh.h"
+
+namespace sffd {
+
+// Output buffers as the kernel writes them, widened to double: 4 values per vertex.
+struct ClassicOutput {
+  std::vector<double> positions;   // x, y, z, inside (1 or 0)
+  std::vector<double> normals;     // x, y, z, 0 (unit)
+  std::vector<DispatchTiming> timings;
+  double wallMs = 0;
+};
+
+// The CPU reference: double arithmetic when variant.f64, else float in the strict kernels' order.
+ClassicOutput classicFfdCpu(const Mesh& mesh, const PackedLattice& lattice, KernelVariant variant);
+// The GPU kernel, chunked within the device's binding and group-count limits.
+ClassicOutput classicFfdGpu(Backend& backend, const Mesh& mesh, const PackedLattice& lattice, KernelVariant variant);
+
+// Copies the deformed positions and normals into a mesh with the input's vertex order and connectivity.
+Mesh applyClassicOutput(const Mesh& input, const ClassicOutput& out);
+
+}  // namespace sffd

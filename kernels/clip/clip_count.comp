@@ -1,0 +1,15 @@
+#version 450
+// Kernel clip_count: per clip triangle, the number of sub-triangles its split pattern makes (the
+// counting pass before the exclusive scan; ALGORITHM.md 4.2 step 5).
+#extension GL_GOOGLE_include_directive : require
+#include "../common/prelude.glsl"
+#include "clip_sites.glsl"
+
+layout(std430, SFFD_SET binding = SFFD_BINDING_CLIP_COUNTS) writeonly buffer Counts { uint counts[]; };
+
+void main() {
+  uint t = sffdThreadIndex();
+  if (t >= params.range.y) return;
+  uint ct = params.range.x + t;
+  counts[ct] = clipSetup(ct).entry.w;
+}

@@ -1,0 +1,249 @@
+// kernels/clip/clip_sites.glsl: regular clipping by the split-pattern table (Lu & Feng; ALGORITHM.md 4.2),
+// shared by the kernels clip_count and clip_write. The C++ twin is kernels/clip/regular_clip.cpp.
+//
+// Crack-freeness rests on three rules: (1) edge lengths and counts are computed from the endpoint with
+// the lower weld id; (2) a boundary vertex's parameter along its edge is read from the table, whose
+// pairs are bit-symmetric (split_pattern_table.h); (3) points on a parent edge are evaluated on that
+// edge's PN curve from its lower-weld endpoint, from data both triangles hold identically.
+#ifndef SFFD_CLIP_GLSL
+#define SFFD_CLIP_GLSL
+
+#include "../pn/pn_eval.glsl"
+
+layout(std140, SFFD_SET binding = SFFD_BINDING_PARAMS) uniform ClipBlock { ClipParams params; };
+layout(std430, SFFD_SET binding = SFFD_BINDING_SPLIT_TABLE) readonly buffer SplitTable { uint splitTable[]; };
+layout(std430, SFFD_SET binding = SFFD_BINDING_MESH_POSITIONS) readonly buffer Positions { real4 positions[]; };
+layout(std430, SFFD_SET binding = SFFD_BINDING_MESH_NORMALS) readonly buffer Normals { real4 normals[]; };
+layout(std430, SFFD_SET binding = SFFD_BINDING_MESH_TRIANGLES) readonly buffer Triangles { uvec4 triangles[]; };
+layout(std430, SFFD_SET binding = SFFD_BINDING_MESH_SLOT_NORMALS) readonly buffer SlotNormals { real4 slotNormals[]; };
+layout(std430, SFFD_SET binding = SFFD_BINDING_PN_OUT) readonly buffer PnRecords { real4 pn[]; };
+layout(std430, SFFD_SET binding = SFFD_BINDING_CLIP_HEADERS) readonly buffer ClipHeaders { uvec4 clipHeaders[]; };
+layout(std430, SFFD_SET binding = SFFD_BINDING_CLIP_REALS) readonly buffer ClipReals { real4 clipReals[]; };
+
+const uint kSlotCp[6] = uint[6](2u, 1u, 3u, 7u, 8u, 5u);
+const uint kEdgeNormalCp[3] = uint[3](1u, 4u, 2u);
+const uint kCornerCp[3] = uint[3](0u, 6u, 9u);
+const uint kCornerNormalCp[3] = uint[3](0u, 3u, 5u);
+
+// The split of one clip triangle: counts, the canonical-to-local corner map and the pattern entry.
+struct ClipSetup {
+  uint perm[3];      // canonical corner m -> local corner
+  bool odd;          // the map reverses the winding
+  uint count[3];     // segments of canonical edges C0C1, C1C2, C2C0
+  uvec4 entry;       // firstVertex, vertexCount, firstTriangle, triangleCount
+};
+
+ClipSetup clipSetup(uint ct) {
+  uvec4 welds = clipHeaders[SFFD_CLIP_HEADER_STRIDE * ct + 1u];
+  real3 corner[3];
+  for (uint c = 0u; c < 3u; ++c) corner[c] = clipReals[SFFD_CLIP_REAL_STRIDE * ct + 3u + c].xyz;
+  uint n[3];
+  uint nmax = params.table.x;
+  for (uint e = 0u; e < 3u; ++e) {
+    uint a = e, b = (e + 1u) % 3u;
+    if (welds[b] < welds[a]) { uint x = a; a = b; b = x; }
+    P real3 d = corner[b] - corner[a];
+    P real len = sqrt(sdot(d, d));
+    P real q = len / real(params.target.x);
+    real segs = ceil(q);
+    n[e] = uint(clamp(segs, real(1), real(nmax)));
+  }
+  // Sort the edges by (count, index): a-edge, b-edge, c-edge.
+  uint ord[3] = uint[3](0u, 1u, 2u);
+  for (uint i = 0u; i < 2u; ++i)
+    for (uint j = 0u; j < 2u - i; ++j) {
+      uint x = ord[j], y = ord[j + 1u];
+      if (n[y] < n[x] || (n[y] == n[x] && y < x)) { ord[j] = y; ord[j + 1u] = x; }
+    }
+  ClipSetup S;
+  uint ea = ord[0], eb = ord[1];
+  if (eb == (ea + 1u) % 3u) {   // C0 C1 C2 = ea, ea+1, ea+2: a rotation
+    S.perm[0] = ea; S.perm[1] = (ea + 1u) % 3u; S.perm[2] = (ea + 2u) % 3u; S.odd = false;
+  } else {                      // C1 is the start of the a-edge: a reflection
+    S.perm[0] = (ea + 1u) % 3u; S.perm[1] = ea; S.perm[2] = (ea + 2u) % 3u; S.odd = true;
+  }
+  S.count[0] = n[ord[0]];
+  S.count[1] = n[ord[1]];
+  S.count[2] = n[ord[2]];
+  // Float lengths of a flat triangle may break a + b >= c by one segment: fall back to c = a + b.
+  uint cc = min(S.count[2], S.count[0] + S.count[1]);
+  uint key = ((S.count[0] - 1u) * nmax + (S.count[1] - 1u)) * nmax + (cc - 1u);
+  S.entry = uvec4(splitTable[4u * key], splitTable[4u * key + 1u], splitTable[4u * key + 2u], splitTable[4u * key + 3u]);
+  return S;
+}
+
+// Where a point lies on the parent: kind 0..2 parent corner, 3..5 on parent edge kind-3 at t (from the
+// edge's lower-weld endpoint), 6 inside at lam.
+struct Site {
+  uint kind;
+  real t;
+  real3 lam;
+};
+
+struct SiteValue {
+  real3 lam, xpn, xflat, nlin, npn;
+};
+
+struct Parent {
+  uint id;
+  uvec4 verts, welds;
+  real3 V[3], N[3];
+};
+
+Parent loadParent(uint id) {
+  Parent p;
+  p.id = id;
+  p.verts = triangles[SFFD_MESH_TRIANGLE_STRIDE * id];
+  p.welds = triangles[SFFD_MESH_TRIANGLE_STRIDE * id + 1u];
+  for (uint c = 0u; c < 3u; ++c) {
+    p.V[c] = positions[p.verts[c]].xyz;
+    p.N[c] = normals[p.verts[c]].xyz;
+  }
+  return p;
+}
+
+// Corners of parent edge e ordered by weld id.
+void edgeEnds(Parent p, uint e, out uint lo, out uint hi) {
+  lo = e;
+  hi = (e + 1u) % 3u;
+  if (p.welds[hi] < p.welds[lo]) { uint x = lo; lo = hi; hi = x; }
+}
+
+uint slotOf(uint corner, uint e) { return corner == e ? 2u * corner + 1u : 2u * corner; }
+
+SiteValue evaluateSite(Parent p, Site s) {
+  SiteValue r;
+  uint base = SFFD_PN_STRIDE * p.id;
+  if (s.kind < 3u) {
+    uint k = s.kind;
+    r.lam = real3(0);
+    r.lam[k] = real(1);
+    r.xpn = p.V[k];
+    r.xflat = p.V[k];
+    r.nlin = p.N[k];
+    r.npn = p.N[k];
+  } else if (s.kind < 6u) {
+    uint e = s.kind - 3u, lo, hi;
+    edgeEnds(p, e, lo, hi);
+    P real t = s.t;
+    P real u = real(1) - t;
+    r.lam = real3(0);
+    r.lam[lo] = u;
+    r.lam[hi] = t;
+    real3 bLo = pn[base + kSlotCp[slotOf(lo, e)]].xyz, bHi = pn[base + kSlotCp[slotOf(hi, e)]].xyz;
+    r.xpn = pnEdgeCurve(p.V[lo], bLo, bHi, p.V[hi], t);
+    P real3 xf = p.V[lo] + (p.V[hi] - p.V[lo]) * t;
+    r.xflat = xf;
+    r.nlin = snormalize(p.N[lo] * u + p.N[hi] * t);
+    r.npn = pnEdgeNormalCurve(p.N[lo], pn[base + SFFD_PN_NORMALS + kEdgeNormalCp[e]].xyz, p.N[hi], t);
+  } else {
+    P real3 l = s.lam;
+    r.lam = l;
+    real w[10];
+    pnCubicWeights(l, w);
+    P real3 x = real3(0);
+    for (uint i = 0u; i < 10u; ++i) x = x + pn[base + i].xyz * w[i];
+    r.xpn = x;
+    P real3 xf = (p.V[0] * l.x + p.V[1] * l.y) + p.V[2] * l.z;
+    r.xflat = xf;
+    P real3 nl = (p.N[0] * l.x + p.N[1] * l.y) + p.N[2] * l.z;
+    r.nlin = snormalize(nl);
+    real q[6];
+    pnQuadraticWeights(l, q);
+    P real3 nn = real3(0);
+    for (uint i = 0u; i < 6u; ++i) nn = nn + pn[base + SFFD_PN_NORMALS + i].xyz * q[i];
+    r.npn = snormalize(nn);
+  }
+  return r;
+}
+
+// Parameter of a site along parent edge e (the site lies on it), from the edge's lower-weld endpoint.
+real siteParamOnEdge(Parent p, Site s, uint e) {
+  uint lo, hi;
+  edgeEnds(p, e, lo, hi);
+  if (s.kind < 3u) return s.kind == lo ? real(0) : real(1);
+  return s.t;
+}
+
+// The neighbouring triangle's PN normal at a point of parent edge e, and whether the edge is a crease
+// there (w = 1). Its normals at the edge's ends are in this triangle's slot records.
+real4 neighbourNormalOnEdge(Parent p, uint e, real t) {
+  uint lo, hi;
+  edgeEnds(p, e, lo, hi);
+  uint sLo = SFFD_SLOT_NORMAL_STRIDE * p.id + 2u * slotOf(lo, e);
+  uint sHi = SFFD_SLOT_NORMAL_STRIDE * p.id + 2u * slotOf(hi, e);
+  real4 fLo = slotNormals[sLo], gLo = slotNormals[sLo + 1u];
+  real4 fHi = slotNormals[sHi], gHi = slotNormals[sHi + 1u];
+  if (fLo.w < real(0.5) && fHi.w < real(0.5)) return real4(0);
+  real3 nLo = gLo.w > real(0.5) ? gLo.xyz : fLo.xyz;   // the one that is not this triangle's own
+  real3 nHi = gHi.w > real(0.5) ? gHi.xyz : fHi.xyz;
+  // At the edge's ends the neighbour's normal is its vertex normal itself, bit for bit, as the
+  // neighbour's own records hold it there.
+  if (t == real(0)) return real4(nLo, 1);
+  if (t == real(1)) return real4(nHi, 1);
+  real3 nMid = pnEdgeNormal(p.V[lo], p.V[hi], nLo, nHi);
+  return real4(pnEdgeNormalCurve(nLo, nMid, nHi, t), 1);
+}
+
+// Site of a corner of the clip triangle.
+Site clipCornerSite(uint ct, uint c) {
+  uint kinds = clipHeaders[SFFD_CLIP_HEADER_STRIDE * ct].y;
+  Site s;
+  s.kind = (kinds >> (8u * c)) & 255u;
+  real4 l = clipReals[SFFD_CLIP_REAL_STRIDE * ct + c];
+  s.lam = l.xyz;
+  s.t = l.w;
+  return s;
+}
+
+// Site of a pattern vertex of the clip triangle. `edge`/`step` come from the table.
+Site patternSite(uint ct, ClipSetup S, uint edge, uint step, real3 lamCanon) {
+  if (edge < 3u && step == 0u) return clipCornerSite(ct, S.perm[edge]);
+  real3 lamLocal;
+  lamLocal[S.perm[0]] = lamCanon.x;
+  lamLocal[S.perm[1]] = lamCanon.y;
+  lamLocal[S.perm[2]] = lamCanon.z;
+  uint base = SFFD_CLIP_REAL_STRIDE * ct;
+  if (edge < 3u) {
+    // On clip edge between local corners a and b: the parameter from the lower-weld end is that
+    // end's partner's weight, bit-identical from both sides (the table's symmetric pairs).
+    uint a = S.perm[edge], b = S.perm[(edge + 1u) % 3u];
+    uvec4 welds = clipHeaders[SFFD_CLIP_HEADER_STRIDE * ct + 1u];
+    uint lo = welds[a] <= welds[b] ? a : b, hi = lo == a ? b : a;
+    P real tl = lamLocal[hi];
+    uint ce = (b == (a + 1u) % 3u) ? a : b;   // local clip edge index (corner ce -> ce+1)
+    real4 ep = clipReals[base + 6u + ce];
+    Site s;
+    if (ep.x >= real(0)) {
+      real tLo = lo == ce ? ep.y : ep.z, tHi = lo == ce ? ep.z : ep.y;
+      s.kind = 3u + uint(ep.x);
+      P real tt = tLo + (tHi - tLo) * tl;
+      s.t = tt;
+      s.lam = real3(0);
+    } else {
+      real3 lamLo = clipReals[base + lo].xyz, lamHi = clipReals[base + hi].xyz;
+      s.kind = 6u;
+      s.t = real(0);
+      P real3 lm = lamLo + (lamHi - lamLo) * tl;
+      s.lam = lm;
+    }
+    return s;
+  }
+  Site s;
+  s.kind = 6u;
+  s.t = real(0);
+  P real3 lm = (clipReals[base].xyz * lamLocal.x + clipReals[base + 1u].xyz * lamLocal.y) + clipReals[base + 2u].xyz * lamLocal.z;
+  s.lam = lm;
+  return s;
+}
+
+// The canonical edge two pattern vertices share (3: none).
+uint sharedCanonicalEdge(uint ea, uint ja, uint eb, uint jb) {
+  if (ea > 2u || eb > 2u) return 3u;
+  if (ea == eb) return ea;
+  if (ja == 0u && eb == (ea + 2u) % 3u) return eb;   // a is corner C_ea, the end of edge ea-1
+  if (jb == 0u && ea == (eb + 2u) % 3u) return ea;
+  return 3u;
+}
+
+#endif

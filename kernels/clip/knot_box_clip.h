@@ -1,0 +1,21 @@
+// Knot-box clipping (Cui & Feng 2015; ALGORITHM.md 2.1): each triangle is cut by the interior knot
+// planes of the lattice into convex pieces that each lie in one knot box, and the pieces are fanned
+// into sub-triangles. The baseline that the improved (regular) clipping replaces, and the first step
+// of accurate FFD.
+#pragma once
+#include <vector>
+
+#include "model/lattice.h"
+#include "model/mesh.h"
+#include "model/sub_triangles.h"
+
+namespace sffd {
+
+// Clips every triangle of `mesh` (positions in world space) by the interior knot planes of
+// `lattice` (in its parameter space: planes p_d = knot, p = frameLinear * x + frameOffset).
+// Watertight: a split point on a parent edge is computed from the edge's endpoint with the lower
+// weldId, so both triangles of a shared edge produce bitwise-identical points. Degenerate fans
+// (zero area in the parameter space) are skipped.
+std::vector<SubTriangle> clipAgainstKnotBoxes(const Mesh& mesh, const Lattice& lattice);
+
+}  // namespace sffd

@@ -1,0 +1,533 @@
+#include "kernels/clip/regular_clip.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <map>
+
+#include "kernels/clip/clip_sites.h"
+#include <sffd/error.h>
+#include "model/lattice_pack.h"
+#include "kernels/clip/split_pattern_table.h"
+#include "core/wall_clock.h"
+
+namespace sffd {
+namespace {
+
+// ---------------------------------------------------------------- pre-split into clip triangles
+
+int segmentCount(const glm::dvec3& a, const glm::dvec3& b, double l) {
+  double q = glm::length(b - a) / l;
+  return q > 1e9 ? 1000000000 : int(std::max(1.0, std::ceil(q)));
+}
+
+struct SplitPoint {
+  uint32_t weld;
+  glm::dvec3 flat;
+};
+
+ClipTriangle parentClipTriangle(const Mesh& mesh, uint32_t t) {
+  ClipTriangle c;
+  c.parent = t;
+  for (int k = 0; k < 3; ++k) {
+    uint32_t v = mesh.triangles[t][k];
+    c.weld[k] = mesh.weldId[v];
+    c.flat[k] = mesh.positions[v];
+    c.corners[k].kind = SubVertexKind(k);
+    c.corners[k].lam = glm::dvec3(0);
+    c.corners[k].lam[k] = 1;
+  }
+  for (int e = 0; e < 3; ++e) {
+    c.parentEdge[e] = e;
+    bool startIsLo = c.weld[e] <= c.weld[(e + 1) % 3];
+    c.edgeParam[e] = startIsLo ? std::array<double, 2>{0, 1} : std::array<double, 2>{1, 0};
+  }
+  return c;
+}
+
+// Bisects clip edge e of c at its split point; returns the two children (same winding).
+std::array<ClipTriangle, 2> bisect(const Mesh& mesh, const ClipTriangle& c, int e, const SplitPoint& sp) {
+  int a = e, b = (e + 1) % 3, o = (e + 2) % 3;
+  SubVertex mid;
+  double tMid = 0;
+  if (c.parentEdge[e] >= 0) {
+    int pe = c.parentEdge[e];
+    tMid = 0.5 * (c.edgeParam[e][0] + c.edgeParam[e][1]);
+    const auto& tri = mesh.triangles[c.parent];
+    int lo = pe, hi = (pe + 1) % 3;
+    if (mesh.weldId[tri[hi]] < mesh.weldId[tri[lo]]) std::swap(lo, hi);
+    mid.kind = SubVertexKind(3 + pe);
+    mid.t = tMid;
+    mid.lam = glm::dvec3(0);
+    mid.lam[lo] = 1 - tMid;
+    mid.lam[hi] = tMid;
+  } else {
+    mid.kind = SubVertexKind::Interior;
+    mid.lam = 0.5 * (c.corners[a].lam + c.corners[b].lam);
+  }
+  // Child 0: (a, mid, o); child 1: (mid, b, o).
+  ClipTriangle c0 = c, c1 = c;
+  c0.weld = {c.weld[a], sp.weld, c.weld[o]};
+  c0.corners = {c.corners[a], mid, c.corners[o]};
+  c0.flat = {c.flat[a], sp.flat, c.flat[o]};
+  c0.parentEdge = {c.parentEdge[e], -1, c.parentEdge[o]};
+  c0.edgeParam = {std::array<double, 2>{c.edgeParam[e][0], tMid}, std::array<double, 2>{0, 0}, c.edgeParam[o]};
+  c1.weld = {sp.weld, c.weld[b], c.weld[o]};
+  c1.corners = {mid, c.corners[b], c.corners[o]};
+  c1.flat = {sp.flat, c.flat[b], c.flat[o]};
+  c1.parentEdge = {c.parentEdge[e], c.parentEdge[b], -1};
+  c1.edgeParam = {std::array<double, 2>{tMid, c.edgeParam[e][1]}, c.edgeParam[b], std::array<double, 2>{0, 0}};
+  return {c0, c1};
+}
+
+}  // namespace
+
+ClipTriangles buildClipTriangles(const Mesh& mesh, double l, int nmax) {
+  ClipTriangles out;
+  uint32_t nextWeld = 0;
+  for (uint32_t w : mesh.weldId) nextWeld = std::max(nextWeld, w + 1);
+  std::map<std::pair<uint32_t, uint32_t>, SplitPoint> splits;   // by the clip edge's weld pair
+  for (uint32_t t = 0; t < mesh.triangles.size(); ++t) {
+    std::vector<ClipTriangle> work = {parentClipTriangle(mesh, t)};
+    bool split = false;
+    for (size_t i = 0; i < work.size();) {
+      ClipTriangle& c = work[i];
+      int worst = -1, worstCount = nmax;
+      double worstLen = 0;
+      for (int e = 0; e < 3; ++e) {
+        int a = e, b = (e + 1) % 3;
+        if (c.weld[b] < c.weld[a]) std::swap(a, b);
+        int n = segmentCount(c.flat[a], c.flat[b], l);
+        double len = glm::length(c.flat[b] - c.flat[a]);
+        if (n > worstCount || (n == worstCount && n > nmax && len > worstLen)) worst = e, worstCount = n, worstLen = len;
+      }
+      if (worst < 0 || out.triangles.size() + work.size() > (size_t(1) << 31)) {
+        ++i;
+        continue;
+      }
+      split = true;
+      uint32_t wa = c.weld[worst], wb = c.weld[(worst + 1) % 3];
+      auto key = std::minmax(wa, wb);
+      auto it = splits.find(key);
+      if (it == splits.end()) {
+        // The split point from the edge's lower-weld end: the neighbour finds the same point here.
+        const glm::dvec3& pLo = wa <= wb ? c.flat[worst] : c.flat[(worst + 1) % 3];
+        const glm::dvec3& pHi = wa <= wb ? c.flat[(worst + 1) % 3] : c.flat[worst];
+        it = splits.emplace(key, SplitPoint{nextWeld++, pLo + (pHi - pLo) * 0.5}).first;
+      }
+      auto kids = bisect(mesh, c, worst, it->second);
+      work[i] = kids[0];
+      work.push_back(kids[1]);
+    }
+    if (split) ++out.presplitParents;
+    out.triangles.insert(out.triangles.end(), work.begin(), work.end());
+  }
+  return out;
+}
+
+// ---------------------------------------------------------------- packed inputs of the clip kernels
+
+PackedClip packClip(const ClipTriangles& clip) {
+  PackedClip P;
+  size_t n = clip.triangles.size();
+  P.headers.assign(8 * n, 0);
+  P.reals.assign(4 * SFFD_CLIP_REAL_STRIDE * n, 0.0);
+  for (size_t i = 0; i < n; ++i) {
+    const ClipTriangle& c = clip.triangles[i];
+    uint32_t kinds = 0;
+    for (int k = 0; k < 3; ++k) kinds |= uint32_t(c.corners[k].kind) << (8 * k);
+    P.headers[8 * i] = c.parent;
+    P.headers[8 * i + 1] = kinds;
+    for (int k = 0; k < 3; ++k) P.headers[8 * i + 4 + k] = c.weld[k];
+    double* r = &P.reals[4 * SFFD_CLIP_REAL_STRIDE * i];
+    for (int k = 0; k < 3; ++k) {
+      const SubVertex& s = c.corners[k];
+      r[4 * k] = s.lam.x, r[4 * k + 1] = s.lam.y, r[4 * k + 2] = s.lam.z, r[4 * k + 3] = s.t;
+      r[4 * (3 + k)] = c.flat[k].x, r[4 * (3 + k) + 1] = c.flat[k].y, r[4 * (3 + k) + 2] = c.flat[k].z;
+      r[4 * (6 + k)] = c.parentEdge[k], r[4 * (6 + k) + 1] = c.edgeParam[k][0], r[4 * (6 + k) + 2] = c.edgeParam[k][1];
+    }
+  }
+  return P;
+}
+
+const PackedTable& packedTable() {
+  static const PackedTable T = [] {
+    const SplitPatternTable& S = splitPatternTable();
+    PackedTable t;
+    t.nmax = uint32_t(S.nmax());
+    for (const SplitPattern& p : S.patterns())
+      t.words.insert(t.words.end(), {p.firstVertex, p.vertexCount, p.firstTriangle, p.triangleCount});
+    t.vertexWord = uint32_t(t.words.size());
+    for (const SplitPatternVertex& v : S.vertices()) {
+      uint32_t w[4];
+      std::memcpy(w, v.lambda, 12);
+      w[3] = uint32_t(v.edge) | (uint32_t(v.step) << 16);
+      t.words.insert(t.words.end(), w, w + 4);
+    }
+    t.triangleWord = uint32_t(t.words.size());
+    auto tri = S.triangles();
+    for (size_t i = 0; i < tri.size(); i += 2)
+      t.words.push_back(uint32_t(tri[i]) | (i + 1 < tri.size() ? uint32_t(tri[i + 1]) << 16 : 0u));
+    return t;
+  }();
+  return T;
+}
+
+namespace {
+
+// ---------------------------------------------------------------- the CPU twin of clip_count / clip_write
+
+template <class Real>
+struct ClipCpu {
+  const PackedTable& table;
+  const std::vector<uint32_t>& meshTriangles;
+  std::vector<Real> positions, normals, slots, pn, clipReals;
+  const std::vector<uint32_t>& clipHeaders;
+  Real l;
+
+  RVec3<Real> v3(const std::vector<Real>& a, size_t i) const { return {a[4 * i], a[4 * i + 1], a[4 * i + 2]}; }
+
+  struct Setup {
+    int perm[3];
+    bool odd;
+    uint32_t count[3];
+    uint32_t entry[4];
+  };
+
+  Setup setup(size_t ct) const {
+    const uint32_t* welds = &clipHeaders[8 * ct + 4];
+    RVec3<Real> corner[3];
+    for (int c = 0; c < 3; ++c) corner[c] = v3(clipReals, SFFD_CLIP_REAL_STRIDE * ct + 3 + c);
+    uint32_t n[3], nmax = table.nmax;
+    for (int e = 0; e < 3; ++e) {
+      int a = e, b = (e + 1) % 3;
+      if (welds[b] < welds[a]) std::swap(a, b);
+      RVec3<Real> d = corner[b] - corner[a];
+      Real len = std::sqrt(sdot(d, d));
+      Real q = len / l;
+      Real segs = std::ceil(q);
+      n[e] = uint32_t(std::clamp(segs, Real(1), Real(nmax)));
+    }
+    int ord[3] = {0, 1, 2};
+    for (int i = 0; i < 2; ++i)
+      for (int j = 0; j < 2 - i; ++j) {
+        int x = ord[j], y = ord[j + 1];
+        if (n[y] < n[x] || (n[y] == n[x] && y < x)) ord[j] = y, ord[j + 1] = x;
+      }
+    Setup S;
+    int ea = ord[0], eb = ord[1];
+    if (eb == (ea + 1) % 3) S.perm[0] = ea, S.perm[1] = (ea + 1) % 3, S.perm[2] = (ea + 2) % 3, S.odd = false;
+    else S.perm[0] = (ea + 1) % 3, S.perm[1] = ea, S.perm[2] = (ea + 2) % 3, S.odd = true;
+    for (int i = 0; i < 3; ++i) S.count[i] = n[ord[i]];
+    uint32_t cc = std::min(S.count[2], S.count[0] + S.count[1]);
+    uint32_t key = ((S.count[0] - 1) * nmax + (S.count[1] - 1)) * nmax + (cc - 1);
+    for (int i = 0; i < 4; ++i) S.entry[i] = table.words[4 * key + i];
+    return S;
+  }
+
+  ParentT<Real> parent(uint32_t id) const {
+    ParentT<Real> p;
+    p.id = id;
+    for (int c = 0; c < 3; ++c) {
+      p.verts[c] = meshTriangles[8 * id + c];
+      p.welds[c] = meshTriangles[8 * id + 4 + c];
+      p.V[c] = v3(positions, p.verts[c]);
+      p.N[c] = v3(normals, p.verts[c]);
+    }
+    p.pn = &pn[size_t(id) * SFFD_PN_STRIDE * 4];
+    p.slot = &slots[size_t(id) * SFFD_SLOT_NORMAL_STRIDE * 4];
+    return p;
+  }
+
+  SiteT<Real> cornerSite(size_t ct, int c) const {
+    SiteT<Real> s;
+    s.kind = (clipHeaders[8 * ct + 1] >> (8 * c)) & 255u;
+    size_t i = SFFD_CLIP_REAL_STRIDE * ct + c;
+    s.lam = v3(clipReals, i);
+    s.t = clipReals[4 * i + 3];
+    return s;
+  }
+
+  SiteT<Real> patternSite(size_t ct, const Setup& S, uint32_t edge, uint32_t step, RVec3<Real> lamCanon) const {
+    if (edge < 3 && step == 0) return cornerSite(ct, S.perm[edge]);
+    RVec3<Real> lamLocal;
+    lamLocal[S.perm[0]] = lamCanon.x;
+    lamLocal[S.perm[1]] = lamCanon.y;
+    lamLocal[S.perm[2]] = lamCanon.z;
+    size_t base = SFFD_CLIP_REAL_STRIDE * ct;
+    SiteT<Real> s;
+    if (edge < 3) {
+      int a = S.perm[edge], b = S.perm[(edge + 1) % 3];
+      const uint32_t* welds = &clipHeaders[8 * ct + 4];
+      int lo = welds[a] <= welds[b] ? a : b, hi = lo == a ? b : a;
+      Real tl = lamLocal[hi];
+      int ce = (b == (a + 1) % 3) ? a : b;
+      const Real* ep = &clipReals[4 * (base + 6 + ce)];
+      if (ep[0] >= Real(0)) {
+        Real tLo = lo == ce ? ep[1] : ep[2], tHi = lo == ce ? ep[2] : ep[1];
+        s.kind = 3 + uint32_t(ep[0]);
+        s.t = tLo + (tHi - tLo) * tl;
+        s.lam = {};
+      } else {
+        RVec3<Real> lamLo = v3(clipReals, base + lo), lamHi = v3(clipReals, base + hi);
+        s.kind = 6;
+        s.t = 0;
+        s.lam = lamLo + (lamHi - lamLo) * tl;
+      }
+      return s;
+    }
+    s.kind = 6;
+    s.t = 0;
+    s.lam = (v3(clipReals, base) * lamLocal.x + v3(clipReals, base + 1) * lamLocal.y) + v3(clipReals, base + 2) * lamLocal.z;
+    return s;
+  }
+
+  static uint32_t sharedCanonicalEdge(uint32_t ea, uint32_t ja, uint32_t eb, uint32_t jb) {
+    if (ea > 2 || eb > 2) return 3;
+    if (ea == eb) return ea;
+    if (ja == 0 && eb == (ea + 2) % 3) return eb;
+    if (jb == 0 && ea == (eb + 2) % 3) return ea;
+    return 3;
+  }
+
+  void write(size_t ct, size_t out0, SubTriangleRecords& R) const {
+    Setup S = setup(ct);
+    ParentT<Real> par = parent(clipHeaders[8 * ct]);
+    for (uint32_t k = 0; k < S.entry[3]; ++k) {
+      uint32_t idx[3], edge[3], step[3];
+      for (int c = 0; c < 3; ++c) {
+        uint32_t i = 3 * (S.entry[2] + k) + c;
+        uint32_t word = table.words[table.triangleWord + i / 2];
+        idx[c] = (i % 2 == 0) ? (word & 65535u) : (word >> 16);
+      }
+      if (S.odd) std::swap(idx[1], idx[2]);
+      SiteT<Real> site[3];
+      SiteValueT<Real> val[3];
+      for (int c = 0; c < 3; ++c) {
+        size_t v = table.vertexWord + 4 * (size_t(S.entry[0]) + idx[c]);
+        float lf[3];
+        std::memcpy(lf, &table.words[v], 12);
+        uint32_t w = table.words[v + 3];
+        edge[c] = w & 255u;
+        step[c] = w >> 16;
+        site[c] = patternSite(ct, S, edge[c], step[c], RVec3<Real>{Real(lf[0]), Real(lf[1]), Real(lf[2])});
+        val[c] = par.evaluate(site[c]);
+      }
+      size_t o = out0 + k;
+      auto parentEdgeOf = [&](int c, int d) {
+        uint32_t ce = sharedCanonicalEdge(edge[c], step[c], edge[d], step[d]);
+        if (ce >= 3) return -1;
+        int a = S.perm[ce], b = S.perm[(ce + 1) % 3];
+        int le = (b == (a + 1) % 3) ? a : b;
+        Real pe = clipReals[4 * (SFFD_CLIP_REAL_STRIDE * ct + 6 + le)];
+        return pe >= Real(0) ? int(pe) : -1;
+      };
+      storeSubTriangle(par, site, val, parentEdgeOf, &R.records[o * SFFD_SUB_STRIDE * 4], &R.headers[4 * o]);
+    }
+  }
+};
+
+template <class Real>
+SubTriangleRecords clipCpu(const PreparedMesh& M, const PnOutput& pn, const ClipTriangles& clip, double l) {
+  PackedClip pc = packClip(clip);
+  ClipCpu<Real> C{packedTable(), M.triangles, convertReals<Real>(M.positions), convertReals<Real>(M.normals),
+                  convertReals<Real>(M.slotNormals), convertReals<Real>(pn.records), convertReals<Real>(pc.reals),
+                  pc.headers, Real(float(l))};
+  size_t n = clip.triangles.size();
+  std::vector<size_t> offsets(n + 1, 0);
+  for (size_t i = 0; i < n; ++i) offsets[i + 1] = offsets[i] + C.setup(i).entry[3];
+  SubTriangleRecords R;
+  R.headers.assign(4 * offsets[n], 0);
+  R.records.assign(offsets[n] * SFFD_SUB_STRIDE * 4, 0.0);
+  for (size_t i = 0; i < n; ++i) C.write(i, offsets[i], R);
+  return R;
+}
+
+
+template <class Real>
+SubTriangleRecords clipGpu(Backend& backend, const PreparedMesh& M, const PnOutput& pn, const ClipTriangles& clip,
+                           double l, KernelVariant variant) {
+  const DeviceLimits& lim = backend.info().limits;
+  const PackedTable& T = packedTable();
+  PackedClip pc = packClip(clip);
+  const size_t n = clip.triangles.size();
+  std::vector<Real> pos = convertReals<Real>(M.positions), nrm = convertReals<Real>(M.normals),
+                    slots = convertReals<Real>(M.slotNormals), rec = convertReals<Real>(pn.records),
+                    reals = convertReals<Real>(pc.reals);
+  auto fits = [&](size_t bytes, const char* what) {
+    if (bytes > lim.maxStorageBufferRange)
+      throw Error(ErrorKind::Input, std::string("the job's ") + what + " (" + std::to_string(bytes >> 20) +
+                                        " MiB) exceed one storage binding on this device (" +
+                                        std::to_string(lim.maxStorageBufferRange >> 20) + " MiB); use a coarser mesh");
+  };
+  fits(pos.size() * sizeof(Real), "vertices");
+  fits(rec.size() * sizeof(Real), "PN records");
+  fits(reals.size() * sizeof(Real), "clip triangles");
+  auto make = [&](const void* data, size_t bytes) {
+    BufferId b = backend.createBuffer(std::max<size_t>(bytes, 16));
+    if (bytes) backend.upload(b, 0, data, bytes);
+    return b;
+  };
+  BufferId bTable = make(T.words.data(), T.words.size() * 4);
+  BufferId bPos = make(pos.data(), pos.size() * sizeof(Real)), bNrm = make(nrm.data(), nrm.size() * sizeof(Real));
+  BufferId bTri = make(M.triangles.data(), M.triangles.size() * 4);
+  BufferId bSlot = make(slots.data(), slots.size() * sizeof(Real)), bPn = make(rec.data(), rec.size() * sizeof(Real));
+  BufferId bHdr = make(pc.headers.data(), pc.headers.size() * 4), bReal = make(reals.data(), reals.size() * sizeof(Real));
+  BufferId bCounts = backend.createBuffer(std::max<size_t>(n * 4, 16));
+
+  gpu::ClipParams params;
+  params.table = {T.nmax, T.vertexWord, T.triangleWord, 0};
+  params.target = {float(l), 0, 0, 0};
+  auto dispatch = [&](const char* kernel, const char* label, size_t first, size_t count, std::vector<BufferBinding> extra) {
+    params.range = {uint32_t(first), uint32_t(count), 0, 0};
+    Dispatch d;
+    d.kernel = kernel;
+    d.label = label;
+    d.variant = variant;
+    d.params = &params;
+    d.paramsSize = sizeof(params);
+    d.buffers = {{SFFD_BINDING_SPLIT_TABLE, bTable}, {SFFD_BINDING_MESH_POSITIONS, bPos}, {SFFD_BINDING_MESH_NORMALS, bNrm},
+                 {SFFD_BINDING_MESH_TRIANGLES, bTri}, {SFFD_BINDING_MESH_SLOT_NORMALS, bSlot}, {SFFD_BINDING_PN_OUT, bPn},
+                 {SFFD_BINDING_CLIP_HEADERS, bHdr}, {SFFD_BINDING_CLIP_REALS, bReal}};
+    d.buffers.insert(d.buffers.end(), extra.begin(), extra.end());
+    gridFor(count, lim, d.groups);
+    backend.dispatch(d);
+    backend.barrier();
+  };
+  // Counting pass, exclusive scan on the host, then the writing pass in chunks whose output fits a binding.
+  std::vector<uint32_t> counts(n);
+  if (n) {
+    dispatch("clip_count", "clip_count", 0, n, {{SFFD_BINDING_CLIP_COUNTS, bCounts}});
+    backend.download(bCounts, 0, counts.data(), n * 4);
+  }
+  std::vector<uint64_t> offsets(n + 1, 0);
+  for (size_t i = 0; i < n; ++i) offsets[i + 1] = offsets[i] + counts[i];
+  const uint64_t total = offsets[n];
+  SubTriangleRecords R;
+  R.headers.resize(4 * total);
+  R.records.resize(total * SFFD_SUB_STRIDE * 4);
+  const uint64_t recordBytes = SFFD_SUB_STRIDE * 4 * sizeof(Real);
+  uint64_t maxSubs = lim.maxStorageBufferRange / recordBytes;
+  if (const char* forced = std::getenv("SFFD_MAX_CHUNK_SUBTRIANGLES")) maxSubs = std::min<uint64_t>(maxSubs, std::strtoull(forced, nullptr, 10));
+  maxSubs = std::max<uint64_t>(maxSubs, 1);
+  uint64_t largest = 0;
+  for (uint32_t c : counts) largest = std::max<uint64_t>(largest, c);
+  maxSubs = std::max(maxSubs, largest);
+  BufferId bSubHdr = backend.createBuffer(std::max<uint64_t>(std::min(maxSubs, total) * 16, 16));
+  BufferId bSubRec = backend.createBuffer(std::max<uint64_t>(std::min(maxSubs, total) * recordBytes, 16));
+  // Each chunk writes from offset 0 of the sub-triangle buffers: its clip triangles' offsets are
+  // stored relative to the chunk's first sub-triangle.
+  std::vector<uint32_t> chunkOffsets(n);
+  std::vector<Real> recs;
+  for (size_t first = 0; first < n;) {
+    size_t last = first;
+    while (last < n && offsets[last + 1] - offsets[first] <= maxSubs) ++last;
+    for (size_t i = first; i < last; ++i) chunkOffsets[i] = uint32_t(offsets[i] - offsets[first]);
+    uint64_t subs = offsets[last] - offsets[first];
+    backend.upload(bCounts, first * 4, chunkOffsets.data() + first, (last - first) * 4);
+    dispatch("clip_write", "clip_write", first, last - first,
+             {{SFFD_BINDING_CLIP_COUNTS, bCounts}, {SFFD_BINDING_SUB_HEADERS, bSubHdr}, {SFFD_BINDING_SUB_RECORDS, bSubRec}});
+    if (subs) {
+      backend.download(bSubHdr, 0, &R.headers[4 * offsets[first]], subs * 16);
+      recs.resize(subs * SFFD_SUB_STRIDE * 4);
+      backend.download(bSubRec, 0, recs.data(), subs * recordBytes);
+      std::copy(recs.begin(), recs.end(), R.records.begin() + offsets[first] * SFFD_SUB_STRIDE * 4);
+    }
+    first = last;
+  }
+  backend.finish();
+  for (BufferId b : {bTable, bPos, bNrm, bTri, bSlot, bPn, bHdr, bReal, bCounts, bSubHdr, bSubRec}) backend.destroyBuffer(b);
+  R.timings = backend.takeTimings();
+  return R;
+}
+
+}  // namespace
+
+SubTriangleRecords regularClipCpu(const PreparedMesh& mesh, const PnOutput& pn, const ClipTriangles& clip, double l,
+                                  KernelVariant variant) {
+  auto t0 = std::chrono::steady_clock::now();
+  SubTriangleRecords R = variant.f64 ? clipCpu<double>(mesh, pn, clip, l) : clipCpu<float>(mesh, pn, clip, l);
+  R.wallMs = msSince(t0);
+  R.timings.push_back({"clip", R.wallMs});
+  return R;
+}
+
+}  // namespace sffd
+
+namespace sffd {
+
+SubTriangleRecords regularClipGpu(Backend& backend, const PreparedMesh& mesh, const PnOutput& pn,
+                                  const ClipTriangles& clip, double l, KernelVariant variant) {
+  if (variant.f64 && !backend.info().limits.float64)
+    throw deviceError(backend.info().name + " has no double-precision shader support; use --precision float");
+  auto t0 = std::chrono::steady_clock::now();
+  SubTriangleRecords R = variant.f64 ? clipGpu<double>(backend, mesh, pn, clip, l, variant)
+                                     : clipGpu<float>(backend, mesh, pn, clip, l, variant);
+  R.wallMs = msSince(t0);
+  return R;
+}
+
+}  // namespace sffd
+
+namespace sffd {
+namespace {
+
+// Whether a parent site lies on parent edge e (corners e and e+1 do, edge sites of e do).
+bool siteOnEdge(SubVertexKind kind, int e) {
+  int k = int(kind);
+  if (k < 3) return k == e || k == (e + 1) % 3;
+  return k == 3 + e;
+}
+
+template <class Real>
+SubTriangleRecords recordsCpu(const PreparedMesh& M, const PnOutput& pn, const std::vector<SubTriangle>& subs) {
+  std::vector<Real> pos = convertReals<Real>(M.positions), nrm = convertReals<Real>(M.normals),
+                    slots = convertReals<Real>(M.slotNormals), rec = convertReals<Real>(pn.records);
+  SubTriangleRecords R;
+  R.headers.assign(4 * subs.size(), 0);
+  R.records.assign(subs.size() * SFFD_SUB_STRIDE * 4, 0.0);
+  auto v3 = [](const std::vector<Real>& a, size_t i) { return RVec3<Real>{a[4 * i], a[4 * i + 1], a[4 * i + 2]}; };
+  for (size_t s = 0; s < subs.size(); ++s) {
+    const SubTriangle& st = subs[s];
+    ParentT<Real> par;
+    par.id = st.parent;
+    for (int c = 0; c < 3; ++c) {
+      par.verts[c] = M.triangles[8 * st.parent + c];
+      par.welds[c] = M.triangles[8 * st.parent + 4 + c];
+      par.V[c] = v3(pos, par.verts[c]);
+      par.N[c] = v3(nrm, par.verts[c]);
+    }
+    par.pn = &rec[size_t(st.parent) * SFFD_PN_STRIDE * 4];
+    par.slot = &slots[size_t(st.parent) * SFFD_SLOT_NORMAL_STRIDE * 4];
+    SiteT<Real> site[3];
+    SiteValueT<Real> val[3];
+    for (int c = 0; c < 3; ++c) {
+      site[c].kind = uint32_t(st.corners[c].kind);
+      site[c].t = Real(st.corners[c].t);
+      site[c].lam = RVec3<Real>::from(st.corners[c].lam);
+      val[c] = par.evaluate(site[c]);
+    }
+    auto parentEdgeOf = [&](int c, int d) {
+      for (int e = 0; e < 3; ++e)
+        if (siteOnEdge(st.corners[c].kind, e) && siteOnEdge(st.corners[d].kind, e)) return e;
+      return -1;
+    };
+    storeSubTriangle(par, site, val, parentEdgeOf, &R.records[s * SFFD_SUB_STRIDE * 4], &R.headers[4 * s]);
+  }
+  return R;
+}
+
+}  // namespace
+
+SubTriangleRecords recordsFromSubTriangles(const PreparedMesh& mesh, const PnOutput& pn,
+                                           const std::vector<SubTriangle>& subs, KernelVariant variant) {
+  auto t0 = std::chrono::steady_clock::now();
+  SubTriangleRecords R = variant.f64 ? recordsCpu<double>(mesh, pn, subs) : recordsCpu<float>(mesh, pn, subs);
+  R.wallMs = msSince(t0);
+  R.timings.push_back({"clip", R.wallMs});
+  return R;
+}
+
+}  // namespace sffd

@@ -1,0 +1,68 @@
+// Kernel K2 "clip" with the improved regular clipping of Lu & Feng (ALGORITHM.md 3.3, 4.2): every
+// triangle split by the pattern of its edges' segment counts ceil(len / l), into near-regular
+// sub-triangles lifted onto the PN surface, crack-free by construction. Also turns knot-box clipping
+// (knot_box_clip.h) into the same sub-triangle records, so both clippings feed one deform stage.
+#pragma once
+#include <vector>
+
+#include "core/backend.h"
+#include "kernels/pn/pn_triangles.h"
+#include "model/prepared_mesh.h"
+#include "model/sub_triangles.h"
+
+namespace sffd {
+
+// A piece of a parent triangle that one split pattern covers. Without pre-split it is the parent
+// itself; triangles whose edges need more than Nmax segments are first bisected (longest edge first,
+// conforming across shared edges) into clip triangles that need at most Nmax.
+struct ClipTriangle {
+  uint32_t parent = 0;
+  std::array<uint32_t, 3> weld{};      // corner weld ids (split points get fresh ids above the mesh's)
+  std::array<SubVertex, 3> corners;    // where each corner lies on the parent
+  std::array<glm::dvec3, 3> flat{};    // corner positions on the flat parent
+  // Per clip edge e (corner e -> e+1): the parent edge it lies on (-1: inside the parent) and the
+  // parameters of its two corners along that parent edge, from its lower-weld endpoint.
+  std::array<int, 3> parentEdge{-1, -1, -1};
+  std::array<std::array<double, 2>, 3> edgeParam{};
+};
+
+struct ClipTriangles {
+  std::vector<ClipTriangle> triangles;
+  size_t presplitParents = 0;   // parents that needed the pre-split
+};
+
+// Clip triangles for target edge length l: pre-splits where some edge needs more than `nmax` segments.
+ClipTriangles buildClipTriangles(const Mesh& mesh, double l, int nmax);
+
+struct SubTriangleRecords {
+  std::vector<uint32_t> headers;   // 4 per sub-triangle: parent, crease slot bits, 0, 0
+  std::vector<double> records;     // SFFD_SUB_STRIDE * 4 per sub-triangle (kernels/common/layout.h)
+  std::vector<DispatchTiming> timings;
+  double wallMs = 0;
+  size_t size() const { return headers.size() / 4; }
+};
+
+// Regular clipping on the CPU reference (double, or float in the strict kernels' order) and on a GPU.
+SubTriangleRecords regularClipCpu(const PreparedMesh& mesh, const PnOutput& pn, const ClipTriangles& clip, double l,
+                                  KernelVariant variant);
+SubTriangleRecords regularClipGpu(Backend& backend, const PreparedMesh& mesh, const PnOutput& pn,
+                                  const ClipTriangles& clip, double l, KernelVariant variant);
+
+// Records of sub-triangles given by their parent sites (knot-box clipping), on the CPU reference.
+SubTriangleRecords recordsFromSubTriangles(const PreparedMesh& mesh, const PnOutput& pn,
+                                           const std::vector<SubTriangle>& subs, KernelVariant variant);
+
+// Device inputs of the clip kernels (layout.h): the clip triangles packed as headers (8 uint each) and
+// reals (SFFD_CLIP_REAL_STRIDE real4 each), and the split-pattern table packed into uint words.
+struct PackedClip {
+  std::vector<uint32_t> headers;
+  std::vector<double> reals;
+};
+PackedClip packClip(const ClipTriangles& clip);
+struct PackedTable {
+  std::vector<uint32_t> words;
+  uint32_t nmax = 0, vertexWord = 0, triangleWord = 0;
+};
+const PackedTable& packedTable();
+
+}  // namespace sffd

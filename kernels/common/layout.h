@@ -1,0 +1,172 @@
+// kernels/common/layout.h: the one place where buffer bindings, work-group size and
+// parameter-block layouts shared by the GLSL kernels and the C++ host are declared.
+// This file is valid GLSL (after kernels/common/prelude.glsl) and valid C++
+// (after kernels/common/shader_layout.h), so the two sides cannot drift apart.
+//
+// Real-valued data (positions, lattice) lives in storage buffers of `real`, which is float or
+// double per kernel variant (SFFD_F64); parameter blocks hold only integers.
+//
+// Rules that keep std140 (GLSL) and C++ layouts identical: parameter blocks hold only
+// vec4 / uvec4 / ivec4 members and arrays of them (16-byte stride in both).
+// Storage buffers hold vec4 or float/uint arrays, never vec3 (std430 pads vec3 to 16 bytes).
+#ifndef SFFD_LAYOUT_H
+#define SFFD_LAYOUT_H
+
+// Work-group size of every 1-D kernel.
+#define SFFD_LOCAL_SIZE 64
+// Largest work-group count per dimension guaranteed by the API (and the limit on llvmpipe/lavapipe).
+#define SFFD_MAX_GROUPS_X 65535
+
+// Binding 0 of every kernel is its parameter block (a uniform buffer); storage buffers use 1..SFFD_MAX_STORAGE_BINDINGS.
+// Vulkan shares one binding namespace between uniform and storage buffers, so the numbers never overlap.
+#define SFFD_BINDING_PARAMS 0
+#define SFFD_MAX_STORAGE_BINDINGS 12
+
+// Highest B-spline degree per axis supported by the kernels.
+#define SFFD_MAX_DEGREE 5
+
+// ---- lattice (shared by every kernel that evaluates the B-spline volume) ----
+#define SFFD_BINDING_LATTICE_COEFFS 1   // per-knot-box Bezier control points: real4 each (w unused)
+#define SFFD_BINDING_LATTICE_FRAME 2    // reals: the affine frame, then the distinct knot values
+
+// Offsets (in reals) inside the lattice frame buffer.
+#define SFFD_FRAME_AFFINE 0        // 12: rows of the 3x4 map world point -> lattice parameter
+#define SFFD_FRAME_COF_AFFINE 12   // 12: rows of cof(A) (A = the 3x3 part), 4th of each row unused
+#define SFFD_FRAME_BREAKS 24       // distinct knot values of u, then v, then w
+
+// outside_mode values: what happens to a point outside the lattice box.
+#define SFFD_OUTSIDE_EXTRAPOLATE 0u   // evaluate the nearest knot box's polynomial (continuous)
+#define SFFD_OUTSIDE_KEEP 1u          // leave the point and its normal unmoved, as PyGeM does
+
+// The lattice part of every parameter block.
+SFFD_STRUCT_BEGIN(LatticeParams)
+  SFFD_UVEC4 degree;         // xyz: degree per axis (1..SFFD_MAX_DEGREE); w: outside_mode
+  SFFD_UVEC4 boxes;          // xyz: knot boxes per axis; w: coefficients per box
+  SFFD_UVEC4 break_offset;   // xyz: first break of each axis in the frame buffer
+SFFD_STRUCT_END(LatticeParams)
+
+// ---- kernel classic_ffd: one thread per vertex, deforms the position and normal ----
+#define SFFD_BINDING_CLASSIC_POS_IN 3    // real4 per vertex (w ignored)
+#define SFFD_BINDING_CLASSIC_NRM_IN 4    // real4 per vertex (w ignored)
+#define SFFD_BINDING_CLASSIC_POS_OUT 5   // real4 per vertex (w = 1 inside the lattice box, 0 outside)
+#define SFFD_BINDING_CLASSIC_NRM_OUT 6   // real4 per vertex (unit normal, w = 0)
+
+SFFD_STRUCT_BEGIN(ClassicParams)
+  SFFD_STRUCT_MEMBER(LatticeParams, lattice)
+  SFFD_UVEC4 range;          // x: first vertex of this chunk (relative to the bound ranges), y: vertex count
+SFFD_STRUCT_END(ClassicParams)
+
+// ---- kernel pn_triangles: one thread per original triangle (ALGORITHM.md 3.2) ----
+// Mesh buffers shared by the pre-compute kernels.
+#define SFFD_BINDING_MESH_POSITIONS 3      // real4 per vertex (w unused)
+#define SFFD_BINDING_MESH_NORMALS 4        // real4 per vertex, unit (w unused)
+#define SFFD_BINDING_MESH_TRIANGLES 5      // 2 uvec4 per triangle: vertex ids (w unused), weld ids (w unused)
+#define SFFD_BINDING_MESH_SLOT_NORMALS 6   // 12 real4 per triangle: per corner slot, the first then the second
+                                           // normal of the slot (w of the first: 1 crease, 0 smooth;
+                                           // w of the second: 1 when the first is the triangle's own)
+#define SFFD_BINDING_PN_OUT 7              // SFFD_PN_STRIDE real4 per triangle
+#define SFFD_MESH_TRIANGLE_STRIDE 2
+#define SFFD_SLOT_NORMAL_STRIDE 12
+// PN record: the 10 cubic geometry control points (linear index order 300,210,201,120,111,102,030,021,012,003)
+// then the 6 quadratic normal control points (200,110,101,020,011,002).
+#define SFFD_PN_STRIDE 16
+#define SFFD_PN_NORMALS 10
+
+// ---- kernels clip_count and clip_write: regular clipping by the split-pattern table (ALGORITHM.md 4.2) ----
+// One thread per clip triangle (an original triangle, or a piece of one after the pre-split of
+// triangles whose edges need more than Nmax segments). Buffers 3..7 are the mesh and PN buffers above.
+#define SFFD_BINDING_SPLIT_TABLE 1     // uint: pattern entries (4 each), then vertices (4 each: lambda bits, edge | step << 16), then packed uint16 triangle indices
+#define SFFD_BINDING_CLIP_COUNTS 2     // uint per clip triangle: sub-triangle count (clip_count), exclusive offset (clip_write)
+#define SFFD_BINDING_CLIP_HEADERS 8    // 2 uvec4 per clip triangle: (parent, corner kinds, 0, 0), corner weld ids
+#define SFFD_BINDING_CLIP_REALS 9      // 9 real4 per clip triangle: lam[3], flat[3], edge params[3]
+#define SFFD_BINDING_SUB_HEADERS 10    // uvec4 per sub-triangle: parent, crease slot bits, 0, 0
+#define SFFD_BINDING_SUB_RECORDS 11    // SFFD_SUB_STRIDE real4 per sub-triangle
+#define SFFD_CLIP_HEADER_STRIDE 2
+#define SFFD_CLIP_REAL_STRIDE 9
+// Corner kinds of a clip triangle (packed 8 bits each in header.y): the corner is parent corner k (0..2),
+// lies on parent edge e (3 + e) at the parameter in its edge params, or inside the parent (6).
+#define SFFD_CORNER_INTERIOR 6u
+// Edge params of clip edge e (corner e -> corner e+1): x = parent edge it lies on (-1: none),
+// y = parameter of corner e along that parent edge, z = of corner e+1; parameters are measured from
+// the parent edge's endpoint with the lower weld id.
+// Sub-triangle record (ALGORITHM.md 3.3): lam[3], x_pn[3], x_flat[3], n_lin[3], n_pn[3], n_nbr[6].
+#define SFFD_SUB_STRIDE 21
+#define SFFD_SUB_LAM 0
+#define SFFD_SUB_XPN 3
+#define SFFD_SUB_XFLAT 6
+#define SFFD_SUB_NLIN 9
+#define SFFD_SUB_NPN 12
+#define SFFD_SUB_NNBR 15
+
+SFFD_STRUCT_BEGIN(ClipParams)
+  SFFD_UVEC4 range;    // x: first clip triangle, y: clip triangle count
+  SFFD_UVEC4 table;    // x: Nmax, y: first vertex word, z: first triangle word
+  SFFD_VEC4 target;    // x: target edge length l
+SFFD_STRUCT_END(ClipParams)
+
+// ---- kernel deform_smooth: the deform stage of smooth FFD, one thread per sub-triangle (ALGORITHM.md 3.4) ----
+// Bindings 1 and 2 are the lattice (lattice_eval.glsl).
+#define SFFD_BINDING_DEFORM_FIT 3          // reals: per interior fitting point SFFD_FIT_STRIDE values
+#define SFFD_BINDING_DEFORM_SUB_HEADERS 4  // uvec4 per sub-triangle (clip_write's headers)
+#define SFFD_BINDING_DEFORM_SUB_RECORDS 5  // SFFD_SUB_STRIDE real4 per sub-triangle (clip_write's records)
+#define SFFD_BINDING_DEFORM_PATCHES 6      // SFFD_PATCH_STRIDE real4 per patch
+#define SFFD_BINDING_DEFORM_TESS 7         // per patch: tessellation positions, then normals (real4 each)
+// Fitting point record: lambda (3), weight w of the centre fit, then the 10 cubic Bernstein values.
+#define SFFD_FIT_STRIDE 14
+// Patch record: 10 geometry control points, then 10 normal control points (linear index order).
+#define SFFD_PATCH_STRIDE 20
+#define SFFD_MAX_FIT_POINTS 91   // interior points of the degree-15 lattice: s <= 15
+// Split form (kernels deform_step_sample, _fit, _adjust, _tessellate): the samples of one sub-triangle,
+// SFFD_SAMPLE_FIXED + (interior fitting points) real4: Q[3], QN[3], E[6], EN[6], adj[3], adjNbr[6], then
+// the interior sample normals.
+#define SFFD_BINDING_DEFORM_SAMPLES 8
+#define SFFD_SAMPLE_FIXED 27
+
+// The deform kernels' parameter block also carries the lattice itself (float variants, when it fits):
+// on llvmpipe/lavapipe a uniform-buffer read is a vector load or gather, while every storage-buffer
+// read is a loop over the SIMD lanes, which made lattice evaluation several times slower. 16 KiB in
+// all, the smallest uniform block every GL 4.3 and Vulkan device accepts. lattice.break_offset.w is
+// then the first vec4 of the Bezier coefficients in inline_lattice (the frame reals come first, four
+// to a vec4); 0 means the kernel reads the lattice storage buffers instead (f64, or too large).
+// The fit table follows the lattice there when it fits too (inline_fit.x: its first vec4, 0: read
+// the fit buffer).
+#define SFFD_INLINE_LATTICE_VEC4 1015
+SFFD_STRUCT_BEGIN(DeformParams)
+  SFFD_STRUCT_MEMBER(LatticeParams, lattice)
+  SFFD_UVEC4 range;    // x: first sub-triangle, y: count, z: interior fitting points, w: tessellation level
+  SFFD_UVEC4 inline_fit;
+  SFFD_VEC4 inline_lattice[SFFD_INLINE_LATTICE_VEC4];
+SFFD_STRUCT_END(DeformParams)
+
+SFFD_STRUCT_BEGIN(PnParams)
+  SFFD_UVEC4 range;   // x: first triangle, y: triangle count
+SFFD_STRUCT_END(PnParams)
+
+// ---- kernel accurate_patches (accurate FFD, ALGORITHM.md 2; owner: accurate FFD) ----
+// Three dispatches a chunk of knot-box sub-triangles (range.z selects the stage), so that no invocation
+// runs more than a few hundred loop iterations (llvmpipe ends every invocation after 65535 in all):
+//   stage 0, a thread per (sub-triangle, sample l): S_l = R(x(l/n)) at the principal lattice points;
+//   stage 1, a thread per (sub-triangle, control point k): P_k = sum_l A_n^{-1}[k][l] S_l (l ascending);
+//   stage 2, a thread per (sub-triangle, tessellation vertex): position and normal (patch_output.h layout).
+#define SFFD_ACC_MAX_DEGREE 15           // 3 * SFFD_MAX_DEGREE
+#define SFFD_ACC_MAX_CP 136              // (n+1)(n+2)/2 for n = SFFD_ACC_MAX_DEGREE
+#define SFFD_ACC_STAGE_SAMPLES 0u
+#define SFFD_ACC_STAGE_PATCHES 1u
+#define SFFD_ACC_STAGE_TESSELLATE 2u
+#define SFFD_BINDING_ACC_MATRIX 3        // reals: A_n^{-1} transposed, entry (sample l, control point k) at l*m + k
+#define SFFD_BINDING_ACC_TESS_BASIS 4    // reals: per tessellation vertex v, B^n_k(lambda_v) for the m control points k
+#define SFFD_BINDING_ACC_CORNERS 5       // 4 real4 per sub-triangle: its flat corners sum_i lam_i V_i, the parent's unit face normal
+#define SFFD_ACC_CORNER_STRIDE 4
+#define SFFD_BINDING_ACC_PATCHES 6       // m real4 per sub-triangle: the patch control points, linear index order (stage 1 writes)
+#define SFFD_BINDING_ACC_POSITIONS 7     // nv real4 per sub-triangle: tessellation positions (stage 2 writes)
+#define SFFD_BINDING_ACC_NORMALS 8       // nv real4 per sub-triangle: unit geometric normals of the patch, cof(J) n_face (stage 2)
+#define SFFD_BINDING_ACC_SAMPLES 9       // m real4 per sub-triangle: the samples S_l (stage 0 writes, stage 1 reads)
+
+SFFD_STRUCT_BEGIN(AccurateParams)
+  SFFD_STRUCT_MEMBER(LatticeParams, lattice)
+  SFFD_UVEC4 range;   // x: first sub-triangle of this chunk (relative to the bound ranges), y: sub-triangle count, z: stage
+  SFFD_UVEC4 shape;   // x: patch degree n, y: control points m = (n+1)(n+2)/2, z: tessellation level L, w: vertices (L+1)(L+2)/2
+SFFD_STRUCT_END(AccurateParams)
+// ---- end of accurate_patches ----
+
+#endif

@@ -1,0 +1,80 @@
+// kernels/common/prelude.glsl: included first by every kernel.
+// Maps the layout words of layout.h onto GLSL and selects the arithmetic variant:
+//   SFFD_STRICT 0 (fast): built-in dot/cross/normalize, the compiler may fuse and reorder.
+//   SFFD_STRICT 1 (strict): every operation `precise`, no fma, hand-written dot/cross/normalize in a
+//   fixed order, so GL, Vulkan and the C++ reference built with -ffp-contract=off agree bit for bit
+//   (see docs/ARCHITECTURE.md, "Strict kernels").
+#ifndef SFFD_PRELUDE_GLSL
+#define SFFD_PRELUDE_GLSL
+
+#ifndef SFFD_STRICT
+#define SFFD_STRICT 0
+#endif
+#ifndef SFFD_F64
+#define SFFD_F64 0
+#endif
+
+// `real` is the kernel's arithmetic type: float, or double in the F64 variant (GL 4.0+ core,
+// Vulkan shaderFloat64), used where float32 cannot meet an oracle's tolerance (PyGeM's 1.5e-6).
+#if SFFD_F64
+#define real double
+#define real3 dvec3
+#define real4 dvec4
+#else
+#define real float
+#define real3 vec3
+#define real4 vec4
+#endif
+
+#define SFFD_VEC4 vec4
+#define SFFD_UVEC4 uvec4
+#define SFFD_IVEC4 ivec4
+#define SFFD_STRUCT_BEGIN(name) struct name {
+#define SFFD_STRUCT_MEMBER(type, member) type member;
+#define SFFD_STRUCT_END(name) };
+
+#include "layout.h"
+
+// Vulkan needs a descriptor set number; OpenGL GLSL forbids the qualifier.
+#ifdef VULKAN
+#define SFFD_SET set = 0,
+#else
+#define SFFD_SET
+#endif
+
+// P marks a declaration precise in the strict variant (no contraction, no reassociation).
+#if SFFD_STRICT
+#define P precise
+#else
+#define P
+#endif
+
+layout(local_size_x = SFFD_LOCAL_SIZE, local_size_y = 1, local_size_z = 1) in;
+
+// Global thread index of a 1-D job dispatched as a 2-D grid of groups (65535 groups a dimension).
+uint sffdThreadIndex() {
+  return gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * (gl_NumWorkGroups.x * uint(SFFD_LOCAL_SIZE));
+}
+
+#if SFFD_STRICT
+real sdot(real3 a, real3 b) {
+  P real xy = a.x * b.x + a.y * b.y;
+  P real r = xy + a.z * b.z;
+  return r;
+}
+real3 scross(real3 a, real3 b) {
+  P real3 r = real3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
+  return r;
+}
+real3 snormalize(real3 v) {
+  P real len = sqrt(sdot(v, v));
+  P real3 r = v / len;
+  return r;
+}
+#else
+real sdot(real3 a, real3 b) { return dot(a, b); }
+real3 scross(real3 a, real3 b) { return cross(a, b); }
+real3 snormalize(real3 v) { return normalize(v); }
+#endif
+
+#endif

@@ -1,0 +1,122 @@
+#include "kernels/pn/pn_triangles.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdlib>
+
+#include <sffd/error.h>
+#include "model/lattice_pack.h"
+#include "kernels/pn/pn_eval.h"
+#include "kernels/common/shader_layout.h"
+#include "core/wall_clock.h"
+
+namespace sffd {
+namespace {
+
+template <class Real>
+void pnCpu(const PreparedMesh& M, PnOutput& out) {
+  const size_t nt = M.triangleCount();
+  out.records.assign(nt * SFFD_PN_STRIDE * 4, 0.0);
+  auto vec = [](const std::vector<double>& a, size_t i) { return RVec3<Real>{Real(a[4 * i]), Real(a[4 * i + 1]), Real(a[4 * i + 2])}; };
+  for (size_t t = 0; t < nt; ++t) {
+    RVec3<Real> V[3], N[3], first[6], second[6];
+    bool crease[6];
+    uint32_t weld[3];
+    for (int c = 0; c < 3; ++c) {
+      V[c] = vec(M.positions, M.triangles[8 * t + c]);
+      N[c] = vec(M.normals, M.triangles[8 * t + c]);
+      weld[c] = M.triangles[8 * t + 4 + c];
+    }
+    for (int s = 0; s < 6; ++s) {
+      first[s] = vec(M.slotNormals, 12 * t + 2 * s);
+      crease[s] = Real(M.slotNormals[48 * t + 8 * s + 3]) > Real(0.5);
+      second[s] = vec(M.slotNormals, 12 * t + 2 * s + 1);
+    }
+    PnPatchT<Real> P = pnBuild(V, N, first, crease, second, weld);
+    double* o = &out.records[t * SFFD_PN_STRIDE * 4];
+    for (int i = 0; i < 10; ++i) o[4 * i] = P.cp[i].x, o[4 * i + 1] = P.cp[i].y, o[4 * i + 2] = P.cp[i].z;
+    for (int i = 0; i < 6; ++i) {
+      double* q = o + 4 * (SFFD_PN_NORMALS + i);
+      q[0] = P.n[i].x, q[1] = P.n[i].y, q[2] = P.n[i].z;
+    }
+  }
+}
+
+template <class Real>
+void pnGpu(Backend& backend, const PreparedMesh& M, KernelVariant variant, PnOutput& out) {
+  const DeviceLimits& lim = backend.info().limits;
+  const size_t nt = M.triangleCount(), nv = M.positions.size() / 4;
+  const uint64_t vertexBytes = nv * 4 * sizeof(Real);
+  if (vertexBytes > lim.maxStorageBufferRange)
+    throw Error(ErrorKind::Input, "mesh has too many vertices for one storage binding on this device (" +
+                                      std::to_string(nv) + " vertices)");
+  // Per-triangle arrays go in chunks that fit one binding each; the largest is the PN record.
+  const size_t perTriangle = SFFD_PN_STRIDE * 4 * sizeof(Real);
+  size_t chunk = size_t(lim.maxStorageBufferRange / perTriangle);
+  chunk = std::min<size_t>(chunk, size_t(lim.maxWorkGroupCount[0]) * lim.maxWorkGroupCount[1] * SFFD_LOCAL_SIZE);
+  if (const char* forced = std::getenv("SFFD_MAX_CHUNK_TRIANGLES")) chunk = std::min<size_t>(chunk, std::strtoull(forced, nullptr, 10));
+  chunk = std::max<size_t>(1, std::min(chunk, std::max<size_t>(nt, 1)));
+
+  std::vector<Real> pos = convertReals<Real>(M.positions), nrm = convertReals<Real>(M.normals);
+  BufferId bPos = backend.createBuffer(std::max<uint64_t>(vertexBytes, 16));
+  BufferId bNrm = backend.createBuffer(std::max<uint64_t>(vertexBytes, 16));
+  backend.upload(bPos, 0, pos.data(), vertexBytes);
+  backend.upload(bNrm, 0, nrm.data(), vertexBytes);
+  BufferId bTri = backend.createBuffer(chunk * 8 * sizeof(uint32_t));
+  BufferId bSlot = backend.createBuffer(chunk * 48 * sizeof(Real));
+  BufferId bOut = backend.createBuffer(chunk * perTriangle);
+  out.records.resize(nt * SFFD_PN_STRIDE * 4);
+  std::vector<Real> slot(chunk * 48), rec(chunk * SFFD_PN_STRIDE * 4);
+  for (size_t first = 0; first < nt; first += chunk) {
+    size_t count = std::min(chunk, nt - first);
+    for (size_t i = 0; i < 48 * count; ++i) slot[i] = Real(M.slotNormals[48 * first + i]);
+    backend.upload(bTri, 0, &M.triangles[8 * first], count * 8 * sizeof(uint32_t));
+    backend.upload(bSlot, 0, slot.data(), count * 48 * sizeof(Real));
+    gpu::PnParams params;
+    params.range = {0, uint32_t(count), 0, 0};
+    Dispatch d;
+    d.kernel = "pn_triangles";
+    d.label = "pn";
+    d.variant = variant;
+    d.params = &params;
+    d.paramsSize = sizeof(params);
+    d.buffers = {{SFFD_BINDING_MESH_POSITIONS, bPos}, {SFFD_BINDING_MESH_NORMALS, bNrm},
+                 {SFFD_BINDING_MESH_TRIANGLES, bTri}, {SFFD_BINDING_MESH_SLOT_NORMALS, bSlot},
+                 {SFFD_BINDING_PN_OUT, bOut}};
+    gridFor(count, lim, d.groups);
+    backend.dispatch(d);
+    backend.barrier();
+    backend.download(bOut, 0, rec.data(), count * perTriangle);
+    std::copy(rec.begin(), rec.begin() + count * SFFD_PN_STRIDE * 4, out.records.begin() + first * SFFD_PN_STRIDE * 4);
+  }
+  backend.finish();
+  for (BufferId b : {bPos, bNrm, bTri, bSlot, bOut}) backend.destroyBuffer(b);
+  out.timings = backend.takeTimings();
+}
+
+}  // namespace
+
+PnOutput pnTrianglesCpu(const PreparedMesh& mesh, KernelVariant variant) {
+  PnOutput out;
+  auto t0 = std::chrono::steady_clock::now();
+  if (variant.f64) pnCpu<double>(mesh, out);
+  else pnCpu<float>(mesh, out);
+  out.wallMs = msSince(t0);
+  out.timings.push_back({"pn", out.wallMs});
+  return out;
+}
+
+PnOutput pnTrianglesGpu(Backend& backend, const PreparedMesh& mesh, KernelVariant variant) {
+  if (variant.f64 && !backend.info().limits.float64)
+    throw deviceError(backend.info().name + " has no double-precision shader support; use --precision float");
+  PnOutput out;
+  auto t0 = std::chrono::steady_clock::now();
+  if (mesh.triangleCount() > 0) {
+    if (variant.f64) pnGpu<double>(backend, mesh, variant, out);
+    else pnGpu<float>(backend, mesh, variant, out);
+  }
+  out.wallMs = msSince(t0);
+  return out;
+}
+
+}  // namespace sffd

@@ -1,0 +1,45 @@
+#version 450
+// Kernel deform_smooth (K3 of ALGORITHM.md 3.4, fused): per sub-triangle, (1) sampling and (2)
+// constraint points by exact FFD, (3) control points by the constrained least-squares fit, the normal
+// patch by the same fit on cofactor-deformed normals, (4) adjusting normals, (5) adjustment of the edge
+// control points (tangent plane, or crease line on crease slots) and the PN centre rule, (6)
+// tessellation at level L. The split form (deform_step_*) runs the same functions one step a dispatch.
+#extension GL_GOOGLE_include_directive : require
+#include "../common/prelude.glsl"
+#include "smooth_deform.glsl"
+
+layout(std430, SFFD_SET binding = SFFD_BINDING_DEFORM_PATCHES) writeonly buffer Patches { real4 patches[]; };
+layout(std430, SFFD_SET binding = SFFD_BINDING_DEFORM_TESS) writeonly buffer Tess { real4 tess[]; };
+
+void main() {
+  uint tid = sffdThreadIndex();
+  if (tid >= params.range.y) return;
+  uint st = params.range.x + tid;
+  real3 Q[3], QN[3], adj[3], adjNbr[6], E[6], EN[6];
+  SubCorners corners = smoothSubCorners(st);
+  smoothCornerSamples(st, corners, Q, QN, adj, adjNbr);
+  smoothEdgeSamples(corners, E, EN);
+  real3 cp[10], ncp[10];
+  smoothBoundaryControlPoints(Q, QN, E, EN, cp, ncp);
+  P real3 centreN = real3(0);
+  for (uint i = 0u; i < params.range.z; ++i) centreN = centreN + smoothCentreTerm(ncp, smoothInteriorNormal(corners, i), i);
+  ncp[4] = centreN;
+  smoothAdjust(subHeaders[st].y, adj, adjNbr, cp);
+
+  uint pbase = SFFD_PATCH_STRIDE * st;
+  for (uint k = 0u; k < 10u; ++k) {
+    patches[pbase + k] = real4(cp[k], 0);
+    patches[pbase + 10u + k] = real4(ncp[k], 0);
+  }
+  uint L = params.range.w;
+  uint nv = (L + 1u) * (L + 2u) / 2u;
+  uint tbase = 2u * nv * st;
+  for (uint r = 0u; r <= L; ++r)
+    for (uint t = 0u; t <= r; ++t) {
+      real3 x, n;
+      smoothTessVertex(cp, ncp, L, r, t, x, n);
+      uint v = r * (r + 1u) / 2u + t;
+      tess[tbase + v] = real4(x, 0);
+      tess[tbase + nv + v] = real4(n, 0);
+    }
+}

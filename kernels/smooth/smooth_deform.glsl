@@ -1,0 +1,245 @@
+// kernels/smooth/smooth_deform.glsl: the steps of the smooth-FFD deform stage (ALGORITHM.md 3.4) as
+// functions, shared by the fused kernel deform_smooth and the split kernels deform_step_*; the C++
+// twin is kernels/smooth/smooth_deform.cpp. Both forms call the same functions, so they agree.
+//
+// Bitwise C0: everything on a sub-edge is computed from that edge's data in an order both patches
+// share (sums of two products are commutative; near-corner control points use one expression from the
+// corner; boundary tessellation vertices are evaluated on the edge curve from its lexicographically
+// smaller corner; crease-line normals are ordered the same way).
+#ifndef SFFD_SMOOTH_GLSL
+#define SFFD_SMOOTH_GLSL
+
+// Declared before lattice_eval.glsl, which then reads the lattice from the block when the host put it there.
+layout(std140, SFFD_SET binding = SFFD_BINDING_PARAMS) uniform DeformBlock { DeformParams params; };
+#define SFFD_LATTICE_INLINE 1
+#include "../common/lattice_eval.glsl"
+#include "../pn/pn_eval.glsl"
+layout(std430, SFFD_SET binding = SFFD_BINDING_DEFORM_FIT) readonly buffer Fit { real fit[]; };
+
+// Fit-table reads: from the parameter block when the host put the table there (layout.h), as the lattice.
+#if !SFFD_F64
+real fitAt(uint i) {
+  real v;
+  if (params.inline_fit.x != 0u) v = params.inline_lattice[params.inline_fit.x + (i >> 2u)][i & 3u];
+  else v = fit[i];
+  return v;
+}
+#else
+real fitAt(uint i) { return fit[i]; }
+#endif
+layout(std430, SFFD_SET binding = SFFD_BINDING_DEFORM_SUB_HEADERS) readonly buffer SubHeaders { uvec4 subHeaders[]; };
+layout(std430, SFFD_SET binding = SFFD_BINDING_DEFORM_SUB_RECORDS) readonly buffer SubRecords { real4 subRecords[]; };
+
+// Control point of corner slot s (2, 1, 3, 7, 8, 5) and of corner c (0, 6, 9), as 4-bit fields of a
+// constant: a constant array indexed by a variable is copied into local memory at every use in the
+// SPIR-V that glslang emits, which made the Vulkan kernels several times slower than GL on lavapipe.
+uint kSlotCp(uint s) { return (0x587312u >> (4u * s)) & 15u; }
+uint kCornerCp(uint c) { return (0x960u >> (4u * c)) & 15u; }
+
+// a before b in the lexicographic order of their coordinates (a total order both patches agree on).
+bool lexLess(real3 a, real3 b) {
+  if (a.x != b.x) return a.x < b.x;
+  if (a.y != b.y) return a.y < b.y;
+  return a.z < b.z;
+}
+
+// (-5 q0 + 18 q1 - 9 q2 + 2 q3) / 6: the cubic through q0..q3 at 0, 1/3, 2/3, 1, control point near q0.
+real3 nearControlPoint(real3 q0, real3 q1, real3 q2, real3 q3) {
+  P real3 r = (((q0 * real(-5) + q1 * real(18)) + q2 * real(-9)) + q3 * real(2)) / real(6);
+  return r;
+}
+
+// The flat-lifted corners and their linear normals of a sub-triangle, read once for every interior
+// sample (each storage-buffer read is costly on SIMD CPU devices).
+struct SubCorners {
+  real3 x0, x1, x2, n0, n1, n2;
+};
+SubCorners smoothSubCorners(uint st) {
+  uint rec = SFFD_SUB_STRIDE * st;
+  SubCorners C;
+  C.x0 = subRecords[rec + SFFD_SUB_XPN].xyz;
+  C.x1 = subRecords[rec + SFFD_SUB_XPN + 1u].xyz;
+  C.x2 = subRecords[rec + SFFD_SUB_XPN + 2u].xyz;
+  C.n0 = subRecords[rec + SFFD_SUB_NLIN].xyz;
+  C.n1 = subRecords[rec + SFFD_SUB_NLIN + 1u].xyz;
+  C.n2 = subRecords[rec + SFFD_SUB_NLIN + 2u].xyz;
+  return C;
+}
+
+// Steps 1 and 2 at corner c (and step 4, which needs the same Jacobian): the deformed corner, its
+// deformed normal, and the adjusting normals of the corner and of its two slots (crease slots only).
+void smoothCornerSample(uint st, uint c, uint creaseBits, real3 x, real3 nlin, out real3 Q, out real3 QN, out real3 adj,
+                        out real3 adjA, out real3 adjB) {
+  uint rec = SFFD_SUB_STRIDE * st;
+  LatticeSample S = latticeEvaluate(params.lattice, x);
+  Q = S.value;
+  QN = snormalize(latticeCofactorNormal(S, nlin));
+  adj = snormalize(latticeCofactorNormal(S, subRecords[rec + SFFD_SUB_NPN + c].xyz));
+  adjA = adj;
+  adjB = adj;
+  if (((creaseBits >> (2u * c)) & 1u) != 0u) adjA = snormalize(latticeCofactorNormal(S, subRecords[rec + SFFD_SUB_NNBR + 2u * c].xyz));
+  if (((creaseBits >> (2u * c + 1u)) & 1u) != 0u) adjB = snormalize(latticeCofactorNormal(S, subRecords[rec + SFFD_SUB_NNBR + 2u * c + 1u].xyz));
+}
+
+// Corner c's lifted point and linear normal (selects, not an indexed array).
+real3 subCornerX(SubCorners C, uint c) { return c == 0u ? C.x0 : (c == 1u ? C.x1 : C.x2); }
+real3 subCornerN(SubCorners C, uint c) { return c == 0u ? C.n0 : (c == 1u ? C.n1 : C.n2); }
+
+// Loops rather than calls written out: every call inlines a whole lattice evaluation, and the
+// kernels' compile time grows with their number.
+void smoothCornerSamples(uint st, SubCorners C, out real3 Q[3], out real3 QN[3], out real3 adj[3], out real3 adjNbr[6]) {
+  uint creaseBits = subHeaders[st].y;
+  for (uint c = 0u; c < 3u; ++c) {
+    real3 q, qn, ad, a0, a1;
+    smoothCornerSample(st, c, creaseBits, subCornerX(C, c), subCornerN(C, c), q, qn, ad, a0, a1);
+    Q[c] = q;
+    QN[c] = qn;
+    adj[c] = ad;
+    adjNbr[2u * c] = a0;
+    adjNbr[2u * c + 1u] = a1;
+  }
+}
+
+// Step 2 on an edge: the sample at wa * a + wb * b.
+void smoothEdgeSample(real3 xa, real3 xb, real3 na, real3 nb, real wa, real wb, out real3 E, out real3 EN) {
+  P real3 x = xa * wa + xb * wb;
+  P real3 n = na * wa + nb * wb;
+  LatticeSample S = latticeEvaluate(params.lattice, x);
+  E = S.value;
+  EN = snormalize(latticeCofactorNormal(S, snormalize(n)));
+}
+
+// Step 2 on the edges: samples at one third from each end, E[2e] near corner e, E[2e+1] near e+1.
+void smoothEdgeSamples(SubCorners C, out real3 E[6], out real3 EN[6]) {
+  P real third = real(1) / real(3);
+  P real twoThirds = real(2) / real(3);
+  for (uint k = 0u; k < 6u; ++k) {
+    uint e = k / 2u, b = e == 2u ? 0u : e + 1u;
+    P real wa = k % 2u == 0u ? twoThirds : third;
+    P real wb = k % 2u == 0u ? third : twoThirds;
+    real3 x, n;
+    smoothEdgeSample(subCornerX(C, e), subCornerX(C, b), subCornerN(C, e), subCornerN(C, b), wa, wb, x, n);
+    E[k] = x;
+    EN[k] = n;
+  }
+}
+
+// Step 1 inside: the deformed normal at interior fitting point i (the geometry's centre comes from
+// the PN rule after the adjustment, so only the normal patch needs the interior samples).
+real3 smoothInteriorNormal(SubCorners C, uint i) {
+  uint f = SFFD_FIT_STRIDE * i;
+  P real3 lam = real3(fitAt(f), fitAt(f + 1u), fitAt(f + 2u));
+  P real3 x = (C.x0 * lam.x + C.x1 * lam.y) + C.x2 * lam.z;
+  P real3 n = (C.n0 * lam.x + C.n1 * lam.y) + C.n2 * lam.z;
+  LatticeSample S = latticeEvaluate(params.lattice, x);
+  P real3 r = snormalize(latticeCofactorNormal(S, snormalize(n)));
+  return r;
+}
+
+// Step 3: boundary control points by the closed form of the constrained fit.
+void smoothBoundaryControlPoints(real3 Q[3], real3 QN[3], real3 E[6], real3 EN[6], out real3 cp[10], out real3 ncp[10]) {
+  for (uint c = 0u; c < 3u; ++c) {
+    cp[kCornerCp(c)] = Q[c];
+    ncp[kCornerCp(c)] = QN[c];
+  }
+  for (uint s = 0u; s < 6u; ++s) {
+    uint c = s / 2u;
+    uint o = (s % 2u == 1u) ? (c + 1u) % 3u : (c + 2u) % 3u;
+    uint e = (s % 2u == 1u) ? c : o;               // edge index (corner e -> e+1)
+    uint nearC = c == e ? 2u * e : 2u * e + 1u;    // the edge sample a third from c
+    uint nearO = c == e ? 2u * e + 1u : 2u * e;
+    cp[kSlotCp(s)] = nearControlPoint(Q[c], E[nearC], E[nearO], Q[o]);
+    ncp[kSlotCp(s)] = nearControlPoint(QN[c], EN[nearC], EN[nearO], QN[o]);
+  }
+  cp[4] = real3(0);
+  ncp[4] = real3(0);
+}
+
+// Step 3 inside: one interior sample's share of the normal patch's least-squares centre.
+real3 smoothCentreTerm(real3 ncp[10], real3 qn, uint i) {
+  uint f = SFFD_FIT_STRIDE * i;
+  P real3 r = qn;
+  for (uint k = 0u; k < 10u; ++k)
+    if (k != 4u) r = r - ncp[k] * fitAt(f + 4u + k);
+  P real3 term = r * fitAt(f + 3u);
+  return term;
+}
+
+// Step 5: edge control points onto the deformed tangent plane, or onto the crease line; centre by the PN rule.
+void smoothAdjust(uint creaseBits, real3 adj[3], real3 adjNbr[6], inout real3 cp[10]) {
+  for (uint s = 0u; s < 6u; ++s) {
+    uint c = s / 2u;
+    real3 X = cp[kCornerCp(c)];
+    P real3 b = cp[kSlotCp(s)];
+    P real3 d = b - X;
+    bool adjusted = false;
+    if (((creaseBits >> s) & 1u) != 0u) {
+      real3 n1 = adj[c], n2 = adjNbr[s];
+      if (lexLess(n2, n1)) { real3 x = n1; n1 = n2; n2 = x; }
+      P real3 cr = scross(n1, n2);
+      P real len2 = sdot(cr, cr);
+      if (len2 > real(1e-12)) {
+        P real3 t = cr / sqrt(len2);
+        b = X + t * sdot(d, t);
+        adjusted = true;
+      }
+    }
+    if (!adjusted) b = b - adj[c] * sdot(d, adj[c]);
+    cp[kSlotCp(s)] = b;
+  }
+  P real3 edgeSum = ((((cp[1] + cp[2]) + cp[3]) + cp[5]) + cp[7]) + cp[8];
+  P real3 cornerSum = (cp[0] + cp[6]) + cp[9];
+  P real3 centre = edgeSum / real(4) - cornerSum / real(6);
+  cp[4] = centre;
+}
+
+// Step 6: tessellation vertex (r, t) at level L. Corners exact, edge vertices on the canonical edge
+// curve, the rest by the patch.
+void smoothTessVertex(real3 cp[10], real3 ncp[10], uint L, uint r, uint t, out real3 x, out real3 n) {
+  uint i = L - r, j = r - t, k = t;
+  // Control points are picked with constant indices in each branch: a local array indexed by a
+  // variable lives in memory on lavapipe (SPIR-V path), three times slower than GL's select chains.
+  if (i == L || j == L || k == L) {
+    real3 xc = cp[9], nc = ncp[9];
+    if (i == L) { xc = cp[0]; nc = ncp[0]; }
+    else if (j == L) { xc = cp[6]; nc = ncp[6]; }
+    x = xc;
+    n = snormalize(nc);
+  } else if (i == 0u || j == 0u || k == 0u) {
+    // Edge a -> a+1 is (0,1) when k == 0, (1,2) when i == 0, (2,0) when j == 0; its cubic runs through
+    // corner a, the control points of slots 2a+1 and 2a+2, corner a+1 (cp 0,1,3,6 / 6,7,8,9 / 9,5,2,0).
+    uint stepsFromA = i;
+    real3 e0 = cp[9], e1 = cp[5], e2 = cp[2], e3 = cp[0], f0 = ncp[9], f1 = ncp[5], f2 = ncp[2], f3 = ncp[0];
+    if (k == 0u) {
+      stepsFromA = j;
+      e0 = cp[0]; e1 = cp[1]; e2 = cp[3]; e3 = cp[6]; f0 = ncp[0]; f1 = ncp[1]; f2 = ncp[3]; f3 = ncp[6];
+    } else if (i == 0u) {
+      stepsFromA = k;
+      e0 = cp[6]; e1 = cp[7]; e2 = cp[8]; e3 = cp[9]; f0 = ncp[6]; f1 = ncp[7]; f2 = ncp[8]; f3 = ncp[9];
+    }
+    // Evaluated from the lexicographically smaller corner, so both patches of the edge agree bit for bit.
+    uint steps = stepsFromA;
+    if (lexLess(e3, e0)) {
+      steps = L - stepsFromA;
+      real3 t0 = e0, t1 = e1, g0 = f0, g1 = f1;
+      e0 = e3; e1 = e2; e2 = t1; e3 = t0;
+      f0 = f3; f1 = f2; f2 = g1; f3 = g0;
+    }
+    P real u = real(steps) / real(L);
+    x = pnEdgeCurve(e0, e1, e2, e3, u);
+    n = snormalize(pnEdgeCurve(f0, f1, f2, f3, u));
+  } else {
+    P real3 lam = real3(real(i), real(j), real(k)) / real(L);
+    real w[10];
+    pnCubicWeights(lam, w);
+    P real3 xs = real3(0), ns = real3(0);
+    for (uint q = 0u; q < 10u; ++q) {
+      xs = xs + cp[q] * w[q];
+      ns = ns + ncp[q] * w[q];
+    }
+    x = xs;
+    n = snormalize(ns);
+  }
+}
+
+#endif

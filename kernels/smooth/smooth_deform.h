@@ -1,0 +1,56 @@
+// Kernel K3 "deform" of smooth FFD (Cui & Feng 2015, improved by Lu & Feng; ALGORITHM.md 3.4): each
+// sub-triangle becomes a cubic triangular Bezier patch fitted to the exactly deformed surface, with a
+// cubic normal patch, creases kept sharp, tessellated at level L. GPU kernel kernels/smooth/deform_smooth.comp;
+// the C++ twin here, templated on the arithmetic type.
+#pragma once
+#include <vector>
+
+#include "core/backend.h"
+#include "model/lattice_pack.h"
+#include "pipelines/patch_output.h"
+#include "kernels/clip/regular_clip.h"
+#include "kernels/common/shader_layout.h"
+
+namespace sffd {
+
+// The interior fitting points of the degree-s sampling lattice with their centre-fit weights
+// (closed form of the constrained least squares, ALGORITHM.md 3.4 step 3): SFFD_FIT_STRIDE values each.
+struct FitTable {
+  int s = 6;
+  int points = 0;
+  std::vector<double> data;
+};
+FitTable makeFitTable(int s);
+
+struct SmoothOutput {
+  std::vector<double> patches;   // SFFD_PATCH_STRIDE * 4 per sub-triangle
+  std::vector<double> tess;      // 2 * tessVertexCount(level) * 4 per sub-triangle: positions, then normals
+  int level = 10;
+  std::vector<DispatchTiming> timings;
+  double wallMs = 0;
+};
+
+// Threads the CPU reference's deform stage uses: every core, or SFFD_CPU_THREADS.
+unsigned cpuThreadCount();
+
+SmoothOutput smoothDeformCpu(const PackedLattice& lattice, const SubTriangleRecords& subs, const FitTable& fit,
+                             int level, KernelVariant variant);
+// split: one dispatch per step (deform.sample: steps 1, 2, 4; deform.fit: 3; deform.adjust: 5;
+// deform.tessellate: 6), for per-step timings; the same output as the fused kernel.
+SmoothOutput smoothDeformGpu(Backend& backend, const PackedLattice& lattice, const SubTriangleRecords& subs,
+                             const FitTable& fit, int level, KernelVariant variant, bool split = false);
+
+// The deform stage's dispatches over `count` sub-triangles (params.range set by the caller): the
+// fused kernel, or with `split` the four step kernels (`samples` then holds their intermediate data).
+// Shared by smoothDeformGpu and DeformSession.
+struct DeformBuffers {
+  BufferId coeffs = 0, frame = 0, fit = 0, headers = 0, records = 0, patches = 0, tess = 0, samples = 0;
+};
+void dispatchDeform(Backend& backend, const gpu::DeformParams& params, const DeformBuffers& buffers, size_t count,
+                    KernelVariant variant, bool split);
+
+// The tessellation with each vertex's pre-image in its parent triangle (for the writers and the
+// error analysis).
+PatchVertices patchVerticesOf(const SubTriangleRecords& subs, const SmoothOutput& out);
+
+}  // namespace sffd

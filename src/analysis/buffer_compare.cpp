@@ -1,0 +1,69 @@
+#include "analysis/buffer_compare.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+namespace sffd {
+namespace {
+// Maps the bits of a float onto a line where adjacent floats are adjacent integers.
+int64_t ordered(float f) {
+  int32_t i;
+  std::memcpy(&i, &f, 4);
+  return i < 0 ? int64_t(INT32_MIN) - i : i;
+}
+__int128 ordered(double d) {
+  int64_t i;
+  std::memcpy(&i, &d, 8);
+  return i < 0 ? __int128(INT64_MIN) - i : __int128(i);
+}
+}  // namespace
+
+uint64_t ulpDistance(float a, float b) {
+  if (std::isnan(a) || std::isnan(b)) return std::isnan(a) && std::isnan(b) ? 0 : UINT64_MAX;
+  int64_t d = ordered(a) - ordered(b);
+  return uint64_t(d < 0 ? -d : d);
+}
+
+uint64_t ulpDistance(double a, double b) {
+  if (std::isnan(a) || std::isnan(b)) return std::isnan(a) && std::isnan(b) ? 0 : UINT64_MAX;
+  __int128 d = ordered(a) - ordered(b);
+  if (d < 0) d = -d;
+  return d > __int128(UINT64_MAX) ? UINT64_MAX : uint64_t(d);
+}
+
+CompareResult compareBuffers(const std::vector<double>& a, const std::vector<double>& b, bool float32,
+                             const CompareTolerance& tol) {
+  CompareResult r;
+  r.total = std::max(a.size(), b.size());
+  if (a.size() != b.size()) {
+    r.mismatched = r.total;
+    r.maxAbs = INFINITY;
+    r.maxUlp = UINT64_MAX;
+    return r;
+  }
+  double scale = 0;
+  for (size_t i = 0; i < a.size(); ++i) scale = std::max({scale, std::abs(a[i]), std::abs(b[i])});
+  for (size_t i = 0; i < a.size(); ++i) {
+    double x = a[i], y = b[i];
+    uint64_t ulp;
+    bool same;
+    if (float32) {
+      float fx = float(x), fy = float(y);
+      ulp = ulpDistance(fx, fy);
+      same = std::memcmp(&fx, &fy, 4) == 0;
+    } else {
+      ulp = ulpDistance(x, y);
+      same = std::memcmp(&x, &y, 8) == 0;
+    }
+    double d = std::abs(x - y);
+    if (std::isnan(d)) d = INFINITY;
+    r.maxAbs = std::max(r.maxAbs, d);
+    r.maxUlp = std::max(r.maxUlp, ulp);
+    bool ok = tol.bitExact ? same : (same || double(ulp) <= tol.maxUlp || d <= tol.absOfScale * scale);
+    if (!ok) ++r.mismatched;
+  }
+  return r;
+}
+
+}  // namespace sffd

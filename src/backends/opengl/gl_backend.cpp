@@ -1,0 +1,478 @@
+// OpenGL 4.3+ core compute driver (sffd::Backend) on a context from gl_context.h.
+// Every GL call goes through glad, whose entry points the context loads when it becomes current;
+// each public method activates the backend's context first, so backends of several providers can
+// live in one process.
+#include "backends/opengl/gl_backend.h"
+
+#include <glad/gl.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <map>
+#include <unordered_map>
+#include <utility>
+
+#include <sffd/error.h>
+#include "core/kernel_registry.h"
+#include "kernels/common/shader_layout.h"
+
+namespace sffd::gl {
+
+namespace {
+
+std::string lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+std::string glString(GLenum which) {
+  const GLubyte* s = glGetString(which);
+  return s ? reinterpret_cast<const char*>(s) : "";
+}
+
+std::string hex(unsigned v) {
+  char buf[16];
+  std::snprintf(buf, sizeof buf, "0x%04x", v);
+  return buf;
+}
+
+uint64_t alignUp(uint64_t v, uint64_t a) { return a <= 1 ? v : (v + a - 1) / a * a; }
+
+// Throws an internal Error naming the operation when GL reports an error (all pending ones are drained).
+void checkGl(const char* what) {
+  GLenum first = glGetError();
+  if (first == GL_NO_ERROR) return;
+  for (int i = 0; i < 16 && glGetError() != GL_NO_ERROR; ++i) {}
+  if (first == GL_OUT_OF_MEMORY) throw deviceError(std::string("gl: out of memory in ") + what);
+  throw Error(ErrorKind::Internal, std::string("gl: error ") + hex(first) + " in " + what);
+}
+
+// Lowers "#version 450" to the context's version (4.3, 4.4): the kernels use nothing past GLSL 4.30.
+void fitVersion(std::string& src, int contextVersion) {
+  if (src.rfind("#version ", 0) != 0) return;
+  int want = std::atoi(src.c_str() + 9);
+  int have = contextVersion * 10;
+  if (want > have && have >= 430) src.replace(9, 3, std::to_string(have));
+}
+
+std::string variantName(KernelVariant v) {
+  return std::string(v.strict ? "strict" : "fast") + (v.f64 ? "-f64" : "-f32");
+}
+
+struct Program {
+  GLuint name = 0;
+  GLint paramsBlockSize = -1;   // GL_UNIFORM_BLOCK_DATA_SIZE of the block at binding 0 (-1: none)
+};
+
+class GlBackend final : public Backend {
+ public:
+  explicit GlBackend(std::shared_ptr<Context> context) : ctx_(std::move(context)) {
+    ctx_->activate();
+    GLint major = 0, minor = 0, profile = 0;
+    glGetIntegerv(GL_MAJOR_VERSION, &major);
+    glGetIntegerv(GL_MINOR_VERSION, &minor);
+    glGetIntegerv(GL_CONTEXT_PROFILE_MASK, &profile);
+    info_.api = "gl";
+    info_.provider = ctx_->name();
+    info_.name = glString(GL_RENDERER);
+    info_.driver = glString(GL_VERSION);
+    if (major * 10 + minor < 43 || !(profile & GL_CONTEXT_CORE_PROFILE_BIT))
+      throw deviceError("gl/" + info_.provider + ": compute needs OpenGL 4.3 core, the context is " +
+                        std::to_string(major) + "." + std::to_string(minor) +
+                        ((profile & GL_CONTEXT_CORE_PROFILE_BIT) ? " core" : " (not core)") + " (" + info_.driver +
+                        ", " + info_.name + ")");
+    std::string r = lower(info_.name);
+    bool cpu = r.find("llvmpipe") != std::string::npos || r.find("softpipe") != std::string::npos ||
+               r.find("swrast") != std::string::npos;
+    info_.type = cpu ? "cpu" : "other";
+
+    DeviceLimits& L = info_.limits;
+    GLint64 ssboSize = 0;
+    glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &ssboSize);
+    L.maxStorageBufferRange = static_cast<uint64_t>(ssboSize);
+    GLint align = 0;
+    glGetIntegerv(GL_SHADER_STORAGE_BUFFER_OFFSET_ALIGNMENT, &align);
+    L.storageOffsetAlignment = static_cast<uint64_t>(std::max(align, 1));
+    for (GLuint i = 0; i < 3; ++i) {
+      GLint n = 0;
+      glGetIntegeri_v(GL_MAX_COMPUTE_WORK_GROUP_COUNT, i, &n);
+      L.maxWorkGroupCount[i] = static_cast<uint32_t>(std::max(n, 0));
+    }
+    L.float64 = true;   // GL 4.0+ core has doubles (ARB_gpu_shader_fp64)
+    GLint bits = 0;
+    glGetQueryiv(GL_TIMESTAMP, GL_QUERY_COUNTER_BITS, &bits);
+    L.timestamps = bits > 0;
+
+    GLint uboAlign = 0, maxBlock = 0;
+    glGetIntegerv(GL_UNIFORM_BUFFER_OFFSET_ALIGNMENT, &uboAlign);
+    glGetIntegerv(GL_MAX_UNIFORM_BLOCK_SIZE, &maxBlock);
+    uboAlign_ = static_cast<uint64_t>(std::max(uboAlign, 16));
+    maxParams_ = static_cast<uint64_t>(std::max(maxBlock, 16384));
+    uboSize_ = std::max<uint64_t>(kRingBytes, alignUp(maxParams_, uboAlign_));
+    glGenBuffers(1, &ubo_);
+    glBindBuffer(GL_UNIFORM_BUFFER, ubo_);
+    glBufferData(GL_UNIFORM_BUFFER, static_cast<GLsizeiptr>(uboSize_), nullptr, GL_STREAM_DRAW);
+    checkGl("creating the parameter ring");
+  }
+
+  ~GlBackend() override {
+    try {
+      ctx_->activate();
+      glFinish();
+      for (auto& [key, p] : programs_) glDeleteProgram(p.name);
+      for (auto& [id, b] : buffers_) glDeleteBuffers(1, &b.name);
+      for (const Pending& p : pending_)
+        if (p.begin) {
+          glDeleteQueries(1, &p.begin);
+          glDeleteQueries(1, &p.end);
+        }
+      if (!freeQueries_.empty()) glDeleteQueries(static_cast<GLsizei>(freeQueries_.size()), freeQueries_.data());
+      glDeleteBuffers(1, &ubo_);
+      glFinish();
+    } catch (...) {
+      // the context could not be made current: its destruction frees everything anyway
+    }
+  }
+
+  const DeviceInfo& info() const override { return info_; }
+  GLuint bufferObject(BufferId id) const {
+    auto it = buffers_.find(id);
+    return it == buffers_.end() ? 0 : it->second.name;
+  }
+
+  BufferId createBuffer(uint64_t bytes) override {
+    ctx_->activate();
+    GLuint name = 0;
+    glGenBuffers(1, &name);
+    glBindBuffer(GL_COPY_WRITE_BUFFER, name);
+    // Zero-sized storage is an error in GL: keep 16 bytes behind an empty buffer.
+    GLsizeiptr size = static_cast<GLsizeiptr>(std::max<uint64_t>(bytes, 16));
+    if (GLAD_GL_VERSION_4_4)
+      glBufferStorage(GL_COPY_WRITE_BUFFER, size, nullptr, GL_DYNAMIC_STORAGE_BIT);
+    else
+      glBufferData(GL_COPY_WRITE_BUFFER, size, nullptr, GL_DYNAMIC_DRAW);
+    try {
+      checkGl("createBuffer");
+    } catch (...) {
+      glDeleteBuffers(1, &name);
+      throw;
+    }
+    BufferId id = nextId_++;
+    buffers_[id] = {name, bytes};
+    return id;
+  }
+
+  void destroyBuffer(BufferId id) override {
+    ctx_->activate();
+    auto it = buffers_.find(id);
+    if (it == buffers_.end()) return;
+    glDeleteBuffers(1, &it->second.name);
+    buffers_.erase(it);
+  }
+
+  void upload(BufferId id, uint64_t offset, const void* data, uint64_t bytes) override {
+    ctx_->activate();
+    const Buf& b = buffer(id, offset, bytes, "upload");
+    if (bytes == 0) return;
+    // Shader writes are incoherent: order them before this write.
+    if (dirty_) glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    glBindBuffer(GL_COPY_WRITE_BUFFER, b.name);
+    glBufferSubData(GL_COPY_WRITE_BUFFER, static_cast<GLintptr>(offset), static_cast<GLsizeiptr>(bytes), data);
+    checkGl("upload");
+  }
+
+  void download(BufferId id, uint64_t offset, void* data, uint64_t bytes) override {
+    ctx_->activate();
+    const Buf& b = buffer(id, offset, bytes, "download");
+    if (bytes == 0) return;
+    if (dirty_) {
+      glMemoryBarrier(kAllBarriers);
+      dirty_ = false;
+    }
+    glBindBuffer(GL_COPY_READ_BUFFER, b.name);
+    // Synchronous: waits for the dispatches that write the buffer.
+    glGetBufferSubData(GL_COPY_READ_BUFFER, static_cast<GLintptr>(offset), static_cast<GLsizeiptr>(bytes), data);
+    checkGl("download");
+  }
+
+  void dispatch(const Dispatch& d) override {
+    ctx_->activate();
+    const EmbeddedKernel* kernel = findKernel(d.kernel);
+    if (!kernel) throw Error(ErrorKind::Internal, "gl: no kernel named '" + std::string(d.kernel) + "'");
+    const Program& prog = program(*kernel, d.variant);
+    std::string what = std::string(d.kernel) + " (" + variantName(d.variant) + ")";
+
+    const DeviceLimits& L = info_.limits;
+    for (int i = 0; i < 3; ++i)
+      if (d.groups[i] > L.maxWorkGroupCount[i])
+        throw Error(ErrorKind::Internal, "gl: dispatch of " + what + " has " + std::to_string(d.groups[i]) +
+                                             " groups on axis " + std::to_string(i) + ", the device allows " +
+                                             std::to_string(L.maxWorkGroupCount[i]) + " (use gridFor)");
+
+    // Parameter block: next slot of the ring, orphaned when it wraps.
+    if (prog.paramsBlockSize >= 0 && d.paramsSize < static_cast<uint64_t>(prog.paramsBlockSize))
+      throw Error(ErrorKind::Internal, "gl: " + what + " takes a " + std::to_string(prog.paramsBlockSize) +
+                                           "-byte parameter block, the dispatch gives " +
+                                           std::to_string(d.paramsSize));
+    if (d.paramsSize > maxParams_)
+      throw Error(ErrorKind::Internal, "gl: parameter block of " + what + " is larger than GL_MAX_UNIFORM_BLOCK_SIZE");
+    uint64_t span = alignUp(std::max<uint64_t>(d.paramsSize, 16), 16);
+    glBindBuffer(GL_UNIFORM_BUFFER, ubo_);
+    if (uboHead_ + span > uboSize_) {
+      glBufferData(GL_UNIFORM_BUFFER, static_cast<GLsizeiptr>(uboSize_), nullptr, GL_STREAM_DRAW);
+      uboHead_ = 0;
+    }
+    if (d.params && d.paramsSize > 0)
+      glBufferSubData(GL_UNIFORM_BUFFER, static_cast<GLintptr>(uboHead_), static_cast<GLsizeiptr>(d.paramsSize),
+                      d.params);
+    glBindBufferRange(GL_UNIFORM_BUFFER, SFFD_BINDING_PARAMS, ubo_, static_cast<GLintptr>(uboHead_),
+                      static_cast<GLsizeiptr>(span));
+    uboHead_ = alignUp(uboHead_ + span, uboAlign_);
+
+    for (const BufferBinding& bb : d.buffers) {
+      if (bb.slot < 1 || bb.slot > SFFD_MAX_STORAGE_BINDINGS)
+        throw Error(ErrorKind::Internal, "gl: " + what + ": storage binding slot " + std::to_string(bb.slot) +
+                                             " is outside 1.." + std::to_string(SFFD_MAX_STORAGE_BINDINGS));
+      auto it = buffers_.find(bb.buffer);
+      if (it == buffers_.end())
+        throw Error(ErrorKind::Internal, "gl: " + what + ": slot " + std::to_string(bb.slot) + " names no buffer");
+      const Buf& b = it->second;
+      if (bb.offset % L.storageOffsetAlignment != 0)
+        throw Error(ErrorKind::Internal, "gl: " + what + ": slot " + std::to_string(bb.slot) + " offset " +
+                                             std::to_string(bb.offset) + " is not a multiple of " +
+                                             std::to_string(L.storageOffsetAlignment));
+      if (bb.offset > b.size || (bb.size > 0 && bb.size > b.size - bb.offset))
+        throw Error(ErrorKind::Internal, "gl: " + what + ": slot " + std::to_string(bb.slot) +
+                                             " range runs past the end of its buffer");
+      uint64_t size = bb.size > 0 ? bb.size : b.size - bb.offset;
+      if (size == 0)
+        throw Error(ErrorKind::Internal, "gl: " + what + ": slot " + std::to_string(bb.slot) + " binds no bytes");
+      if (size > L.maxStorageBufferRange)
+        throw Error(ErrorKind::Internal, "gl: " + what + ": slot " + std::to_string(bb.slot) + " binds " +
+                                             std::to_string(size) + " bytes, the device allows " +
+                                             std::to_string(L.maxStorageBufferRange) + " (process in chunks)");
+      glBindBufferRange(GL_SHADER_STORAGE_BUFFER, bb.slot, b.name, static_cast<GLintptr>(bb.offset),
+                        static_cast<GLsizeiptr>(size));
+    }
+
+    glUseProgram(prog.name);
+    Pending rec{std::string(d.label.empty() ? d.kernel : d.label), 0, 0};
+    // A pair of GL_TIMESTAMP counters, not a GL_TIME_ELAPSED query: llvmpipe's elapsed time covers only
+    // rasterizer scenes and gives 0 or garbage for compute, while its timestamps bracket the dispatch,
+    // which llvmpipe runs to completion before returning.
+    if (L.timestamps) {
+      rec.begin = takeQuery();
+      rec.end = takeQuery();
+      glQueryCounter(rec.begin, GL_TIMESTAMP);
+    }
+    glDispatchCompute(d.groups[0], d.groups[1], d.groups[2]);
+    if (rec.end) glQueryCounter(rec.end, GL_TIMESTAMP);
+    pending_.push_back(std::move(rec));
+    dirty_ = true;
+    checkGl(("dispatch of " + what).c_str());
+  }
+
+  void barrier() override {
+    ctx_->activate();
+    glMemoryBarrier(kAllBarriers);
+    dirty_ = false;
+    checkGl("barrier");
+  }
+
+  void finish() override {
+    ctx_->activate();
+    glFinish();
+    checkGl("finish");
+  }
+
+  std::vector<DispatchTiming> takeTimings() override {
+    ctx_->activate();
+    std::vector<DispatchTiming> out;
+    out.reserve(pending_.size());
+    for (Pending& p : pending_) {
+      DispatchTiming t;
+      t.label = std::move(p.label);
+      if (p.begin) {
+        GLuint64 t0 = 0, t1 = 0;
+        glGetQueryObjectui64v(p.begin, GL_QUERY_RESULT, &t0);   // waits for the result
+        glGetQueryObjectui64v(p.end, GL_QUERY_RESULT, &t1);
+        t.gpuMs = t1 >= t0 ? static_cast<double>(t1 - t0) * 1e-6 : 0.0;
+        freeQueries_.push_back(p.begin);
+        freeQueries_.push_back(p.end);
+      }
+      out.push_back(std::move(t));
+    }
+    pending_.clear();
+    checkGl("takeTimings");
+    return out;
+  }
+
+ private:
+  struct Buf {
+    GLuint name = 0;
+    uint64_t size = 0;
+  };
+  struct Pending {
+    std::string label;
+    GLuint begin = 0, end = 0;   // GL_TIMESTAMP queries around the dispatch (0: no timing)
+  };
+  static constexpr uint64_t kRingBytes = 64 * 1024;
+  // Everything later work may consume: storage and uniform reads, buffer transfers, indirect commands,
+  // and vertex/index fetch (the viewer draws from the output buffers).
+  static constexpr GLbitfield kAllBarriers = GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT |
+                                             GL_UNIFORM_BARRIER_BIT | GL_COMMAND_BARRIER_BIT |
+                                             GL_VERTEX_ATTRIB_ARRAY_BARRIER_BIT | GL_ELEMENT_ARRAY_BARRIER_BIT;
+
+  const Buf& buffer(BufferId id, uint64_t offset, uint64_t bytes, const char* what) const {
+    auto it = buffers_.find(id);
+    if (it == buffers_.end())
+      throw Error(ErrorKind::Internal, std::string("gl: ") + what + " of unknown buffer " + std::to_string(id));
+    if (offset > it->second.size || bytes > it->second.size - offset)
+      throw Error(ErrorKind::Internal, std::string("gl: ") + what + " of bytes " + std::to_string(offset) + ".." +
+                                           std::to_string(offset + bytes) + " of a " +
+                                           std::to_string(it->second.size) + "-byte buffer");
+    return it->second;
+  }
+
+  GLuint takeQuery() {
+    if (freeQueries_.empty()) {
+      GLuint q[16];
+      glGenQueries(16, q);
+      freeQueries_.assign(q, q + 16);
+    }
+    GLuint q = freeQueries_.back();
+    freeQueries_.pop_back();
+    return q;
+  }
+
+  const Program& program(const EmbeddedKernel& kernel, KernelVariant variant) {
+    auto key = std::make_pair(&kernel, variantIndex(variant));
+    auto it = programs_.find(key);
+    if (it != programs_.end()) return it->second;
+    std::string what = std::string(kernel.name) + " (" + variantName(variant) + ")";
+    if (variant.f64 && !info_.limits.float64) throw deviceError("gl: the device has no float64 for " + what);
+
+    std::string src = glslForVariant(kernel, variant);
+    fitVersion(src, ctx_->glVersion());
+    GLuint shader = glCreateShader(GL_COMPUTE_SHADER);
+    const char* text = src.c_str();
+    glShaderSource(shader, 1, &text, nullptr);
+    glCompileShader(shader);
+    GLint ok = 0;
+    glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+    if (!ok) {
+      std::string log = shaderLog(shader, false);
+      glDeleteShader(shader);
+      throw Error(ErrorKind::Internal, "gl: compiling kernel " + what + " failed:\n" + log);
+    }
+    GLuint prog = glCreateProgram();
+    glAttachShader(prog, shader);
+    glLinkProgram(prog);
+    glDetachShader(prog, shader);
+    glDeleteShader(shader);
+    glGetProgramiv(prog, GL_LINK_STATUS, &ok);
+    if (!ok) {
+      std::string log = shaderLog(prog, true);
+      glDeleteProgram(prog);
+      throw Error(ErrorKind::Internal, "gl: linking kernel " + what + " failed:\n" + log);
+    }
+    Program p;
+    p.name = prog;
+    GLint blocks = 0;
+    glGetProgramiv(prog, GL_ACTIVE_UNIFORM_BLOCKS, &blocks);
+    for (GLint i = 0; i < blocks; ++i) {
+      GLint binding = -1, size = 0;
+      glGetActiveUniformBlockiv(prog, static_cast<GLuint>(i), GL_UNIFORM_BLOCK_BINDING, &binding);
+      glGetActiveUniformBlockiv(prog, static_cast<GLuint>(i), GL_UNIFORM_BLOCK_DATA_SIZE, &size);
+      if (binding == SFFD_BINDING_PARAMS) p.paramsBlockSize = size;
+    }
+    checkGl(("building kernel " + what).c_str());
+    return programs_.emplace(key, p).first->second;
+  }
+
+  static std::string shaderLog(GLuint object, bool isProgram) {
+    GLint len = 0;
+    if (isProgram)
+      glGetProgramiv(object, GL_INFO_LOG_LENGTH, &len);
+    else
+      glGetShaderiv(object, GL_INFO_LOG_LENGTH, &len);
+    std::string log(static_cast<size_t>(std::max(len, 1)), '\0');
+    if (isProgram)
+      glGetProgramInfoLog(object, len, nullptr, log.data());
+    else
+      glGetShaderInfoLog(object, len, nullptr, log.data());
+    log.resize(std::strlen(log.c_str()));
+    return log;
+  }
+
+  std::shared_ptr<Context> ctx_;
+  DeviceInfo info_;
+  std::unordered_map<BufferId, Buf> buffers_;
+  BufferId nextId_ = 1;
+  std::map<std::pair<const EmbeddedKernel*, int>, Program> programs_;
+  GLuint ubo_ = 0;
+  uint64_t uboSize_ = 0, uboHead_ = 0, uboAlign_ = 256, maxParams_ = 16384;
+  std::vector<Pending> pending_;
+  std::vector<GLuint> freeQueries_;
+  bool dirty_ = false;   // dispatches since the last barrier
+};
+
+// A backend of one explicit provider, refused when its renderer does not match the device substring.
+std::unique_ptr<Backend> backendOf(Provider provider, const std::string& deviceSubstring) {
+  auto backend = std::make_unique<GlBackend>(std::shared_ptr<Context>(createContext(provider)));
+  if (!deviceSubstring.empty() && lower(backend->info().name).find(lower(deviceSubstring)) == std::string::npos)
+    throw deviceError("gl/" + backend->info().provider + ": renderer '" + backend->info().name +
+                      "' does not contain '" + deviceSubstring + "'");
+  return backend;
+}
+
+}  // namespace
+
+std::unique_ptr<Backend> createBackend(const Options& options) {
+  Provider provider = options.provider;
+  if (provider == Provider::Auto) {
+    const char* env = std::getenv("SFFD_GL_PROVIDER");
+    if (env && *env) provider = parseProvider(env);
+  }
+  if (provider != Provider::Auto) return backendOf(provider, options.deviceSubstring);
+  std::string reasons;
+  for (Provider p : {Provider::EGL, Provider::OSMesa}) {
+    try {
+      return backendOf(p, options.deviceSubstring);
+    } catch (const Error& e) {
+      if (e.kind() != ErrorKind::Device) throw;
+      reasons += (reasons.empty() ? "" : "; ") + std::string(e.what());
+    }
+  }
+  throw deviceError("gl: no usable OpenGL 4.3+ core context: " + reasons);
+}
+
+std::unique_ptr<Backend> createBackendOn(std::shared_ptr<Context> context) {
+  if (!context) throw Error(ErrorKind::Internal, "gl: createBackendOn without a context");
+  return std::make_unique<GlBackend>(std::move(context));
+}
+
+unsigned glBufferObject(const Backend& backend, BufferId buffer) {
+  const auto* gl = dynamic_cast<const GlBackend*>(&backend);
+  return gl ? gl->bufferObject(buffer) : 0;
+}
+
+std::vector<DeviceInfo> listDevices() {
+  std::vector<DeviceInfo> out;
+  std::string reasons;
+  for (Provider p : {Provider::EGL, Provider::OSMesa}) {
+    try {
+      out.push_back(backendOf(p, "")->info());
+    } catch (const Error& e) {
+      if (e.kind() != ErrorKind::Device) throw;
+      reasons += (reasons.empty() ? "" : "; ") + std::string(e.what());
+    }
+  }
+  if (out.empty()) throw deviceError("gl: no usable OpenGL 4.3+ core context: " + reasons);
+  return out;
+}
+
+}  // namespace sffd::gl

@@ -1,0 +1,28 @@
+// OpenGL 4.3+ core compute driver: implements sffd::Backend on a current GL context obtained from
+// one of the context providers (gl_context.h): EGL surfaceless, OSMesa, or a GLFW window.
+#pragma once
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/backend.h"
+#include "backends/opengl/gl_context.h"   // Provider
+
+namespace sffd::gl {
+
+struct Options {
+  Provider provider = Provider::Auto;   // Auto: SFFD_GL_PROVIDER if set, else EGL surfaceless, then OSMesa
+  std::string deviceSubstring;          // refuse a context whose GL_RENDERER does not contain it (case-insensitive)
+};
+
+// One entry per headless provider that gives a GL 4.3+ core context. Throws a device Error when none does.
+std::vector<DeviceInfo> listDevices();
+std::unique_ptr<Backend> createBackend(const Options& options);
+// A backend on a context the caller made (the viewer's visible GLFW window); the backend activates it
+// before its GL calls and keeps it alive. Throws a device Error when it is not GL 4.3+ core.
+std::unique_ptr<Backend> createBackendOn(std::shared_ptr<Context> context);
+// The GL buffer object behind a buffer of a GL backend, for drawing from it in the same context
+// (0 when `backend` is not a GL backend or has no such buffer).
+unsigned glBufferObject(const Backend& backend, BufferId buffer);
+
+}  // namespace sffd::gl

@@ -1,0 +1,566 @@
+// Tests of the OpenGL compute driver and its context providers (EGL surfaceless, OSMesa, GLFW) on
+// Mesa's llvmpipe. No X display is needed except for the GLFW test, which is skipped without one.
+#include <dlfcn.h>
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "kernels/classic/classic_ffd.h"
+#include <sffd/error.h>
+#include "backends/opengl/gl_backend.h"
+#include "backends/opengl/gl_context.h"
+#include "kernels/common/shader_layout.h"
+
+namespace sffd::gl {
+namespace {
+
+// Software devices only, as ctest runs them (set before any GL library is opened).
+const bool kSoftware = [] {
+  setenv("LIBGL_ALWAYS_SOFTWARE", "1", 1);
+  return true;
+}();
+
+std::unique_ptr<Backend> open(Provider p) {
+  Options o;
+  o.provider = p;
+  return createBackend(o);
+}
+
+// Skips when the provider's library is missing on this machine (OSMesa is gone from Mesa 25.1).
+#define SKIP_WITHOUT(provider)                                                                  \
+  do {                                                                                          \
+    if (!providerLibraryPresent(provider))                                                      \
+      GTEST_SKIP() << providerName(provider) << " library not installed";                       \
+  } while (0)
+
+// A hand-built lattice: one knot box [0,1]^3, degree 1, identity frame; coefficient
+// (p*2+q)*2+r is the corner (p,q,r). `moved` displaces corner 7 (1,1,1) to make it non-trivial.
+template <class Real>
+struct HandLattice {
+  gpu::LatticeParams params;
+  std::vector<Real> frame;
+  std::vector<Real> coeffs;
+  explicit HandLattice(bool moved = false) {
+    params.degree = {1, 1, 1, SFFD_OUTSIDE_EXTRAPOLATE};
+    params.boxes = {1, 1, 1, 8};
+    params.break_offset = {24, 26, 28, 0};
+    frame = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0,    // affine rows
+             1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0,    // cof(A) rows
+             0, 1, 0, 1, 0, 1};                      // breaks u, v, w
+    for (int p = 0; p < 2; ++p)
+      for (int q = 0; q < 2; ++q)
+        for (int r = 0; r < 2; ++r) {
+          coeffs.push_back(Real(p));
+          coeffs.push_back(Real(q));
+          coeffs.push_back(Real(r));
+          coeffs.push_back(Real(0));
+        }
+    if (moved) {
+      coeffs[4 * 7 + 0] = Real(1.3);
+      coeffs[4 * 7 + 1] = Real(0.8);
+      coeffs[4 * 7 + 2] = Real(1.17);
+      coeffs[4 * 2 + 1] = Real(1.25);   // corner (0,1,0) too
+    }
+  }
+};
+
+// Points (w = 1) and unit normals (w = 0) as real4; `inside` of them in [0,1]^3, the rest outside.
+template <class Real>
+void makeVertices(size_t n, size_t inside, std::vector<Real>& pos, std::vector<Real>& nrm, unsigned seed = 7) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> in(0.0, 1.0), out(-0.5, 1.5), dir(-1.0, 1.0);
+  pos.resize(4 * n);
+  nrm.resize(4 * n);
+  for (size_t i = 0; i < n; ++i) {
+    for (int k = 0; k < 3; ++k) pos[4 * i + k] = Real(i < inside ? in(rng) : out(rng));
+    if (i >= inside) pos[4 * i] = Real(1.25 + 0.25 * in(rng));   // surely outside on x
+    pos[4 * i + 3] = 1;
+    double v[3], len = 0;
+    do {
+      for (double& c : v) c = dir(rng);
+      len = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    } while (len < 0.1);
+    for (int k = 0; k < 3; ++k) nrm[4 * i + k] = Real(v[k] / len);
+    nrm[4 * i + 3] = 0;
+  }
+}
+
+template <class Real>
+struct ClassicRun {
+  std::vector<Real> pos, nrm;
+  std::vector<DispatchTiming> timings;
+  double wallMs = 0;   // from the dispatch to the end of the downloads
+  uint32_t groups[3] = {1, 1, 1};
+};
+
+// One classic_ffd dispatch over all vertices (gridFor splits it into a 2-D grid when needed).
+template <class Real>
+ClassicRun<Real> runClassic(Backend& b, KernelVariant v, const HandLattice<Real>& L, const std::vector<Real>& pos,
+                            const std::vector<Real>& nrm) {
+  const size_t n = pos.size() / 4, bytes = pos.size() * sizeof(Real);
+  BufferId frame = b.createBuffer(L.frame.size() * sizeof(Real));
+  BufferId coeffs = b.createBuffer(L.coeffs.size() * sizeof(Real));
+  BufferId io[4];
+  for (BufferId& id : io) id = b.createBuffer(bytes);
+  b.upload(frame, 0, L.frame.data(), L.frame.size() * sizeof(Real));
+  b.upload(coeffs, 0, L.coeffs.data(), L.coeffs.size() * sizeof(Real));
+  b.upload(io[0], 0, pos.data(), bytes);
+  b.upload(io[1], 0, nrm.data(), bytes);
+
+  gpu::ClassicParams params;
+  params.lattice = L.params;
+  params.range = {0, uint32_t(n), 0, 0};
+  Dispatch d;
+  d.kernel = "classic_ffd";
+  d.variant = v;
+  d.params = &params;
+  d.paramsSize = sizeof(params);
+  d.buffers = {{SFFD_BINDING_LATTICE_COEFFS, coeffs}, {SFFD_BINDING_LATTICE_FRAME, frame},
+               {SFFD_BINDING_CLASSIC_POS_IN, io[0]},  {SFFD_BINDING_CLASSIC_NRM_IN, io[1]},
+               {SFFD_BINDING_CLASSIC_POS_OUT, io[2]}, {SFFD_BINDING_CLASSIC_NRM_OUT, io[3]}};
+  d.label = "classic test";
+  ClassicRun<Real> r;
+  gridFor(n, b.info().limits, d.groups);
+  std::memcpy(r.groups, d.groups, sizeof r.groups);
+  auto t0 = std::chrono::steady_clock::now();
+  b.dispatch(d);
+  b.barrier();
+  r.pos.resize(pos.size());
+  r.nrm.resize(nrm.size());
+  b.download(io[2], 0, r.pos.data(), bytes);
+  b.download(io[3], 0, r.nrm.data(), bytes);
+  b.finish();
+  r.wallMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  r.timings = b.takeTimings();
+  for (BufferId id : io) b.destroyBuffer(id);
+  b.destroyBuffer(frame);
+  b.destroyBuffer(coeffs);
+  return r;
+}
+
+// The identity lattice maps every point to itself (inside: w = 1, outside: extrapolated, w = 0)
+// and keeps every normal.
+template <class Real>
+void expectIdentity(Backend& b, KernelVariant v, double tol) {
+  HandLattice<Real> L;
+  std::vector<Real> pos, nrm;
+  makeVertices<Real>(1000, 900, pos, nrm);
+  ClassicRun<Real> r = runClassic(b, v, L, pos, nrm);
+  size_t bad = 0;
+  for (size_t i = 0; i < pos.size() / 4 && bad < 10; ++i) {
+    bool inside = i < 900;
+    for (int k = 0; k < 3; ++k) {
+      if (std::abs(double(r.pos[4 * i + k]) - double(pos[4 * i + k])) > tol ||
+          std::abs(double(r.nrm[4 * i + k]) - double(nrm[4 * i + k])) > tol) {
+        ++bad;
+        ADD_FAILURE() << "vertex " << i << " axis " << k << ": position " << r.pos[4 * i + k] << " vs "
+                      << pos[4 * i + k] << ", normal " << r.nrm[4 * i + k] << " vs " << nrm[4 * i + k];
+      }
+    }
+    EXPECT_EQ(double(r.pos[4 * i + 3]), inside ? 1.0 : 0.0) << "vertex " << i;
+    EXPECT_EQ(double(r.nrm[4 * i + 3]), 0.0) << "vertex " << i;
+  }
+  ASSERT_EQ(r.timings.size(), 1u);
+  EXPECT_EQ(r.timings[0].label, "classic test");
+  if (b.info().limits.timestamps) {
+    EXPECT_GE(r.timings[0].gpuMs, 0.0);
+  }
+}
+
+class GlProviderTest : public ::testing::TestWithParam<Provider> {
+ protected:
+  void SetUp() override { SKIP_WITHOUT(GetParam()); }
+};
+
+TEST_P(GlProviderTest, ContextIsCore43AndInfoIsFilled) {
+  auto b = open(GetParam());
+  const DeviceInfo& info = b->info();
+  EXPECT_EQ(info.api, "gl");
+  EXPECT_EQ(info.provider, providerName(GetParam()));
+  EXPECT_FALSE(info.name.empty());
+  int major = 0, minor = 0;
+  ASSERT_EQ(std::sscanf(info.driver.c_str(), "%d.%d", &major, &minor), 2) << info.driver;
+  EXPECT_GE(major * 10 + minor, 43) << info.driver;
+  EXPECT_NE(info.driver.find("Core"), std::string::npos) << info.driver;
+  EXPECT_EQ(info.type, "cpu") << info.name;   // LIBGL_ALWAYS_SOFTWARE=1: llvmpipe
+  EXPECT_GE(info.limits.maxStorageBufferRange, 16u << 20);
+  EXPECT_GT(info.limits.storageOffsetAlignment, 0u);
+  EXPECT_GE(info.limits.maxWorkGroupCount[0], 65535u);
+  EXPECT_TRUE(info.limits.float64);
+  std::printf("%s: %s | %s | ssbo %llu B, align %llu, groups %u, timestamps %d\n", info.provider.c_str(),
+              info.name.c_str(), info.driver.c_str(), (unsigned long long)info.limits.maxStorageBufferRange,
+              (unsigned long long)info.limits.storageOffsetAlignment, info.limits.maxWorkGroupCount[0],
+              int(info.limits.timestamps));
+}
+
+TEST_P(GlProviderTest, BufferRoundTripWithOffsets) {
+  auto b = open(GetParam());
+  const uint64_t n = 1000;
+  BufferId id = b->createBuffer(n);
+  std::vector<uint8_t> data(n), back(n, 0xEE);
+  for (uint64_t i = 0; i < n; ++i) data[i] = uint8_t(i * 7 + 3);
+  b->upload(id, 0, data.data(), n);
+  b->download(id, 0, back.data(), n);
+  EXPECT_EQ(back, data);
+  // Partial writes at unaligned offsets, partial reads.
+  std::vector<uint8_t> patch(37, 0x5A);
+  b->upload(id, 101, patch.data(), patch.size());
+  for (size_t i = 0; i < patch.size(); ++i) data[101 + i] = 0x5A;
+  std::vector<uint8_t> mid(300);
+  b->download(id, 77, mid.data(), mid.size());
+  EXPECT_TRUE(std::equal(mid.begin(), mid.end(), data.begin() + 77));
+  b->download(id, n - 1, mid.data(), 1);
+  EXPECT_EQ(mid[0], data[n - 1]);
+  // Out of range and unknown buffers are internal errors.
+  EXPECT_THROW(b->upload(id, n - 10, patch.data(), 11), Error);
+  EXPECT_THROW(b->download(id, n + 1, mid.data(), 0), Error);
+  EXPECT_THROW(b->download(9999, 0, mid.data(), 1), Error);
+  b->destroyBuffer(id);
+  // A zero-sized buffer exists and can be destroyed.
+  BufferId empty = b->createBuffer(0);
+  b->download(empty, 0, mid.data(), 0);
+  b->destroyBuffer(empty);
+}
+
+TEST_P(GlProviderTest, ClassicIdentityAllVariants) {
+  auto b = open(GetParam());
+  expectIdentity<float>(*b, {false, false}, 1e-6);
+  expectIdentity<float>(*b, {true, false}, 1e-6);
+  expectIdentity<double>(*b, {false, true}, 1e-14);
+  expectIdentity<double>(*b, {true, true}, 1e-14);
+}
+
+TEST_P(GlProviderTest, StorageBindingsAtOffsets) {
+  // The vertices live in the middle of larger buffers, bound with an aligned offset and a size.
+  auto b = open(GetParam());
+  const uint64_t align = b->info().limits.storageOffsetAlignment;
+  HandLattice<float> L;
+  std::vector<float> pos, nrm;
+  makeVertices<float>(100, 100, pos, nrm);
+  const uint64_t bytes = pos.size() * sizeof(float), off = 3 * align;
+  BufferId frame = b->createBuffer(L.frame.size() * 4), coeffs = b->createBuffer(L.coeffs.size() * 4);
+  b->upload(frame, 0, L.frame.data(), L.frame.size() * 4);
+  b->upload(coeffs, 0, L.coeffs.data(), L.coeffs.size() * 4);
+  BufferId big = b->createBuffer(off + 4 * bytes + 4 * align);
+  uint64_t at[4];
+  for (int k = 0; k < 4; ++k) at[k] = off + k * (bytes + align - 1) / align * align;
+  b->upload(big, at[0], pos.data(), bytes);
+  b->upload(big, at[1], nrm.data(), bytes);
+  gpu::ClassicParams params;
+  params.lattice = L.params;
+  params.range = {0, 100, 0, 0};
+  Dispatch d;
+  d.kernel = "classic_ffd";
+  d.variant = {true, false};
+  d.params = &params;
+  d.paramsSize = sizeof params;
+  d.buffers = {{SFFD_BINDING_LATTICE_COEFFS, coeffs}, {SFFD_BINDING_LATTICE_FRAME, frame},
+               {SFFD_BINDING_CLASSIC_POS_IN, big, at[0], bytes},  {SFFD_BINDING_CLASSIC_NRM_IN, big, at[1], bytes},
+               {SFFD_BINDING_CLASSIC_POS_OUT, big, at[2], bytes}, {SFFD_BINDING_CLASSIC_NRM_OUT, big, at[3], bytes}};
+  gridFor(100, b->info().limits, d.groups);
+  b->dispatch(d);
+  b->barrier();
+  std::vector<float> out(pos.size());
+  b->download(big, at[2], out.data(), bytes);
+  for (size_t i = 0; i < 100; ++i)
+    for (int k = 0; k < 3; ++k) ASSERT_NEAR(out[4 * i + k], pos[4 * i + k], 1e-6);
+  // A misaligned offset, a range past the end, a slot out of range, too many groups, a short
+  // parameter block and an unknown kernel are internal errors.
+  auto expectInternal = [&](Dispatch bad) {
+    try {
+      b->dispatch(bad);
+      ADD_FAILURE() << "dispatch accepted";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.kind(), ErrorKind::Internal) << e.what();
+    }
+  };
+  if (align > 1) {
+    Dispatch bad = d;
+    bad.buffers[2].offset = at[0] + 4;
+    expectInternal(bad);
+  }
+  {
+    Dispatch bad = d;
+    bad.buffers[2].size = 100 * bytes;
+    expectInternal(bad);
+  }
+  {
+    Dispatch bad = d;
+    bad.buffers[0].slot = SFFD_MAX_STORAGE_BINDINGS + 1;
+    expectInternal(bad);
+  }
+  {
+    Dispatch bad = d;
+    bad.groups[0] = b->info().limits.maxWorkGroupCount[0] + 1;
+    expectInternal(bad);
+  }
+  {
+    Dispatch bad = d;
+    bad.paramsSize = 16;
+    expectInternal(bad);
+  }
+  {
+    Dispatch bad = d;
+    bad.kernel = "no_such_kernel";
+    expectInternal(bad);
+  }
+  b->takeTimings();
+}
+
+TEST_P(GlProviderTest, DispatchBeyond65535GroupsViaGridFor) {
+  auto b = open(GetParam());
+  // 65535 groups of 64 and then three more groups: a 2-D grid of 65535 x 2.
+  const size_t n = size_t(SFFD_MAX_GROUPS_X) * SFFD_LOCAL_SIZE + 3 * SFFD_LOCAL_SIZE - 5;
+  HandLattice<float> L;
+  std::vector<float> pos(4 * n), nrm(4 * n);
+  for (size_t i = 0; i < n; ++i) {
+    // Distinct points on a 256 x 256 x 64 grid inside the box, exactly representable.
+    pos[4 * i + 0] = float(i % 256) / 256.0f;
+    pos[4 * i + 1] = float((i / 256) % 256) / 256.0f;
+    pos[4 * i + 2] = float((i / 65536) % 64) / 64.0f;
+    pos[4 * i + 3] = 1;
+    nrm[4 * i + 2] = 1;
+  }
+  ClassicRun<float> r = runClassic(*b, {false, false}, L, pos, nrm);
+  EXPECT_LE(r.groups[0], 65535u);
+  EXPECT_EQ(r.groups[1], 2u);   // more than 65535 groups of work: a second row of groups is needed
+  EXPECT_GE(uint64_t(r.groups[0]) * r.groups[1] * SFFD_LOCAL_SIZE, n);
+  ASSERT_EQ(r.timings.size(), 1u);
+  std::printf("%s: %zu vertices, 2 rows of groups: %.1f ms by timestamps, %.1f ms wall with downloads\n",
+              b->info().provider.c_str(), n, r.timings[0].gpuMs, r.wallMs);
+  if (b->info().limits.timestamps) {
+    EXPECT_GT(r.timings[0].gpuMs, 0.0);
+    EXPECT_LE(r.timings[0].gpuMs, r.wallMs);
+  }
+  size_t bad = 0;
+  for (size_t i = 0; i < n; ++i) {
+    bool ok = std::abs(r.pos[4 * i] - pos[4 * i]) <= 1e-6f && std::abs(r.pos[4 * i + 1] - pos[4 * i + 1]) <= 1e-6f &&
+              std::abs(r.pos[4 * i + 2] - pos[4 * i + 2]) <= 1e-6f && r.pos[4 * i + 3] == 1.0f &&
+              r.nrm[4 * i + 2] == 1.0f;
+    if (!ok && bad++ < 5) ADD_FAILURE() << "vertex " << i << " of " << n << " not written or wrong";
+  }
+  EXPECT_EQ(bad, 0u);
+}
+
+TEST_P(GlProviderTest, StrictMatchesCpuReferenceBitForBit) {
+  // The strict kernels and the C++ reference (built with -ffp-contract=off) round alike.
+  auto b = open(GetParam());
+  HandLattice<double> L(true);
+  PackedLattice P;
+  P.params = L.params;
+  P.frame = L.frame;
+  P.coeffs = L.coeffs;
+  std::vector<double> pos, nrm;
+  makeVertices<double>(500, 400, pos, nrm, 11);
+  Mesh mesh;
+  for (size_t i = 0; i < 500; ++i) {
+    mesh.positions.push_back({pos[4 * i], pos[4 * i + 1], pos[4 * i + 2]});
+    mesh.normals.push_back({nrm[4 * i], nrm[4 * i + 1], nrm[4 * i + 2]});
+  }
+  for (bool f64 : {false, true}) {
+    KernelVariant v{true, f64};
+    ClassicOutput gpu = classicFfdGpu(*b, mesh, P, v), cpu = classicFfdCpu(mesh, P, v);
+    size_t diff = 0;
+    for (size_t i = 0; i < gpu.positions.size(); ++i) {
+      if (std::memcmp(&gpu.positions[i], &cpu.positions[i], sizeof(double)) != 0 ||
+          std::memcmp(&gpu.normals[i], &cpu.normals[i], sizeof(double)) != 0) {
+        if (diff++ < 5)
+          ADD_FAILURE() << (f64 ? "f64" : "f32") << " value " << i << ": gpu " << gpu.positions[i] << "/"
+                        << gpu.normals[i] << " cpu " << cpu.positions[i] << "/" << cpu.normals[i];
+      }
+    }
+    EXPECT_EQ(diff, 0u) << (f64 ? "f64" : "f32");
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Headless, GlProviderTest, ::testing::Values(Provider::EGL, Provider::OSMesa),
+                         [](const ::testing::TestParamInfo<Provider>& i) {
+                           return std::string(i.param == Provider::EGL ? "EGL" : "OSMesa");
+                         });
+
+template <class Real>
+void expectBitIdenticalAcrossProviders(KernelVariant v) {
+  HandLattice<Real> L(true);
+  std::vector<Real> pos, nrm;
+  makeVertices<Real>(2000, 1500, pos, nrm, 3);
+  ClassicRun<Real> egl, osmesa;
+  {
+    auto b = open(Provider::EGL);
+    egl = runClassic(*b, v, L, pos, nrm);
+  }
+  {
+    auto b = open(Provider::OSMesa);
+    osmesa = runClassic(*b, v, L, pos, nrm);
+  }
+  // The lattice is not the identity: outputs really moved.
+  double moved = 0;
+  for (size_t i = 0; i < pos.size(); ++i) moved = std::max(moved, std::abs(double(egl.pos[i]) - double(pos[i])));
+  EXPECT_GT(moved, 0.01);
+  bool same = std::memcmp(egl.pos.data(), osmesa.pos.data(), pos.size() * sizeof(Real)) == 0 &&
+              std::memcmp(egl.nrm.data(), osmesa.nrm.data(), nrm.size() * sizeof(Real)) == 0;
+  std::printf("%s-%s: EGL and OSMesa outputs %s\n", v.strict ? "strict" : "fast", v.f64 ? "f64" : "f32",
+              same ? "bit-identical" : "differ");
+  if (v.strict) {
+    EXPECT_TRUE(same);   // fast variants: measured and printed only
+  }
+}
+
+TEST(GlCrossProvider, StrictOutputsBitIdenticalEglVsOSMesa) {
+  SKIP_WITHOUT(Provider::EGL);
+  SKIP_WITHOUT(Provider::OSMesa);
+  expectBitIdenticalAcrossProviders<float>({true, false});
+  expectBitIdenticalAcrossProviders<double>({true, true});
+  expectBitIdenticalAcrossProviders<float>({false, false});
+  expectBitIdenticalAcrossProviders<double>({false, true});
+}
+
+TEST(GlCrossProvider, EglThenOSMesaThenEglInOneProcess) {
+  SKIP_WITHOUT(Provider::EGL);
+  SKIP_WITHOUT(Provider::OSMesa);
+  for (Provider p : {Provider::EGL, Provider::OSMesa, Provider::EGL}) {
+    auto b = open(p);
+    EXPECT_EQ(b->info().provider, providerName(p));
+    expectIdentity<float>(*b, {true, false}, 1e-6);
+  }
+}
+
+TEST(GlCrossProvider, TwoLiveBackendsInterleaved) {
+  // Both providers alive at once: every call switches the current context and reloads glad.
+  SKIP_WITHOUT(Provider::EGL);
+  SKIP_WITHOUT(Provider::OSMesa);
+  auto egl = open(Provider::EGL);
+  auto osmesa = open(Provider::OSMesa);
+  BufferId a = egl->createBuffer(64), c = osmesa->createBuffer(64);
+  std::vector<uint8_t> x(64, 1), y(64, 2), back(64);
+  egl->upload(a, 0, x.data(), 64);
+  osmesa->upload(c, 0, y.data(), 64);
+  expectIdentity<float>(*egl, {true, false}, 1e-6);
+  expectIdentity<double>(*osmesa, {true, true}, 1e-14);
+  egl->download(a, 0, back.data(), 64);
+  EXPECT_EQ(back, x);
+  osmesa->download(c, 0, back.data(), 64);
+  EXPECT_EQ(back, y);
+  egl.reset();
+  expectIdentity<float>(*osmesa, {false, false}, 1e-6);
+}
+
+TEST(GlCrossProvider, TwoEglBackendsAndAnOutsideContextSwitch) {
+  // Two contexts of one provider share its EGL display; a context switch made behind sffd's back
+  // (as a viewer's own code might) is noticed and undone.
+  SKIP_WITHOUT(Provider::EGL);
+  auto a = open(Provider::EGL);
+  auto b = open(Provider::EGL);
+  expectIdentity<float>(*a, {true, false}, 1e-6);
+  expectIdentity<float>(*b, {true, false}, 1e-6);
+  void* egl = dlopen("libEGL.so.1", RTLD_NOW | RTLD_LOCAL);
+  ASSERT_NE(egl, nullptr);
+  using GetDisplay = void* (*)();
+  using MakeCurrent = unsigned (*)(void*, void*, void*, void*);
+  auto getDisplay = reinterpret_cast<GetDisplay>(dlsym(egl, "eglGetCurrentDisplay"));
+  auto makeCurrent = reinterpret_cast<MakeCurrent>(dlsym(egl, "eglMakeCurrent"));
+  ASSERT_TRUE(getDisplay && makeCurrent);
+  void* dpy = getDisplay();
+  ASSERT_NE(dpy, nullptr);
+  ASSERT_TRUE(makeCurrent(dpy, nullptr, nullptr, nullptr));   // nothing current any more
+  expectIdentity<float>(*b, {false, false}, 1e-6);
+  a.reset();   // the display stays initialised for b
+  expectIdentity<double>(*b, {true, true}, 1e-14);
+}
+
+TEST(GlSelection, ListDevicesGivesEachHeadlessProvider) {
+  auto devices = listDevices();
+  ASSERT_FALSE(devices.empty());
+  for (const DeviceInfo& d : devices) {
+    EXPECT_EQ(d.api, "gl");
+    EXPECT_TRUE(d.provider == "egl" || d.provider == "osmesa") << d.provider;
+  }
+  if (providerLibraryPresent(Provider::EGL) && providerLibraryPresent(Provider::OSMesa)) {
+    ASSERT_EQ(devices.size(), 2u);
+    EXPECT_EQ(devices[0].provider, "egl");
+    EXPECT_EQ(devices[1].provider, "osmesa");
+  }
+}
+
+TEST(GlSelection, AutoPrefersEglAndEnvironmentOverrides) {
+  SKIP_WITHOUT(Provider::EGL);
+  SKIP_WITHOUT(Provider::OSMesa);
+  unsetenv("SFFD_GL_PROVIDER");
+  EXPECT_EQ(open(Provider::Auto)->info().provider, "egl");
+  setenv("SFFD_GL_PROVIDER", "osmesa", 1);
+  EXPECT_EQ(open(Provider::Auto)->info().provider, "osmesa");
+  EXPECT_EQ(open(Provider::EGL)->info().provider, "egl");   // only Auto is overridden
+  setenv("SFFD_GL_PROVIDER", "vulkan", 1);
+  try {
+    open(Provider::Auto);
+    ADD_FAILURE() << "unknown provider accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Input) << e.what();
+  }
+  unsetenv("SFFD_GL_PROVIDER");
+}
+
+TEST(GlSelection, DeviceSubstringIsCheckedCaseInsensitively) {
+  SKIP_WITHOUT(Provider::EGL);
+  Options o;
+  o.provider = Provider::EGL;
+  o.deviceSubstring = "LLVMPIPE";
+  EXPECT_EQ(createBackend(o)->info().provider, "egl");
+  o.deviceSubstring = "no such renderer";
+  try {
+    createBackend(o);
+    ADD_FAILURE() << "mismatching renderer accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Device) << e.what();
+  }
+  o.provider = Provider::Auto;   // tries every headless provider, then fails as a device error
+  try {
+    createBackend(o);
+    ADD_FAILURE() << "mismatching renderer accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Device) << e.what();
+  }
+}
+
+TEST(GlGlfw, HiddenWindowContextRunsKernels) {
+  const char* display = std::getenv("DISPLAY");
+  if (!display || !*display) GTEST_SKIP() << "DISPLAY is not set (run under xvfb-run -a)";
+  auto b = open(Provider::GLFW);
+  EXPECT_EQ(b->info().provider, "glfw");
+  expectIdentity<float>(*b, {true, false}, 1e-6);
+  expectIdentity<double>(*b, {true, true}, 1e-14);
+  // A second window after the first is gone, and one next to an EGL backend.
+  b.reset();
+  auto again = open(Provider::GLFW);
+  if (providerLibraryPresent(Provider::EGL)) {
+    auto egl = open(Provider::EGL);
+    expectIdentity<float>(*egl, {true, false}, 1e-6);
+  }
+  expectIdentity<float>(*again, {false, false}, 1e-6);
+}
+
+TEST(GlGlfw, NoDisplayIsADeviceError) {
+  const char* display = std::getenv("DISPLAY");
+  const char* wayland = std::getenv("WAYLAND_DISPLAY");
+  std::string saved = display ? display : "", savedWayland = wayland ? wayland : "";
+  unsetenv("DISPLAY");
+  unsetenv("WAYLAND_DISPLAY");
+  try {
+    open(Provider::GLFW);
+    ADD_FAILURE() << "a GLFW context without a display";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Device) << e.what();
+    EXPECT_NE(std::string(e.what()).find("glfw"), std::string::npos) << e.what();
+  }
+  if (!saved.empty()) setenv("DISPLAY", saved.c_str(), 1);
+  if (!savedWayland.empty()) setenv("WAYLAND_DISPLAY", savedWayland.c_str(), 1);
+}
+
+}  // namespace
+}  // namespace sffd::gl

@@ -1,0 +1,107 @@
+// What the context providers share: the per-thread current context and glad loading on switch.
+#include "backends/opengl/gl_context.h"
+
+#include <dlfcn.h>
+
+#include <glad/gl.h>
+
+#include <sffd/error.h>
+
+namespace sffd::gl {
+
+namespace {
+// The sffd context current on this thread (activate() keeps it; providers release it on destruction).
+thread_local Context* tCurrent = nullptr;
+
+GLADapiproc loadThrough(void* userptr, const char* name) {
+  return reinterpret_cast<GLADapiproc>(static_cast<const Context*>(userptr)->procAddress(name));
+}
+}  // namespace
+
+const char* providerName(Provider provider) {
+  switch (provider) {
+    case Provider::Auto: return "auto";
+    case Provider::EGL: return "egl";
+    case Provider::OSMesa: return "osmesa";
+    case Provider::GLFW: return "glfw";
+  }
+  return "?";
+}
+
+Provider parseProvider(const std::string& name) {
+  if (name == "auto") return Provider::Auto;
+  if (name == "egl") return Provider::EGL;
+  if (name == "osmesa") return Provider::OSMesa;
+  if (name == "glfw") return Provider::GLFW;
+  throw Error(ErrorKind::Input, "unknown GL provider '" + name + "' (egl, osmesa, glfw)");
+}
+
+bool providerLibraryPresent(Provider provider) {
+  const char* const* names = nullptr;
+  static const char* const egl[] = {"libEGL.so.1", "libEGL.so", nullptr};
+  static const char* const osmesa[] = {"libOSMesa.so.8", "libOSMesa.so.6", "libOSMesa.so", nullptr};
+  switch (provider) {
+    case Provider::Auto: return providerLibraryPresent(Provider::EGL) || providerLibraryPresent(Provider::OSMesa);
+    case Provider::GLFW: return true;   // linked in
+    case Provider::EGL: names = egl; break;
+    case Provider::OSMesa: names = osmesa; break;
+  }
+  for (const char* const* n = names; *n; ++n) {
+    // The providers keep their libraries open for the life of the process, so this handle is not closed
+    // either: a dlclose of Mesa is never safe.
+    if (dlopen(*n, RTLD_NOW | RTLD_LOCAL)) return true;
+  }
+  return false;
+}
+
+Context::~Context() {
+  // Derived destructors released the context already (releaseIfCurrent); forget it in any case.
+  if (tCurrent == this) tCurrent = nullptr;
+}
+
+bool Context::isCurrent() const { return tCurrent == this; }
+
+void Context::activate() {
+  if (tCurrent == this && providerCurrent()) return;
+  if (tCurrent) {
+    tCurrent->release();
+    tCurrent = nullptr;
+  }
+  makeCurrent();
+  tCurrent = this;
+  // The GL entry points belong to the provider's library (OSMesa has its own copy of Mesa's GL):
+  // reload them whenever another context becomes current.
+  int version = gladLoadGLUserPtr(loadThrough, this);
+  if (version == 0) {
+    release();
+    tCurrent = nullptr;
+    throw deviceError(std::string(name()) + ": cannot load the GL entry points (glad found no GL version)");
+  }
+  glVersion_ = GLAD_VERSION_MAJOR(version) * 10 + GLAD_VERSION_MINOR(version);
+}
+
+void Context::deactivateCurrent() {
+  if (tCurrent) {
+    tCurrent->release();
+    tCurrent = nullptr;
+  }
+}
+
+void Context::releaseIfCurrent() {
+  if (tCurrent == this) {
+    release();
+    tCurrent = nullptr;
+  }
+}
+
+std::unique_ptr<Context> createContext(Provider provider) {
+  switch (provider) {
+    case Provider::EGL: return createEglContext();
+    case Provider::OSMesa: return createOSMesaContext();
+    case Provider::GLFW: return createGlfwContext();
+    case Provider::Auto: break;
+  }
+  throw Error(ErrorKind::Internal, "createContext: pick a provider (Auto is resolved by the GL driver)");
+}
+
+}  // namespace sffd::gl

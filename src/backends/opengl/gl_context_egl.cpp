@@ -1,0 +1,264 @@
+// EGL context provider: a GL 4.3+ core context with no surface, on Mesa's surfaceless platform
+// (EGL_MESA_platform_surfaceless), else on each EGL device (EGL_EXT_platform_device, e.g. NVIDIA).
+// libEGL.so.1 is opened at run time; the EGL headers are used for types and constants only.
+#define EGL_NO_X11 1
+#include <EGL/egl.h>
+#include <EGL/eglext.h>
+#include <dlfcn.h>
+
+#include <cstdio>
+#include <map>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include <sffd/error.h>
+#include "backends/opengl/gl_context.h"
+
+#ifndef EGL_PLATFORM_SURFACELESS_MESA
+#define EGL_PLATFORM_SURFACELESS_MESA 0x31DD
+#endif
+
+namespace sffd::gl {
+
+namespace {
+
+struct EglLib {
+  void* handle = nullptr;
+  std::string loadError;
+  PFNEGLGETPROCADDRESSPROC GetProcAddress = nullptr;
+  PFNEGLGETERRORPROC GetError = nullptr;
+  PFNEGLQUERYSTRINGPROC QueryString = nullptr;
+  PFNEGLINITIALIZEPROC Initialize = nullptr;
+  PFNEGLTERMINATEPROC Terminate = nullptr;
+  PFNEGLBINDAPIPROC BindAPI = nullptr;
+  PFNEGLCHOOSECONFIGPROC ChooseConfig = nullptr;
+  PFNEGLCREATECONTEXTPROC CreateContext = nullptr;
+  PFNEGLDESTROYCONTEXTPROC DestroyContext = nullptr;
+  PFNEGLMAKECURRENTPROC MakeCurrent = nullptr;
+  PFNEGLGETCURRENTCONTEXTPROC GetCurrentContext = nullptr;
+  PFNEGLRELEASETHREADPROC ReleaseThread = nullptr;
+  PFNEGLGETPLATFORMDISPLAYEXTPROC GetPlatformDisplayEXT = nullptr;   // EGL_EXT_platform_base
+  PFNEGLGETPLATFORMDISPLAYPROC GetPlatformDisplay = nullptr;         // EGL 1.5 core
+  PFNEGLQUERYDEVICESEXTPROC QueryDevicesEXT = nullptr;
+
+  EglLib() {
+    for (const char* name : {"libEGL.so.1", "libEGL.so"}) {
+      handle = dlopen(name, RTLD_NOW | RTLD_LOCAL);
+      if (handle) break;
+      const char* e = dlerror();
+      if (loadError.empty()) loadError = e ? e : name;
+    }
+    if (!handle) return;   // kept open for the life of the process: unloading Mesa is never safe
+    loadError.clear();
+    auto sym = [&](auto& fn, const char* name) {
+      fn = reinterpret_cast<std::remove_reference_t<decltype(fn)>>(dlsym(handle, name));
+      if (!fn && loadError.empty()) loadError = std::string("libEGL has no ") + name;
+    };
+    sym(GetProcAddress, "eglGetProcAddress");
+    sym(GetError, "eglGetError");
+    sym(QueryString, "eglQueryString");
+    sym(Initialize, "eglInitialize");
+    sym(Terminate, "eglTerminate");
+    sym(BindAPI, "eglBindAPI");
+    sym(ChooseConfig, "eglChooseConfig");
+    sym(CreateContext, "eglCreateContext");
+    sym(DestroyContext, "eglDestroyContext");
+    sym(MakeCurrent, "eglMakeCurrent");
+    sym(GetCurrentContext, "eglGetCurrentContext");
+    sym(ReleaseThread, "eglReleaseThread");
+    if (!loadError.empty()) {
+      handle = nullptr;
+      return;
+    }
+    GetPlatformDisplay = reinterpret_cast<PFNEGLGETPLATFORMDISPLAYPROC>(dlsym(handle, "eglGetPlatformDisplay"));
+    GetPlatformDisplayEXT =
+        reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(GetProcAddress("eglGetPlatformDisplayEXT"));
+    QueryDevicesEXT = reinterpret_cast<PFNEGLQUERYDEVICESEXTPROC>(GetProcAddress("eglQueryDevicesEXT"));
+  }
+  bool ok() const { return handle != nullptr; }
+};
+
+EglLib& lib() {
+  static EglLib l;
+  return l;
+}
+
+std::string errorName(EGLint e) {
+  switch (e) {
+    case EGL_SUCCESS: return "EGL_SUCCESS";
+    case EGL_NOT_INITIALIZED: return "EGL_NOT_INITIALIZED";
+    case EGL_BAD_ACCESS: return "EGL_BAD_ACCESS";
+    case EGL_BAD_ALLOC: return "EGL_BAD_ALLOC";
+    case EGL_BAD_ATTRIBUTE: return "EGL_BAD_ATTRIBUTE";
+    case EGL_BAD_CONFIG: return "EGL_BAD_CONFIG";
+    case EGL_BAD_CONTEXT: return "EGL_BAD_CONTEXT";
+    case EGL_BAD_DISPLAY: return "EGL_BAD_DISPLAY";
+    case EGL_BAD_MATCH: return "EGL_BAD_MATCH";
+    case EGL_BAD_PARAMETER: return "EGL_BAD_PARAMETER";
+    case EGL_BAD_SURFACE: return "EGL_BAD_SURFACE";
+    default: {
+      char buf[32];
+      std::snprintf(buf, sizeof buf, "EGL error 0x%04x", static_cast<unsigned>(e));
+      return buf;
+    }
+  }
+}
+std::string lastError() { return errorName(lib().GetError()); }
+
+bool hasExtension(const char* list, const std::string& ext) {
+  if (!list) return false;
+  std::string s = std::string(" ") + list + " ";
+  return s.find(" " + ext + " ") != std::string::npos;
+}
+
+// eglInitialize / eglTerminate counted per display: EGL returns one EGLDisplay per platform and
+// native display, so contexts of one display must not terminate it under each other.
+std::map<EGLDisplay, int>& displayUsers() {
+  static auto* m = new std::map<EGLDisplay, int>;   // never destroyed: contexts may outlive static destructors
+  return *m;
+}
+void unrefDisplay(EGLDisplay dpy) {
+  auto& users = displayUsers();
+  auto it = users.find(dpy);
+  if (it == users.end()) return;
+  if (--it->second == 0) {
+    users.erase(it);
+    lib().Terminate(dpy);
+  }
+}
+
+class EglContext final : public Context {
+ public:
+  EglContext(EGLDisplay dpy, EGLContext ctx) : dpy_(dpy), ctx_(ctx) {}
+  ~EglContext() override {
+    releaseIfCurrent();
+    EglLib& l = lib();
+    if (l.GetCurrentContext() == ctx_) {
+      l.BindAPI(EGL_OPENGL_API);
+      l.MakeCurrent(dpy_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+    }
+    l.DestroyContext(dpy_, ctx_);
+    unrefDisplay(dpy_);
+    if (displayUsers().empty()) l.ReleaseThread();
+  }
+  const char* name() const override { return "egl"; }
+  GLProc procAddress(const char* function) const override {
+    return reinterpret_cast<GLProc>(lib().GetProcAddress(function));
+  }
+
+ protected:
+  void makeCurrent() override {
+    EglLib& l = lib();
+    l.BindAPI(EGL_OPENGL_API);
+    if (!l.MakeCurrent(dpy_, EGL_NO_SURFACE, EGL_NO_SURFACE, ctx_))
+      throw deviceError("egl: eglMakeCurrent failed (" + lastError() + ")");
+  }
+  bool providerCurrent() const override { return lib().GetCurrentContext() == ctx_; }
+  void release() override {
+    EglLib& l = lib();
+    l.BindAPI(EGL_OPENGL_API);
+    l.MakeCurrent(dpy_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+  }
+
+ private:
+  EGLDisplay dpy_;
+  EGLContext ctx_;
+};
+
+// A 4.5..4.3 core context on an initialised display, or EGL_NO_CONTEXT with the reason.
+EGLContext createOn(EGLDisplay dpy, std::string& why) {
+  EglLib& l = lib();
+  const char* ext = l.QueryString(dpy, EGL_EXTENSIONS);
+  if (!hasExtension(ext, "EGL_KHR_surfaceless_context")) {
+    why = "no EGL_KHR_surfaceless_context";
+    return EGL_NO_CONTEXT;
+  }
+  const char* apis = l.QueryString(dpy, EGL_CLIENT_APIS);
+  if (apis && std::string(apis).find("OpenGL") == std::string::npos) {
+    why = std::string("the display offers only ") + apis;
+    return EGL_NO_CONTEXT;
+  }
+  if (!l.BindAPI(EGL_OPENGL_API)) {
+    why = "eglBindAPI(EGL_OPENGL_API) failed (" + lastError() + ")";
+    return EGL_NO_CONTEXT;
+  }
+  EGLConfig config = nullptr;   // EGL_NO_CONFIG_KHR
+  if (!hasExtension(ext, "EGL_KHR_no_config_context") && !hasExtension(ext, "EGL_MESA_configless_context")) {
+    const EGLint want[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_SURFACE_TYPE, 0, EGL_NONE};
+    EGLint n = 0;
+    if (!l.ChooseConfig(dpy, want, &config, 1, &n) || n < 1) {
+      why = "no EGL config renders OpenGL (" + lastError() + ")";
+      return EGL_NO_CONTEXT;
+    }
+  }
+  for (int minor = 5; minor >= 3; --minor) {
+    const EGLint attribs[] = {EGL_CONTEXT_MAJOR_VERSION, 4, EGL_CONTEXT_MINOR_VERSION, minor,
+                              EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
+    EGLContext ctx = l.CreateContext(dpy, config, EGL_NO_CONTEXT, attribs);
+    if (ctx != EGL_NO_CONTEXT) return ctx;
+    why = "no OpenGL 4.3+ core context (" + lastError() + ")";
+  }
+  return EGL_NO_CONTEXT;
+}
+
+// Initialises the display and makes a context on it; EGL_NO_CONTEXT (display released) on failure.
+std::unique_ptr<Context> tryDisplay(EGLDisplay dpy, const std::string& what, std::string& reasons) {
+  EglLib& l = lib();
+  auto fail = [&](const std::string& why) {
+    reasons += (reasons.empty() ? "" : "; ") + what + ": " + why;
+    return nullptr;
+  };
+  if (dpy == EGL_NO_DISPLAY) return fail("no display (" + lastError() + ")");
+  EGLint major = 0, minor = 0;
+  if (!l.Initialize(dpy, &major, &minor)) return fail("eglInitialize failed (" + lastError() + ")");
+  ++displayUsers()[dpy];
+  std::string why;
+  EGLContext ctx = createOn(dpy, why);
+  if (ctx == EGL_NO_CONTEXT) {
+    unrefDisplay(dpy);
+    return fail(why);
+  }
+  return std::make_unique<EglContext>(dpy, ctx);
+}
+
+}  // namespace
+
+std::unique_ptr<Context> createEglContext() {
+  EglLib& l = lib();
+  if (!l.ok()) throw deviceError("egl: cannot load libEGL.so.1 (" + l.loadError + ")");
+  const char* clientExt = l.QueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
+  auto platformDisplay = [&](EGLenum platform, void* native) -> EGLDisplay {
+    if (l.GetPlatformDisplay) return l.GetPlatformDisplay(platform, native, nullptr);
+    if (l.GetPlatformDisplayEXT) return l.GetPlatformDisplayEXT(platform, native, nullptr);
+    return EGL_NO_DISPLAY;
+  };
+  std::string reasons;
+  auto finish = [&](std::unique_ptr<Context> ctx) -> std::unique_ptr<Context> {
+    ctx->activate();   // current, glad loaded
+    return ctx;
+  };
+
+  if (hasExtension(clientExt, "EGL_MESA_platform_surfaceless")) {
+    if (auto ctx = tryDisplay(platformDisplay(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY), "surfaceless",
+                              reasons))
+      return finish(std::move(ctx));
+  } else {
+    reasons = "surfaceless: no EGL_MESA_platform_surfaceless";
+  }
+  if (hasExtension(clientExt, "EGL_EXT_platform_device") && l.QueryDevicesEXT) {
+    EGLint n = 0;
+    if (l.QueryDevicesEXT(0, nullptr, &n) && n > 0) {
+      std::vector<EGLDeviceEXT> devices(static_cast<size_t>(n));
+      l.QueryDevicesEXT(n, devices.data(), &n);
+      for (EGLint i = 0; i < n; ++i) {
+        if (auto ctx = tryDisplay(platformDisplay(EGL_PLATFORM_DEVICE_EXT, devices[static_cast<size_t>(i)]),
+                                  "device " + std::to_string(i), reasons))
+          return finish(std::move(ctx));
+      }
+    }
+  }
+  throw deviceError("egl: no OpenGL 4.3+ core context without a surface (" + reasons + ")");
+}
+
+}  // namespace sffd::gl

@@ -1,0 +1,141 @@
+#include "backends/vulkan/vk_device.h"
+
+#include <bit>
+#include <string>
+#include <vector>
+
+#include <sffd/error.h>
+
+namespace sffd::vk {
+
+namespace {
+
+constexpr VkMemoryPropertyFlags kMappable = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+// Memory types sffd never uses: they need features or extensions it does not enable.
+constexpr VkMemoryPropertyFlags kExcluded = VK_MEMORY_PROPERTY_LAZILY_ALLOCATED_BIT | VK_MEMORY_PROPERTY_PROTECTED_BIT |
+                                            VK_MEMORY_PROPERTY_DEVICE_COHERENT_BIT_AMD;
+
+}  // namespace
+
+Device::Device(const Instance& instance, const PhysicalDevice& physical)
+    : api_(instance.api()), info_(physical.info), family_(physical.computeFamily), timestampBits_(physical.timestampBits) {
+  api_.vkGetPhysicalDeviceProperties(physical.handle, &props_);
+  api_.vkGetPhysicalDeviceMemoryProperties(physical.handle, &memory_);
+
+  bool anyDeviceLocal = false;
+  // SFFD_VK_STAGING=1 treats the device as discrete even on unified memory, so that the staging
+  // path of real GPUs is exercised on lavapipe too.
+  unified_ = !envFlag("SFFD_VK_STAGING");
+  for (uint32_t i = 0; i < memory_.memoryTypeCount; ++i) {
+    VkMemoryPropertyFlags f = memory_.memoryTypes[i].propertyFlags;
+    if (!(f & VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT) || (f & kExcluded)) continue;
+    anyDeviceLocal = true;
+    if ((f & kMappable) != kMappable) unified_ = false;
+  }
+  unified_ = unified_ && anyDeviceLocal;
+
+  float priority = 1.0f;
+  auto queueInfo = vkStruct<VkDeviceQueueCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO);
+  queueInfo.queueFamilyIndex = family_;
+  queueInfo.queueCount = 1;
+  queueInfo.pQueuePriorities = &priority;
+
+  VkPhysicalDeviceFeatures features{};
+  features.shaderFloat64 = info_.limits.float64 ? VK_TRUE : VK_FALSE;
+
+  // A portability-subset device (MoltenVK) must have the extension enabled to be used at all.
+  std::vector<const char*> extensions;
+  if (hasDeviceExtension(api_, physical.handle, "VK_KHR_portability_subset"))
+    extensions.push_back("VK_KHR_portability_subset");
+
+  auto ci = vkStruct<VkDeviceCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO);
+  ci.queueCreateInfoCount = 1;
+  ci.pQueueCreateInfos = &queueInfo;
+  ci.pEnabledFeatures = &features;
+  ci.enabledExtensionCount = uint32_t(extensions.size());
+  ci.ppEnabledExtensionNames = extensions.data();
+  check(api_.vkCreateDevice(physical.handle, &ci, nullptr, &device_), "vkCreateDevice");
+  try {
+    api_.loadDevice(device_);
+  } catch (...) {
+    auto destroy = reinterpret_cast<PFN_vkDestroyDevice>(api_.vkGetDeviceProcAddr(device_, "vkDestroyDevice"));
+    if (destroy) destroy(device_, nullptr);
+    throw;
+  }
+  api_.vkGetDeviceQueue(device_, family_, 0, &queue_);
+}
+
+Device::~Device() { api_.vkDestroyDevice(device_, nullptr); }
+
+// Best memory type for a use among the buffer's allowed types: it must have the required flags;
+// each preferred flag present scores 4, each avoided flag present costs 1.
+uint32_t Device::memoryType(uint32_t allowedTypes, MemoryUse use) const {
+  VkMemoryPropertyFlags required = kMappable, preferred = 0, avoided = 0;
+  switch (use) {
+    case MemoryUse::Storage:
+      required = 0;
+      preferred = VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
+      if (unified_)
+        preferred |= kMappable;   // mapped directly: no staging copies
+      else
+        avoided = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT;   // plain VRAM; keeps the small BAR window free
+      break;
+    case MemoryUse::Upload:
+      avoided = VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
+      break;
+    case MemoryUse::Download:
+      preferred = VK_MEMORY_PROPERTY_HOST_CACHED_BIT;   // the host reads it: uncached reads are slow
+      avoided = VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
+      break;
+    case MemoryUse::Params:
+      preferred = VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
+      break;
+  }
+  int best = -1, bestScore = 0;
+  for (uint32_t i = 0; i < memory_.memoryTypeCount; ++i) {
+    VkMemoryPropertyFlags f = memory_.memoryTypes[i].propertyFlags;
+    if (!(allowedTypes & (1u << i)) || (f & kExcluded) || (f & required) != required) continue;
+    int score = 4 * std::popcount(f & preferred) - std::popcount(f & avoided);
+    if (best < 0 || score > bestScore) best = int(i), bestScore = score;
+  }
+  if (best < 0) throw deviceError("Vulkan: the device has no memory type suitable for sffd's buffers.");
+  return uint32_t(best);
+}
+
+Allocation Device::allocate(uint64_t bytes, VkBufferUsageFlags usage, MemoryUse use) {
+  Allocation a;
+  a.size = bytes;
+  auto bi = vkStruct<VkBufferCreateInfo>(VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO);
+  bi.size = bytes > 0 ? bytes : 4;   // Vulkan forbids empty buffers
+  bi.usage = usage;
+  bi.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+  check(api_.vkCreateBuffer(device_, &bi, nullptr, &a.buffer), "vkCreateBuffer");
+  try {
+    VkMemoryRequirements req;
+    api_.vkGetBufferMemoryRequirements(device_, a.buffer, &req);
+    uint32_t type = memoryType(req.memoryTypeBits, use);
+    auto ai = vkStruct<VkMemoryAllocateInfo>(VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO);
+    ai.allocationSize = req.size;
+    ai.memoryTypeIndex = type;
+    VkResult r = api_.vkAllocateMemory(device_, &ai, nullptr, &a.memory);
+    if (r == VK_ERROR_OUT_OF_DEVICE_MEMORY || r == VK_ERROR_OUT_OF_HOST_MEMORY)
+      throw deviceError("Vulkan: out of memory allocating a buffer of " + std::to_string(bytes) + " bytes.");
+    check(r, "vkAllocateMemory");
+    check(api_.vkBindBufferMemory(device_, a.buffer, a.memory, 0), "vkBindBufferMemory");
+    bool mappable = (memory_.memoryTypes[type].propertyFlags & kMappable) == kMappable;
+    if (mappable && (use != MemoryUse::Storage || unified_))
+      check(api_.vkMapMemory(device_, a.memory, 0, VK_WHOLE_SIZE, 0, &a.mapped), "vkMapMemory");
+  } catch (...) {
+    release(a);
+    throw;
+  }
+  return a;
+}
+
+void Device::release(Allocation& a) {
+  if (a.buffer) api_.vkDestroyBuffer(device_, a.buffer, nullptr);
+  if (a.memory) api_.vkFreeMemory(device_, a.memory, nullptr);   // implicitly unmaps
+  a = Allocation{};
+}
+
+}  // namespace sffd::vk

@@ -1,0 +1,48 @@
+// The Vulkan instance: loader, optional validation layer with its debug messenger, and the physical
+// devices described as sffd::DeviceInfo, best first. No logical device is created here, so
+// listDevices() is cheap and harmless.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/backend.h"
+#include "backends/vulkan/vk_loader.h"
+
+namespace sffd::vk {
+
+struct PhysicalDevice {
+  VkPhysicalDevice handle = VK_NULL_HANDLE;
+  DeviceInfo info;
+  uint32_t computeFamily = UINT32_MAX;   // first queue family with compute
+  uint32_t timestampBits = 0;            // its timestampValidBits
+  std::string unusable;                  // why sffd cannot run on it; empty when it can
+};
+
+// Validation on: the option, or env SFFD_VK_VALIDATION set to anything but "" or "0".
+bool validationRequested(bool option);
+
+// Whether the physical device offers a device extension.
+bool hasDeviceExtension(const Api& api, VkPhysicalDevice device, const char* name);
+
+class Instance {
+ public:
+  // Throws a device Error when the loader, an ICD or Vulkan 1.1 is missing.
+  explicit Instance(bool validation);
+  ~Instance();
+  Instance(const Instance&) = delete;
+  Instance& operator=(const Instance&) = delete;
+
+  const Api& api() const { return api_; }
+  VkInstance handle() const { return instance_; }
+  // Every physical device, sorted discrete, integrated, virtual, CPU, other (stable within a type).
+  // Throws a device Error when there is none.
+  std::vector<PhysicalDevice> physicalDevices() const;
+
+ private:
+  Api api_;
+  VkInstance instance_ = VK_NULL_HANDLE;
+  VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
+};
+
+}  // namespace sffd::vk

@@ -1,0 +1,89 @@
+#include "backends/vulkan/vk_kernels.h"
+
+#include <sffd/error.h>
+#include "core/kernel_registry.h"
+#include "kernels/common/shader_layout.h"
+
+namespace sffd::vk {
+
+Kernels::Kernels(Device& device) : device_(device) {
+  const Api& api = device_.api();
+  VkDevice dev = device_.handle();
+
+  VkDescriptorSetLayoutBinding bindings[1 + SFFD_MAX_STORAGE_BINDINGS] = {};
+  for (uint32_t i = 0; i <= SFFD_MAX_STORAGE_BINDINGS; ++i) {
+    bindings[i].binding = i;
+    bindings[i].descriptorType =
+        i == SFFD_BINDING_PARAMS ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    bindings[i].descriptorCount = 1;
+    bindings[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
+  }
+  auto li = vkStruct<VkDescriptorSetLayoutCreateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO);
+  li.bindingCount = 1 + SFFD_MAX_STORAGE_BINDINGS;
+  li.pBindings = bindings;
+  check(api.vkCreateDescriptorSetLayout(dev, &li, nullptr, &setLayout_), "vkCreateDescriptorSetLayout");
+
+  auto pi = vkStruct<VkPipelineLayoutCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO);
+  pi.setLayoutCount = 1;
+  pi.pSetLayouts = &setLayout_;
+  auto ci = vkStruct<VkPipelineCacheCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_CACHE_CREATE_INFO);
+  try {
+    check(api.vkCreatePipelineLayout(dev, &pi, nullptr, &pipelineLayout_), "vkCreatePipelineLayout");
+    check(api.vkCreatePipelineCache(dev, &ci, nullptr, &cache_), "vkCreatePipelineCache");
+  } catch (...) {
+    destroy();
+    throw;
+  }
+}
+
+Kernels::~Kernels() { destroy(); }
+
+void Kernels::destroy() {
+  const Api& api = device_.api();
+  VkDevice dev = device_.handle();
+  for (auto& [key, pipeline] : pipelines_) api.vkDestroyPipeline(dev, pipeline, nullptr);
+  pipelines_.clear();
+  if (cache_) api.vkDestroyPipelineCache(dev, cache_, nullptr);
+  if (pipelineLayout_) api.vkDestroyPipelineLayout(dev, pipelineLayout_, nullptr);
+  if (setLayout_) api.vkDestroyDescriptorSetLayout(dev, setLayout_, nullptr);
+  cache_ = VK_NULL_HANDLE;
+  pipelineLayout_ = VK_NULL_HANDLE;
+  setLayout_ = VK_NULL_HANDLE;
+}
+
+VkPipeline Kernels::pipeline(std::string_view kernel, KernelVariant variant) {
+  const int v = variantIndex(variant);
+  auto key = std::make_pair(std::string(kernel), v);
+  if (auto it = pipelines_.find(key); it != pipelines_.end()) return it->second;
+
+  const EmbeddedKernel* k = findKernel(kernel);
+  if (!k) throw Error(ErrorKind::Internal, "unknown kernel '" + std::string(kernel) + "'");
+  if (variant.f64 && !device_.info().limits.float64)
+    throw deviceError("The Vulkan device " + device_.info().name +
+                      " has no 64-bit floating point in shaders (shaderFloat64); double precision needs another device.");
+  if (!k->spirv[v] || k->spirvWords[v] == 0)
+    throw Error(ErrorKind::Internal, "kernel '" + std::string(kernel) + "' has no SPIR-V for variant " + std::to_string(v));
+
+  const Api& api = device_.api();
+  VkDevice dev = device_.handle();
+  auto mi = vkStruct<VkShaderModuleCreateInfo>(VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO);
+  mi.codeSize = k->spirvWords[v] * sizeof(uint32_t);
+  mi.pCode = k->spirv[v];
+  VkShaderModule module = VK_NULL_HANDLE;
+  check(api.vkCreateShaderModule(dev, &mi, nullptr, &module), "vkCreateShaderModule");
+
+  auto ci = vkStruct<VkComputePipelineCreateInfo>(VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO);
+  ci.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
+  ci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+  ci.stage.module = module;
+  ci.stage.pName = "main";
+  ci.layout = pipelineLayout_;
+  VkPipeline pipeline = VK_NULL_HANDLE;
+  VkResult r = api.vkCreateComputePipelines(dev, cache_, 1, &ci, nullptr, &pipeline);
+  api.vkDestroyShaderModule(dev, module, nullptr);   // the pipeline keeps what it needs
+  check(r, "vkCreateComputePipelines");
+  pipelines_.emplace(std::move(key), pipeline);
+  return pipeline;
+}
+
+}  // namespace sffd::vk

@@ -1,0 +1,76 @@
+// One submission's worth of recorded work and the transient resources it uses: the command buffer,
+// descriptor sets, the parameter-block ring, timestamp queries and staging buffers. Everything is
+// recycled in one go when the submission completes, so chunked jobs may record thousands of
+// dispatches with no per-dispatch fence or allocation. Submissions are synchronous (finish() waits),
+// hence one command buffer and one fence suffice.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/backend.h"
+#include "backends/vulkan/vk_device.h"
+
+namespace sffd::vk {
+
+class Recorder {
+ public:
+  Recorder(Device& device, VkDescriptorSetLayout setLayout);
+  ~Recorder();
+  Recorder(const Recorder&) = delete;
+  Recorder& operator=(const Recorder&) = delete;
+
+  // Whether commands were recorded since the last submission.
+  bool active() const { return active_; }
+  // The command buffer, begun on first use after a submission.
+  VkCommandBuffer commands();
+  void memoryBarrier(VkPipelineStageFlags srcStages, VkAccessFlags srcAccess, VkPipelineStageFlags dstStages,
+                     VkAccessFlags dstAccess);
+
+  // A descriptor set of the shared kernel layout, valid until the submission completes.
+  VkDescriptorSet descriptorSet();
+  // Copies a parameter block into the ring; returns where to bind it as a uniform buffer.
+  struct ParamsRange {
+    VkBuffer buffer;
+    VkDeviceSize offset;
+  };
+  ParamsRange params(const void* data, size_t bytes);
+
+  // Brackets one dispatch: names its timing record and writes its timestamps when the device has them.
+  void beginDispatch(std::string label);
+  void endDispatch();
+
+  // Frees the allocation once the work recorded so far has completed.
+  void releaseAfterSubmit(Allocation allocation);
+
+  // Ends, submits and waits for the recorded work, then recycles everything.
+  // Returns the timing of each dispatch in the submission, in order.
+  std::vector<DispatchTiming> submitAndWait();
+
+ private:
+  void recycle();
+  void destroy();
+
+  Device& device_;
+  VkDescriptorSetLayout setLayout_;
+  VkCommandPool commandPool_ = VK_NULL_HANDLE;
+  VkCommandBuffer commands_ = VK_NULL_HANDLE;
+  VkFence fence_ = VK_NULL_HANDLE;
+  bool active_ = false;
+
+  std::vector<VkDescriptorPool> descriptorPools_;
+  uint32_t setsAllocated_ = 0;   // in this submission, across pools
+
+  std::vector<Allocation> paramChunks_;
+  size_t paramChunk_ = 0;        // chunk being filled
+  VkDeviceSize paramOffset_ = 0;   // next free byte in it
+
+  bool timestamps_ = false;
+  uint64_t timestampMask_ = 0;
+  std::vector<VkQueryPool> queryPools_;
+  std::vector<std::string> labels_;   // one per dispatch of this submission; 2 queries each
+
+  std::vector<Allocation> releases_;
+};
+
+}  // namespace sffd::vk

@@ -1,0 +1,345 @@
+// PyGeM .prm and reference-implementation .npy lattice files.
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <numbers>
+
+#include <sffd/error.h>
+#include "io/io_util.h"
+#include "io/lattice_io_internal.h"
+
+namespace sffd::latticeio {
+
+// ---------------------------------------------------------------------------------------------------
+// PyGeM .prm (mathLab/PyGeM pygem/ffd.py, read with Python's configparser): sections [Box info] and
+// [Parameters weights]. Keys (case-insensitive, "key: value" or "key = value"): n control points x/y/z,
+// box length x/y/z, box origin x/y/z, rotation angle x/y/z (degrees), and parameter x/y/z, whose value
+// (continued on indented lines) holds "i j k mu" lines, mu the displacement normalised by the box length,
+// in the box's local axes; absent entries are 0.
+// Meaning (ALGORITHM.md 6): a Bernstein lattice, i.e. one knot box of degree n-1 on each axis with knots
+// [0..0, 1..1] in the parameter space [0,1]^3; R = Rx(ax) Ry(ay) Rz(az), A = R diag(L), parameter of a
+// world point x: p = A^-1 (x - origin); control point (i, j, k) = origin + A ((i/(nx-1), j/(ny-1),
+// k/(nz-1)) + mu_ijk); points outside the box are left unmoved (OutsideMode::Keep).
+
+namespace {
+
+struct IniValue {
+  size_t line = 0;                                          // the key's line
+  std::vector<std::pair<std::string_view, size_t>> lines;   // value lines (the first is the rest of the key's line)
+};
+struct IniSection {
+  size_t line = 0;
+  std::map<std::string, IniValue> values;
+};
+
+// configparser's rules, as PyGeM uses them: full-line comments start with '#' or ';' (and end a value's
+// continuation), a line indented deeper than its key continues the value, blank lines do not end it,
+// duplicate sections or keys are errors.
+std::map<std::string, IniSection> parseIni(const std::string& path, const std::string& text) {
+  std::map<std::string, IniSection> sections;
+  IniSection* cur = nullptr;
+  IniValue* value = nullptr;
+  size_t valueIndent = 0;
+  io::LineReader lines(text);
+  std::string_view l;
+  size_t line = 0;
+  while (lines.next(l, line)) {
+    std::string_view t = io::trim(l);
+    if (t.empty()) continue;
+    if (t[0] == '#' || t[0] == ';') {
+      value = nullptr;
+      continue;
+    }
+    size_t indent = size_t(std::find_if(l.begin(), l.end(), [](char c) { return c != ' ' && c != '\t'; }) - l.begin());
+    if (value && indent > valueIndent) {
+      value->lines.push_back({t, line});
+      continue;
+    }
+    value = nullptr;
+    if (t.front() == '[' && t.back() == ']' && t.size() > 2) {
+      std::string name(io::trim(t.substr(1, t.size() - 2)));
+      auto [it, isNew] = sections.emplace(name, IniSection{});
+      if (!isNew) throw inputError(path, line, "section " + io::quoted("[" + name + "]") + " appears twice");
+      it->second.line = line;
+      cur = &it->second;
+      continue;
+    }
+    size_t d = t.find_first_of(":=");
+    if (d == std::string_view::npos) throw inputError(path, line, "expected 'key: value' or a [section], found " + io::quoted(t));
+    if (!cur) throw inputError(path, line, "'key: value' line before any [section]");
+    std::string key(io::trim(t.substr(0, d)));
+    for (char& c : key) c = char(std::tolower(static_cast<unsigned char>(c)));
+    if (key.empty()) throw inputError(path, line, "empty key");
+    auto [it, isNew] = cur->values.emplace(key, IniValue{});
+    if (!isNew) throw inputError(path, line, "key " + io::quoted(key) + " appears twice in its section");
+    it->second.line = line;
+    std::string_view rest = io::trim(t.substr(d + 1));
+    if (!rest.empty()) it->second.lines.push_back({rest, line});
+    value = &it->second;
+    valueIndent = indent;
+  }
+  return sections;
+}
+
+glm::dmat3 rotationX(double a) {   // glm is column-major: m[col][row]
+  glm::dmat3 m(1.0);
+  m[1][1] = std::cos(a), m[2][1] = -std::sin(a);
+  m[1][2] = std::sin(a), m[2][2] = std::cos(a);
+  return m;
+}
+glm::dmat3 rotationY(double a) {
+  glm::dmat3 m(1.0);
+  m[0][0] = std::cos(a), m[2][0] = std::sin(a);
+  m[0][2] = -std::sin(a), m[2][2] = std::cos(a);
+  return m;
+}
+glm::dmat3 rotationZ(double a) {
+  glm::dmat3 m(1.0);
+  m[0][0] = std::cos(a), m[1][0] = -std::sin(a);
+  m[0][1] = std::sin(a), m[1][1] = std::cos(a);
+  return m;
+}
+
+}  // namespace
+
+Lattice readPrm(const std::string& path, const std::string& text) {
+  auto sections = parseIni(path, text);
+  auto section = [&](const char* name) -> IniSection& {
+    auto it = sections.find(name);
+    if (it == sections.end()) throw inputError(path, 0, std::string("missing section [") + name + "]");
+    return it->second;
+  };
+  IniSection& box = section("Box info");
+  IniSection& weights = section("Parameters weights");
+  auto get = [&](IniSection& s, const char* sname, const std::string& key) -> IniValue& {
+    auto it = s.values.find(key);
+    if (it == s.values.end()) throw inputError(path, s.line, "missing key '" + key + "' in [" + sname + "]");
+    return it->second;
+  };
+  auto scalar = [&](const std::string& key) {
+    IniValue& v = get(box, "Box info", key);
+    if (v.lines.size() != 1) throw inputError(path, v.line, "'" + key + "' needs one number");
+    double d = 0;
+    if (!io::parseDouble(v.lines[0].first, d)) throw inputError(path, v.line, "'" + key + "': bad number " + io::quoted(v.lines[0].first));
+    if (!std::isfinite(d)) throw inputError(path, v.line, "'" + key + "' is not finite");
+    return d;
+  };
+  static const char xyz[] = "xyz";
+  std::array<int, 3> n{};
+  glm::dvec3 length, origin, angle;
+  for (int a = 0; a < 3; ++a) {
+    std::string key = std::string("n control points ") + xyz[a];
+    IniValue& v = get(box, "Box info", key);
+    long long c = 0;
+    if (v.lines.size() != 1 || !io::parseInt(v.lines[0].first, c)) throw inputError(path, v.line, "'" + key + "' needs an integer");
+    if (c < 2 || c > 6)
+      throw inputError(path, v.line, "'" + key + "' is " + std::to_string(c) + "; 2..6 are supported (degree = count - 1, 1..5)");
+    n[a] = int(c);
+    length[a] = scalar(std::string("box length ") + xyz[a]);
+    if (!(length[a] > 0)) throw inputError(path, get(box, "Box info", std::string("box length ") + xyz[a]).line, "box length must be positive");
+    origin[a] = scalar(std::string("box origin ") + xyz[a]);
+    angle[a] = scalar(std::string("rotation angle ") + xyz[a]);
+  }
+
+  Lattice L;
+  L.counts = n;
+  for (int a = 0; a < 3; ++a) {
+    L.degree[a] = n[a] - 1;
+    L.knots[a] = clampedUniformKnots(n[a], n[a] - 1, 0.0, 1.0);
+  }
+  std::vector<glm::dvec3> mu(L.pointCount(), glm::dvec3(0.0));
+  for (int a = 0; a < 3; ++a) {
+    IniValue& v = get(weights, "Parameters weights", std::string("parameter ") + xyz[a]);
+    std::vector<std::string_view> tok;
+    for (const auto& [text_, line] : v.lines) {
+      io::splitTokens(text_, tok);
+      if (tok.size() != 4) throw inputError(path, line, "expected 'i j k value', found " + io::quoted(text_));
+      long long idx[3];
+      for (int c = 0; c < 3; ++c) {
+        if (!io::parseInt(tok[c], idx[c])) throw inputError(path, line, "bad index " + io::quoted(tok[c]));
+        if (idx[c] < 0 || idx[c] >= n[c])
+          throw inputError(path, line, "index " + std::to_string(idx[c]) + " out of range 0.." + std::to_string(n[c] - 1));
+      }
+      double d = 0;
+      if (!io::parseDouble(tok[3], d)) throw inputError(path, line, "bad number " + io::quoted(tok[3]));
+      if (!std::isfinite(d)) throw inputError(path, line, "non-finite value " + io::quoted(tok[3]));
+      mu[L.index(int(idx[0]), int(idx[1]), int(idx[2]))][a] = d;   // a repeated entry overrides, as in PyGeM
+    }
+  }
+
+  const double deg = std::numbers::pi / 180.0;
+  glm::dmat3 R = rotationX(angle.x * deg) * rotationY(angle.y * deg) * rotationZ(angle.z * deg);
+  glm::dmat3 A = R;
+  for (int c = 0; c < 3; ++c) A[c] *= length[c];   // A = R diag(L): column c scaled by L_c
+  L.frameLinear = glm::inverse(A);
+  L.frameOffset = -(L.frameLinear * origin);
+  L.controlPoints.resize(L.pointCount());
+  for (int i = 0; i < n[0]; ++i)
+    for (int j = 0; j < n[1]; ++j)
+      for (int k = 0; k < n[2]; ++k) {
+        size_t id = L.index(i, j, k);
+        glm::dvec3 s(double(i) / (n[0] - 1), double(j) / (n[1] - 1), double(k) / (n[2] - 1));
+        L.controlPoints[id] = origin + A * (s + mu[id]);
+      }
+  L.outside = OutsideMode::Keep;
+  validateLattice(L, path);
+  return L;
+}
+
+// ---------------------------------------------------------------------------------------------------
+// .npy (numpy format 1.0/2.0/3.0): a little-endian float32 or float64 array of shape (mu, mv, mw, 3) in
+// C order, point [i][j][k] with i along x. The lattice: degree options.npyDegree, clamped uniform knots
+// over the mesh box [options.meshBoxLo, options.meshBoxHi], identity frame (the reference
+// implementation's convention, ALGORITHM.md 1.1).
+
+namespace {
+
+// A tiny reader for the header's Python dict literal: {'descr': '<f4', 'fortran_order': False, 'shape': (5, 5, 5, 3), }
+struct NpyHeader {
+  std::string descr;
+  bool fortran = false;
+  std::vector<long long> shape;
+  bool haveDescr = false, haveFortran = false, haveShape = false;
+};
+
+NpyHeader parseNpyHeader(const std::string& path, std::string_view h) {
+  NpyHeader r;
+  size_t i = 0;
+  auto fail = [&](const std::string& what) { return inputError(path, 0, "bad .npy header (" + what + "): " + io::quoted(h)); };
+  auto ws = [&]() {
+    while (i < h.size() && std::isspace(static_cast<unsigned char>(h[i]))) ++i;
+  };
+  auto expect = [&](char c) {
+    ws();
+    if (i >= h.size() || h[i] != c) throw fail(std::string("expected '") + c + "'");
+    ++i;
+  };
+  auto str = [&]() {
+    ws();
+    if (i >= h.size() || (h[i] != '\'' && h[i] != '"')) throw fail("expected a string");
+    char q = h[i++];
+    size_t s = i;
+    while (i < h.size() && h[i] != q) ++i;
+    if (i >= h.size()) throw fail("unterminated string");
+    return std::string(h.substr(s, i++ - s));
+  };
+  expect('{');
+  while (true) {
+    ws();
+    if (i < h.size() && h[i] == '}') break;
+    std::string key = str();
+    expect(':');
+    ws();
+    if (key == "descr") {
+      r.descr = str();
+      r.haveDescr = true;
+    } else if (key == "fortran_order") {
+      if (h.compare(i, 4, "True") == 0) r.fortran = true, i += 4;
+      else if (h.compare(i, 5, "False") == 0) r.fortran = false, i += 5;
+      else throw fail("fortran_order must be True or False");
+      r.haveFortran = true;
+    } else if (key == "shape") {
+      expect('(');
+      while (true) {
+        ws();
+        if (i < h.size() && h[i] == ')') break;
+        size_t s = i;
+        while (i < h.size() && std::isdigit(static_cast<unsigned char>(h[i]))) ++i;
+        long long v = 0;
+        if (!io::parseInt(h.substr(s, i - s), v)) throw fail("bad shape");
+        if (i < h.size() && h[i] == 'L') ++i;   // Python 2 long
+        r.shape.push_back(v);
+        ws();
+        if (i < h.size() && h[i] == ',') ++i;
+        if (r.shape.size() > 32) throw fail("too many dimensions");
+      }
+      ++i;
+      r.haveShape = true;
+    } else {
+      throw fail("unknown key " + io::quoted(key));
+    }
+    ws();
+    if (i < h.size() && h[i] == ',') ++i;
+  }
+  if (!r.haveDescr || !r.haveFortran || !r.haveShape) throw fail("descr, fortran_order and shape are required");
+  return r;
+}
+
+}  // namespace
+
+Lattice readNpy(const std::string& path, const std::string& text, const LatticeReadOptions& options) {
+  if (text.size() < 10 || std::memcmp(text.data(), "\x93NUMPY", 6) != 0) throw inputError(path, 0, "not a .npy file (no \\x93NUMPY magic)");
+  const unsigned major = static_cast<unsigned char>(text[6]);
+  size_t headerLen = 0, headerStart = 0;
+  if (major == 1) {
+    headerLen = static_cast<unsigned char>(text[8]) | (size_t(static_cast<unsigned char>(text[9])) << 8);
+    headerStart = 10;
+  } else if (major == 2 || major == 3) {
+    if (text.size() < 12) throw inputError(path, 0, "truncated .npy header");
+    for (int b = 0; b < 4; ++b) headerLen |= size_t(static_cast<unsigned char>(text[8 + b])) << (8 * b);
+    headerStart = 12;
+  } else {
+    throw inputError(path, 0, "unsupported .npy format version " + std::to_string(major));
+  }
+  if (headerLen > text.size() - headerStart) throw inputError(path, 0, "truncated .npy header");
+  NpyHeader h = parseNpyHeader(path, std::string_view(text).substr(headerStart, headerLen));
+  size_t item = 0;
+  if (h.descr == "<f4") item = 4;
+  else if (h.descr == "<f8") item = 8;
+  else if (h.descr == ">f4" || h.descr == ">f8")
+    throw inputError(path, 0, "big-endian .npy data (" + h.descr + ") is not supported; save it as '<f4' or '<f8'");
+  else throw inputError(path, 0, "unsupported .npy dtype " + io::quoted(h.descr) + " (expected float32 '<f4' or float64 '<f8')");
+  if (h.fortran) throw inputError(path, 0, "Fortran-order .npy arrays are not supported (save with C order)");
+  if (h.shape.size() != 4 || h.shape[3] != 3) {
+    std::string s = "(";
+    for (size_t a = 0; a < h.shape.size(); ++a) s += (a ? ", " : "") + std::to_string(h.shape[a]);
+    throw inputError(path, 0, "array shape " + s + ") is not (mu, mv, mw, 3)");
+  }
+  Lattice L;
+  for (int a = 0; a < 3; ++a) {
+    if (h.shape[a] < 2 || h.shape[a] > 4096)
+      throw inputError(path, 0, "array shape has " + std::to_string(h.shape[a]) + " control points on axis " + "uvw"[a] +
+                                    " (2..4096 supported)");
+    L.counts[a] = int(h.shape[a]);
+  }
+  if (L.pointCount() > kMaxControlPoints) throw inputError(path, 0, "lattice too large");
+  const size_t dataStart = headerStart + headerLen;
+  const size_t need = L.pointCount() * 3 * item;
+  if (text.size() - dataStart != need)
+    throw inputError(path, 0, std::string(text.size() - dataStart < need ? "truncated .npy data" : ".npy file has trailing data") +
+                                  ": shape needs " + std::to_string(need) + " bytes, the file holds " +
+                                  std::to_string(text.size() - dataStart));
+  if (!options.haveMeshBox)
+    throw inputError(path, 0, ".npy lattices carry no box: the mesh's (normalised) bounding box is needed to read one");
+  L.degree = options.npyDegree;
+  for (int a = 0; a < 3; ++a) {
+    if (L.degree[a] < 1 || L.degree[a] > 5) throw inputError(path, 0, "degree must be 1..5");
+    if (L.counts[a] <= L.degree[a])
+      throw inputError(path, 0, "axis " + std::string(1, "uvw"[a]) + " has " + std::to_string(L.counts[a]) +
+                                    " control points, too few for degree " + std::to_string(L.degree[a]));
+    if (!(options.meshBoxHi[a] > options.meshBoxLo[a]))
+      throw inputError(path, 0, "the mesh box is empty on axis " + std::string(1, "xyz"[a]) + " (a flat mesh needs a native lattice)");
+    L.knots[a] = clampedUniformKnots(L.counts[a], L.degree[a], options.meshBoxLo[a], options.meshBoxHi[a]);
+  }
+  L.controlPoints.resize(L.pointCount());
+  const char* p = text.data() + dataStart;
+  for (size_t i = 0; i < L.pointCount(); ++i)
+    for (int c = 0; c < 3; ++c, p += item) {
+      double v;
+      if (item == 4) {
+        float f;
+        std::memcpy(&f, p, 4);
+        v = f;
+      } else {
+        std::memcpy(&v, p, 8);
+      }
+      if (!std::isfinite(v)) throw inputError(path, 0, "control point " + std::to_string(i) + " is not finite");
+      L.controlPoints[i][c] = v;
+    }
+  validateLattice(L, path);
+  return L;
+}
+
+}  // namespace sffd::latticeio

@@ -1,0 +1,19 @@
+// Internal interface of the lattice readers (lattice_io*.cpp): each gets the file's bytes.
+#pragma once
+#include <string>
+
+#include "io/lattice_io.h"
+
+namespace sffd::latticeio {
+
+// What readLattice does once the file is read: dispatch by the extension of `path` (used by the fuzz targets).
+Lattice readLatticeBytes(const std::string& path, std::string text, const LatticeReadOptions& options = {});
+
+Lattice readJson(const std::string& path, const std::string& text);
+Lattice readPrm(const std::string& path, const std::string& text);
+Lattice readNpy(const std::string& path, const std::string& text, const LatticeReadOptions& options);
+
+// Most control points a lattice file may ask for (checked before anything is allocated).
+constexpr size_t kMaxControlPoints = size_t(1) << 24;
+
+}  // namespace sffd::latticeio

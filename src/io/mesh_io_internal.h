@@ -1,0 +1,36 @@
+// Internal interface of the mesh readers (mesh_io*.cpp). Each reader gets the file's bytes (read whole
+// by readMesh) and returns a finished Mesh or throws inputError(path, line, what).
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "model/mesh.h"
+
+namespace sffd::meshio {
+
+// What readMesh does once the file is read: dispatch by the extension of `path` (the fuzz targets
+// call it with bytes that never were a file).
+Mesh readMeshBytes(const std::string& path, std::string text, const MeshReadOptions& options = {});
+
+Mesh readObj(const std::string& path, const std::string& text);
+Mesh readOff(const std::string& path, const std::string& text);
+Mesh readPly(const std::string& path, const std::string& text);
+Mesh readStl(const std::string& path, const std::string& text);
+Mesh readOm(const std::string& path, const std::string& text);
+Mesh readBpt(const std::string& path, const std::string& text, const MeshReadOptions& options);
+
+// Completes a mesh whose positions, normals (one slot per vertex, possibly unset) and triangles are
+// filled: checks there is a triangle and every index is in range, normalises the file normals marked in
+// `fromFile`, recomputes (angle-weighted) the others and zero-length ones, sets normalsFromFile and weldId.
+void finishMesh(Mesh& mesh, const std::vector<uint8_t>& fromFile, const std::string& path);
+
+// Polygon -> triangles (fan from its first corner).
+inline void fanTriangulate(const uint32_t* corners, size_t n, std::vector<std::array<uint32_t, 3>>& out) {
+  for (size_t i = 1; i + 1 < n; ++i) out.push_back({corners[0], corners[i], corners[i + 1]});
+}
+
+// Largest vertex count a mesh may have (indices are uint32).
+constexpr uint64_t kMaxVertices = 0xFFFFFFF0u;
+
+}  // namespace sffd::meshio

@@ -1,0 +1,53 @@
+#include "model/lattice_pack.h"
+
+namespace sffd {
+
+PackedLattice packLattice(const Lattice& L) {
+  LatticeBoxForm F = extractBoxForm(L);
+  PackedLattice P;
+  P.params.degree = {uint32_t(F.degree[0]), uint32_t(F.degree[1]), uint32_t(F.degree[2]),
+                     L.outside == OutsideMode::Keep ? SFFD_OUTSIDE_KEEP : SFFD_OUTSIDE_EXTRAPOLATE};
+  P.params.boxes = {uint32_t(F.boxes[0]), uint32_t(F.boxes[1]), uint32_t(F.boxes[2]), uint32_t(F.coeffsPerBox())};
+  P.frame.assign(SFFD_FRAME_BREAKS, 0.0);
+  glm::dmat3 cofA = cofactor(L.frameLinear);
+  for (int r = 0; r < 3; ++r) {
+    // glm is column-major: row r of M is (M[0][r], M[1][r], M[2][r]).
+    for (int c = 0; c < 3; ++c) {
+      P.frame[SFFD_FRAME_AFFINE + 4 * r + c] = L.frameLinear[c][r];
+      P.frame[SFFD_FRAME_COF_AFFINE + 4 * r + c] = cofA[c][r];
+    }
+    P.frame[SFFD_FRAME_AFFINE + 4 * r + 3] = L.frameOffset[r];
+  }
+  uint32_t offs[3];
+  for (int a = 0; a < 3; ++a) {
+    offs[a] = uint32_t(P.frame.size());
+    P.frame.insert(P.frame.end(), F.breaks[a].begin(), F.breaks[a].end());
+  }
+  P.params.break_offset = {offs[0], offs[1], offs[2], 0};
+  P.coeffs.reserve(F.coeffs.size() * 4);
+  for (const glm::dvec3& c : F.coeffs) P.coeffs.insert(P.coeffs.end(), {c.x, c.y, c.z, 0.0});
+  return P;
+}
+
+gpu::DeformParams deformParamsFor(const PackedLattice& lattice, bool f64, const std::vector<double>* fit) {
+  gpu::DeformParams d{};
+  d.lattice = lattice.params;
+  d.lattice.break_offset.w = 0;
+  const size_t frameVec4 = (lattice.frame.size() + 3) / 4, coeffVec4 = lattice.coeffs.size() / 4;
+  if (f64 || frameVec4 == 0 || frameVec4 + coeffVec4 > SFFD_INLINE_LATTICE_VEC4) return d;
+  auto put = [&](size_t i, double v) {
+    gpu::Vec4& q = d.inline_lattice[i / 4];
+    (i % 4 == 0 ? q.x : i % 4 == 1 ? q.y : i % 4 == 2 ? q.z : q.w) = float(v);
+  };
+  for (size_t i = 0; i < lattice.frame.size(); ++i) put(i, lattice.frame[i]);
+  for (size_t i = 0; i < lattice.coeffs.size(); ++i) put(4 * frameVec4 + i, lattice.coeffs[i]);
+  d.lattice.break_offset.w = uint32_t(frameVec4);
+  const size_t fitFirst = frameVec4 + coeffVec4;
+  if (fit && !fit->empty() && fitFirst + (fit->size() + 3) / 4 <= SFFD_INLINE_LATTICE_VEC4) {
+    for (size_t i = 0; i < fit->size(); ++i) put(4 * fitFirst + i, (*fit)[i]);
+    d.inline_fit.x = uint32_t(fitFirst);
+  }
+  return d;
+}
+
+}  // namespace sffd

@@ -1,0 +1,31 @@
+// The lattice as the kernels read it (kernels/common/lattice_eval.glsl): the parameter block, the frame
+// buffer (affine frame, cof(A), knot breaks) and the per-box Bezier coefficients, kept in double
+// and converted to the kernel's `real` type on upload.
+#pragma once
+#include <vector>
+
+#include "model/lattice.h"
+#include "kernels/common/shader_layout.h"
+
+namespace sffd {
+
+struct PackedLattice {
+  gpu::LatticeParams params;
+  std::vector<double> frame;    // SFFD_FRAME_* layout
+  std::vector<double> coeffs;   // 4 per coefficient (x, y, z, 0)
+};
+
+PackedLattice packLattice(const Lattice& lattice);
+
+// The deform kernels' parameter block for a lattice: its LatticeParams, and in the float variants
+// the lattice itself inline when it fits (layout.h, DeformParams), else break_offset.w = 0 and the
+// kernels read the lattice storage buffers.
+// With `fit`, the fit table follows the lattice there when both fit (inline_fit.x).
+gpu::DeformParams deformParamsFor(const PackedLattice& lattice, bool f64, const std::vector<double>* fit = nullptr);
+
+template <class Real>
+std::vector<Real> convertReals(const std::vector<double>& v) {
+  return std::vector<Real>(v.begin(), v.end());
+}
+
+}  // namespace sffd

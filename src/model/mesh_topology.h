@@ -1,0 +1,48 @@
+// Mesh preparation for smooth FFD (ALGORITHM.md 3.1): triangle adjacency by welded position,
+// crease detection from split normals, and per-corner neighbour normals. Plain data in, plain data out.
+//
+// Conventions: edge e of a triangle joins its corners e and (e+1)%3. Corner slots (6 per triangle,
+// the order of the spec's n_nbr and of the PN edge control points): slot 2c is corner c on the
+// edge towards corner (c+2)%3, i.e. edge (c+2)%3; slot 2c+1 is corner c on edge c.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "model/mesh.h"
+
+namespace sffd {
+
+struct MeshTopology {
+  // Per triangle and edge: the neighbouring triangle across it (-1: boundary or non-manifold) and
+  // the neighbour's local index of that edge (-1 when none).
+  std::vector<std::array<int32_t, 3>> neighbour;
+  std::vector<std::array<int8_t, 3>> neighbourEdge;
+  // Per triangle and slot: the neighbour's normal at that corner across that edge (the corner's own
+  // normal when there is no neighbour), and whether the two differ (a crease at this corner).
+  std::vector<std::array<glm::dvec3, 6>> neighbourNormal;
+  std::vector<std::array<uint8_t, 6>> creaseSlot;
+  // Per triangle and slot: the vertex index the neighbour normal belongs to (the corner's own
+  // vertex when none). Lets both sides of an edge order the two normals the same way.
+  std::vector<std::array<uint32_t, 6>> neighbourVertex;
+  // Counts for the statistics.
+  size_t boundaryEdges = 0, nonManifoldEdges = 0, creaseEdges = 0, degenerateTriangles = 0;
+};
+
+// Normals closer than this per component count as equal (the authors' test, ALGORITHM.md 3.2).
+constexpr double kSameNormalTolerance = 1e-6;
+
+inline int slotEdge(int slot) { return slot % 2 ? slot / 2 : (slot / 2 + 2) % 3; }
+inline int slotCorner(int slot) { return slot / 2; }
+
+// Builds adjacency from mesh.weldId (edges with more than two triangles are non-manifold: left
+// unconnected and counted), neighbour normals and crease slots.
+MeshTopology buildTopology(const Mesh& mesh);
+
+// For meshes whose normals were computed on load (mesh.normalsFromFile == false): marks edges whose
+// dihedral angle exceeds `creaseAngleDeg` as creases and gives each vertex one angle-weighted normal
+// per smoothing fan (the faces around it between creases), splitting vertices as needed. The result
+// is the split-normal input the method expects.
+void applyCreaseAngle(Mesh& mesh, double creaseAngleDeg);
+
+}  // namespace sffd

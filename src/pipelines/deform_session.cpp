@@ -1,0 +1,377 @@
+// Device-resident smooth FFD: the kernels of pn_triangles.cpp, regular_clip.cpp and smooth_deform.cpp
+// chained on one backend with the intermediate buffers kept on the device. Only two small host
+// transfers remain: the clip counts (to size the sub-triangle buffers, once per precompute) and the
+// lattice coefficients (once per deform).
+#include "pipelines/deform_session.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+
+#include <sffd/error.h>
+#include "kernels/clip/knot_box_clip.h"
+#include "model/lattice_pack.h"
+#include "model/mesh_topology.h"
+#include "pipelines/patch_output.h"
+#include "kernels/pn/pn_triangles.h"
+#include "model/prepared_mesh.h"
+#include "kernels/clip/split_pattern_table.h"
+#include "core/wall_clock.h"
+
+namespace sffd {
+namespace {
+
+// The reals of a host array in the kernel's storage type, as bytes.
+std::vector<unsigned char> realBytes(const std::vector<double>& v, bool f64) {
+  std::vector<unsigned char> out(v.size() * (f64 ? 8 : 4));
+  if (f64) std::memcpy(out.data(), v.data(), out.size());
+  else
+    for (size_t i = 0; i < v.size(); ++i) {
+      float f = float(v[i]);
+      std::memcpy(&out[4 * i], &f, 4);
+    }
+  return out;
+}
+
+std::vector<double> doublesOf(const std::vector<unsigned char>& bytes, bool f64) {
+  std::vector<double> out(bytes.size() / (f64 ? 8 : 4));
+  if (f64) std::memcpy(out.data(), bytes.data(), out.size() * 8);
+  else
+    for (size_t i = 0; i < out.size(); ++i) {
+      float f;
+      std::memcpy(&f, &bytes[4 * i], 4);
+      out[i] = f;
+    }
+  return out;
+}
+
+}  // namespace
+
+struct DeformSession::Impl {
+  Lattice structure;            // degrees, counts, knots, frame of the session's lattice
+  PreparedMesh mesh;
+  ClipTriangles clip;
+  std::vector<SubTriangle> knotBoxSubs;
+  FitTable fit;
+  size_t realSize = 4;
+  std::vector<BufferId> owned;   // every buffer, destroyed with the session
+  BufferId table = 0, pos = 0, nrm = 0, tri = 0, slot = 0, pn = 0, clipHdr = 0, clipReal = 0, counts = 0;
+  BufferId frame = 0, coeffs = 0, fitBuf = 0, samples = 0;
+  size_t samplesCapacity = 0;
+  struct ChunkBuffers { BufferId headers = 0, records = 0; size_t firstClip = 0, clipCount = 0; };
+  std::vector<ChunkBuffers> chunkBuffers;
+
+  BufferId make(Backend& b, uint64_t bytes) {
+    BufferId id = b.createBuffer(std::max<uint64_t>(bytes, 16));
+    owned.push_back(id);
+    return id;
+  }
+  BufferId upload(Backend& b, const void* data, uint64_t bytes) {
+    BufferId id = make(b, bytes);
+    if (bytes) b.upload(id, 0, data, bytes);
+    return id;
+  }
+};
+
+DeformSession::DeformSession(Backend& backend, const Mesh& input, const Lattice& lattice, const DeformSessionOptions& options)
+    : backend_(backend), options_(options), impl_(std::make_unique<Impl>()) {
+  if (!(options.edgeLength > 0) || !std::isfinite(options.edgeLength))
+    throw Error(ErrorKind::Input, "the edge length must be a finite number > 0");
+  if (options.level < 1 || options.level > 64) throw Error(ErrorKind::Input, "the tessellation level must be 1..64");
+  if (options.variant.f64 && !backend.info().limits.float64)
+    throw deviceError(backend.info().name + " has no double-precision shader support; use --precision float");
+  Impl& I = *impl_;
+  const bool f64 = options.variant.f64;
+  I.realSize = f64 ? 8 : 4;
+  I.structure = lattice;
+  Mesh mesh = input;
+  if (!mesh.normalsFromFile) applyCreaseAngle(mesh, options.creaseAngleDeg);
+  I.mesh = prepareMesh(mesh);
+  if (options.knotBoxClip) I.knotBoxSubs = clipAgainstKnotBoxes(mesh, lattice);
+  else I.clip = buildClipTriangles(mesh, options.edgeLength, splitPatternTable().nmax());
+  int s = options.samples > 0 ? options.samples : lattice.degree[0] + lattice.degree[1] + lattice.degree[2];
+  I.fit = makeFitTable(std::max(3, s));
+
+  const DeviceLimits& lim = backend.info().limits;
+  auto fits = [&](size_t bytes, const char* what) {
+    if (bytes > lim.maxStorageBufferRange)
+      throw Error(ErrorKind::Input, std::string("the job's ") + what + " (" + std::to_string(bytes >> 20) +
+                                        " MiB) exceed one storage binding on this device (" +
+                                        std::to_string(lim.maxStorageBufferRange >> 20) + " MiB); use a coarser mesh");
+  };
+  const size_t nt = I.mesh.triangleCount();
+  fits(I.mesh.positions.size() * I.realSize, "vertices");
+  fits(nt * SFFD_PN_STRIDE * 4 * I.realSize, "PN records");
+  fits(I.mesh.slotNormals.size() * I.realSize, "slot normals");
+  auto up = [&](const std::vector<double>& v) {
+    std::vector<unsigned char> b = realBytes(v, f64);
+    return I.upload(backend, b.data(), b.size());
+  };
+  I.pos = up(I.mesh.positions);
+  I.nrm = up(I.mesh.normals);
+  I.slot = up(I.mesh.slotNormals);
+  I.tri = I.upload(backend, I.mesh.triangles.data(), I.mesh.triangles.size() * 4);
+  I.pn = I.make(backend, nt * SFFD_PN_STRIDE * 16 * (I.realSize / 4));
+  if (!options.knotBoxClip) {
+    const PackedTable& T = packedTable();
+    PackedClip pc = packClip(I.clip);
+    fits(pc.reals.size() * I.realSize, "clip triangles");
+    I.table = I.upload(backend, T.words.data(), T.words.size() * 4);
+    I.clipHdr = I.upload(backend, pc.headers.data(), pc.headers.size() * 4);
+    I.clipReal = up(pc.reals);
+    I.counts = I.make(backend, I.clip.triangles.size() * 4);
+  }
+  PackedLattice packed = packLattice(lattice);
+  I.frame = up(packed.frame);
+  I.coeffs = up(packed.coeffs);
+  I.fitBuf = up(I.fit.data);
+  precompute();
+}
+
+DeformSession::~DeformSession() {
+  for (BufferId b : impl_->owned) backend_.destroyBuffer(b);
+}
+
+namespace {
+
+// Sums the dispatch times by stage (GPU time; the stage's wall share when the device has no timestamps).
+void sumStages(SessionTimings& t) {
+  t.pnMs = t.clipMs = t.deformMs = 0;
+  for (const DispatchTiming& d : t.dispatches) {
+    double ms = std::max(d.gpuMs, 0.0);
+    if (d.label == "pn") t.pnMs += ms;
+    else if (d.label.rfind("clip", 0) == 0) t.clipMs += ms;
+    else if (d.label.rfind("deform", 0) == 0) t.deformMs += ms;
+  }
+}
+
+}  // namespace
+
+const SessionTimings& DeformSession::precompute() {
+  Impl& I = *impl_;
+  Backend& B = backend_;
+  const DeviceLimits& lim = B.info().limits;
+  auto t0 = std::chrono::steady_clock::now();
+  timings_ = {};
+  const size_t nt = I.mesh.triangleCount();
+  auto dispatch = [&](const char* kernel, const char* label, const void* params, size_t paramsSize, size_t threads,
+                      std::vector<BufferBinding> buffers) {
+    Dispatch d;
+    d.kernel = kernel;
+    d.label = label;
+    d.variant = options_.variant;
+    d.params = params;
+    d.paramsSize = paramsSize;
+    d.buffers = std::move(buffers);
+    gridFor(threads, lim, d.groups);
+    B.dispatch(d);
+    B.barrier();
+  };
+  // The clip kernels' parameters and bindings (mesh, PN records, clip triangles, counts), for both passes.
+  auto clipParams = [&](size_t first, size_t count) {
+    gpu::ClipParams params;
+    const PackedTable& T = packedTable();
+    params.table = {T.nmax, T.vertexWord, T.triangleWord, 0};
+    params.target = {float(options_.edgeLength), 0, 0, 0};
+    params.range = {uint32_t(first), uint32_t(count), 0, 0};
+    return params;
+  };
+  auto clipBindings = [&](std::vector<BufferBinding> extra) {
+    std::vector<BufferBinding> b = {
+        {SFFD_BINDING_SPLIT_TABLE, I.table}, {SFFD_BINDING_MESH_POSITIONS, I.pos}, {SFFD_BINDING_MESH_NORMALS, I.nrm},
+        {SFFD_BINDING_MESH_TRIANGLES, I.tri}, {SFFD_BINDING_MESH_SLOT_NORMALS, I.slot}, {SFFD_BINDING_PN_OUT, I.pn},
+        {SFFD_BINDING_CLIP_HEADERS, I.clipHdr}, {SFFD_BINDING_CLIP_REALS, I.clipReal}, {SFFD_BINDING_CLIP_COUNTS, I.counts}};
+    b.insert(b.end(), extra.begin(), extra.end());
+    return b;
+  };
+  if (nt) {
+    gpu::PnParams params;
+    params.range = {0, uint32_t(nt), 0, 0};
+    dispatch("pn_triangles", "pn", &params, sizeof(params), nt,
+             {{SFFD_BINDING_MESH_POSITIONS, I.pos}, {SFFD_BINDING_MESH_NORMALS, I.nrm}, {SFFD_BINDING_MESH_TRIANGLES, I.tri},
+              {SFFD_BINDING_MESH_SLOT_NORMALS, I.slot}, {SFFD_BINDING_PN_OUT, I.pn}});
+  }
+  // Sub-triangle counts per chunk, and the chunk layout (a clip triangle's sub-triangles stay in one chunk).
+  const size_t nv = size_t(tessVertexCount(options_.level));
+  const uint64_t recordBytes = SFFD_SUB_STRIDE * 16 * (I.realSize / 4), tessBytes = 2 * nv * 16 * (I.realSize / 4),
+                 patchBytes = SFFD_PATCH_STRIDE * 16 * (I.realSize / 4),
+                 sampleBytes = (SFFD_SAMPLE_FIXED + uint64_t(I.fit.points)) * 16 * (I.realSize / 4);
+  uint64_t maxSubs = lim.maxStorageBufferRange / std::max({recordBytes, tessBytes, patchBytes, sampleBytes});
+  if (const char* forced = std::getenv("SFFD_MAX_CHUNK_SUBTRIANGLES")) maxSubs = std::min<uint64_t>(maxSubs, std::strtoull(forced, nullptr, 10));
+  maxSubs = std::max<uint64_t>(maxSubs, 1);
+
+  std::vector<uint64_t> offsets;   // per clip triangle (regular) exclusive scan of the counts
+  SubTriangleRecords knotRecords;
+  size_t clipN = 0;
+  if (!options_.knotBoxClip) {
+    clipN = I.clip.triangles.size();
+    gpu::ClipParams params = clipParams(0, clipN);
+    std::vector<uint32_t> counts(clipN);
+    if (clipN) {
+      dispatch("clip_count", "clip_count", &params, sizeof(params), clipN, clipBindings({}));
+      B.download(I.counts, 0, counts.data(), clipN * 4);
+    }
+    offsets.assign(clipN + 1, 0);
+    for (size_t i = 0; i < clipN; ++i) offsets[i + 1] = offsets[i] + counts[i], maxSubs = std::max<uint64_t>(maxSubs, counts[i]);
+  } else {
+    // The 2015 clipping is the CPU baseline: PN records come back to the host for it once.
+    PnOutput pn;
+    pn.records = doublesOf([&] {
+      std::vector<unsigned char> b(nt * SFFD_PN_STRIDE * 4 * I.realSize);
+      if (nt) B.download(I.pn, 0, b.data(), b.size());
+      return b;
+    }(), options_.variant.f64);
+    knotRecords = recordsFromSubTriangles(I.mesh, pn, I.knotBoxSubs, options_.variant);
+    clipN = knotRecords.size();   // each "clip triangle" is one sub-triangle
+    offsets.resize(clipN + 1);
+    for (size_t i = 0; i <= clipN; ++i) offsets[i] = i;
+  }
+  subCount_ = offsets.back();
+
+  // The chunks: per chunk the sub-triangle records and the deform outputs. A clip triangle's
+  // sub-triangles stay in one chunk. The buffers are kept when the layout is the one already there
+  // (a repeated precompute), so that nothing is reallocated.
+  struct Plan { size_t firstClip, clipCount, first, count; };
+  std::vector<Plan> plan;
+  for (size_t first = 0; first < clipN;) {
+    size_t last = first;
+    while (last < clipN && offsets[last + 1] - offsets[first] <= maxSubs) ++last;
+    plan.push_back({first, last - first, offsets[first], offsets[last] - offsets[first]});
+    first = last;
+  }
+  bool same = plan.size() == chunks_.size();
+  for (size_t i = 0; same && i < plan.size(); ++i)
+    same = plan[i].first == chunks_[i].first && plan[i].count == chunks_[i].count && plan[i].firstClip == I.chunkBuffers[i].firstClip;
+  if (!same) {
+    auto drop = [&](BufferId b) {
+      B.destroyBuffer(b);
+      I.owned.erase(std::find(I.owned.begin(), I.owned.end(), b));
+    };
+    for (Chunk& c : chunks_) drop(c.tess), drop(c.patches);
+    for (Impl::ChunkBuffers& c : I.chunkBuffers) drop(c.headers), drop(c.records);
+    chunks_.clear();
+    I.chunkBuffers.clear();
+    for (const Plan& p : plan) {
+      Chunk c;
+      c.first = p.first;
+      c.count = p.count;
+      c.tess = I.make(B, p.count * tessBytes);
+      c.patches = I.make(B, p.count * patchBytes);
+      Impl::ChunkBuffers cb;
+      cb.headers = I.make(B, p.count * 16);
+      cb.records = I.make(B, p.count * recordBytes);
+      cb.firstClip = p.firstClip;
+      cb.clipCount = p.clipCount;
+      chunks_.push_back(c);
+      I.chunkBuffers.push_back(cb);
+    }
+  }
+  std::vector<uint32_t> chunkOffsets(clipN);
+  for (size_t ci = 0; ci < plan.size(); ++ci) {
+    const Plan& p = plan[ci];
+    const Chunk& c = chunks_[ci];
+    const Impl::ChunkBuffers& cb = I.chunkBuffers[ci];
+    const size_t first = p.firstClip, last = p.firstClip + p.clipCount, subs = p.count;
+    if (!options_.knotBoxClip) {
+      for (size_t i = first; i < last; ++i) chunkOffsets[i] = uint32_t(offsets[i] - offsets[first]);
+      B.upload(I.counts, first * 4, chunkOffsets.data() + first, (last - first) * 4);
+      gpu::ClipParams params = clipParams(first, last - first);
+      dispatch("clip_write", "clip_write", &params, sizeof(params), last - first,
+               clipBindings({{SFFD_BINDING_SUB_HEADERS, cb.headers}, {SFFD_BINDING_SUB_RECORDS, cb.records}}));
+    } else if (subs) {
+      B.upload(cb.headers, 0, &knotRecords.headers[4 * c.first], subs * 16);
+      std::vector<double> part(knotRecords.records.begin() + c.first * SFFD_SUB_STRIDE * 4,
+                               knotRecords.records.begin() + (c.first + subs) * SFFD_SUB_STRIDE * 4);
+      std::vector<unsigned char> b = realBytes(part, options_.variant.f64);
+      B.upload(cb.records, 0, b.data(), b.size());
+    }
+  }
+  if (options_.split && !chunks_.empty()) {
+    size_t largest = 0;
+    for (const Chunk& c : chunks_) largest = std::max(largest, c.count);
+    if (largest > I.samplesCapacity) {
+      if (I.samples) B.destroyBuffer(I.samples), I.owned.erase(std::find(I.owned.begin(), I.owned.end(), I.samples));
+      I.samples = I.make(B, largest * sampleBytes);
+      I.samplesCapacity = largest;
+    }
+  }
+  B.finish();
+  timings_.dispatches = B.takeTimings();
+  if (options_.knotBoxClip) timings_.dispatches.push_back({"clip", knotRecords.wallMs});
+  sumStages(timings_);
+  timings_.wallMs = msSince(t0);
+  return timings_;
+}
+
+const SessionTimings& DeformSession::deform(const Lattice& lattice) {
+  Impl& I = *impl_;
+  Backend& B = backend_;
+  if (!sameLatticeStructure(lattice, I.structure))
+    throw Error(ErrorKind::Input, "the lattice's degrees, counts, knots or frame differ from the session's");
+  auto t0 = std::chrono::steady_clock::now();
+  timings_ = {};
+  PackedLattice packed = packLattice(lattice);
+  std::vector<unsigned char> coeffs = realBytes(packed.coeffs, options_.variant.f64);
+  B.upload(I.coeffs, 0, coeffs.data(), coeffs.size());
+  gpu::DeformParams params = deformParamsFor(packed, options_.variant.f64, &I.fit.data);
+  for (size_t ci = 0; ci < chunks_.size(); ++ci) {
+    const Chunk& c = chunks_[ci];
+    if (!c.count) continue;
+    params.range = {0, uint32_t(c.count), uint32_t(I.fit.points), uint32_t(options_.level)};
+    dispatchDeform(B, params,
+                   {I.coeffs, I.frame, I.fitBuf, I.chunkBuffers[ci].headers, I.chunkBuffers[ci].records, c.patches, c.tess,
+                    options_.split ? I.samples : 0},
+                   c.count, options_.variant, options_.split);
+  }
+  B.finish();
+  timings_.dispatches = B.takeTimings();
+  sumStages(timings_);
+  timings_.wallMs = msSince(t0);
+  if (!B.info().limits.timestamps) timings_.deformMs = timings_.wallMs;
+  return timings_;
+}
+
+SubTriangleRecords DeformSession::records() {
+  SubTriangleRecords R;
+  R.headers.resize(4 * subCount_);
+  R.records.resize(subCount_ * SFFD_SUB_STRIDE * 4);
+  const size_t rs = impl_->realSize;
+  for (size_t ci = 0; ci < chunks_.size(); ++ci) {
+    const Chunk& c = chunks_[ci];
+    if (!c.count) continue;
+    backend_.download(impl_->chunkBuffers[ci].headers, 0, &R.headers[4 * c.first], c.count * 16);
+    std::vector<unsigned char> b(c.count * SFFD_SUB_STRIDE * 4 * rs);
+    backend_.download(impl_->chunkBuffers[ci].records, 0, b.data(), b.size());
+    std::vector<double> d = doublesOf(b, options_.variant.f64);
+    std::copy(d.begin(), d.end(), R.records.begin() + c.first * SFFD_SUB_STRIDE * 4);
+  }
+  return R;
+}
+
+SmoothOutput DeformSession::output() {
+  SmoothOutput out;
+  out.level = options_.level;
+  const size_t nv = size_t(tessVertexCount(options_.level)), rs = impl_->realSize;
+  const size_t patchReals = SFFD_PATCH_STRIDE * 4, tessReals = 2 * nv * 4;
+  out.patches.resize(subCount_ * patchReals);
+  out.tess.resize(subCount_ * tessReals);
+  for (const Chunk& c : chunks_) {
+    if (!c.count) continue;
+    std::vector<unsigned char> b(c.count * tessReals * rs);
+    backend_.download(c.patches, 0, b.data(), c.count * patchReals * rs);
+    b.resize(c.count * patchReals * rs);
+    std::vector<double> d = doublesOf(b, options_.variant.f64);
+    std::copy(d.begin(), d.end(), out.patches.begin() + c.first * patchReals);
+    b.resize(c.count * tessReals * rs);
+    backend_.download(c.tess, 0, b.data(), b.size());
+    d = doublesOf(b, options_.variant.f64);
+    std::copy(d.begin(), d.end(), out.tess.begin() + c.first * tessReals);
+  }
+  out.timings = timings_.dispatches;
+  out.wallMs = timings_.wallMs;
+  return out;
+}
+
+}  // namespace sffd

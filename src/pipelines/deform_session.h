@@ -1,0 +1,86 @@
+// Device-resident smooth FFD (Lu & Feng, "Improved smooth FFD"; ALGORITHM.md 3): the pre-compute
+// (PN triangles, regular clipping) runs once and its sub-triangle records stay on the device; each
+// deform() uploads only the lattice's Bezier coefficients and runs the deform kernel into device
+// buffers that a caller on the same GL context can draw from (gl::glBufferObject) or download.
+// This is the interactive path (`sffd view`) and the one `sffd bench` times: no host round trip
+// between the stages of one deformation.
+//
+//   DeformSession s(backend, mesh, lattice, {.edgeLength = 0.2});
+//   s.deform(lattice);                          // after every lattice edit
+//   for (const DeformSession::Chunk& c : s.chunks()) draw(c.tess, c.count);
+#pragma once
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/backend.h"
+#include "model/lattice.h"
+#include "model/mesh.h"
+#include "kernels/clip/regular_clip.h"
+#include "kernels/smooth/smooth_deform.h"
+
+namespace sffd {
+
+struct DeformSessionOptions {
+  KernelVariant variant;       // float (fast) by default
+  double edgeLength = 0.2;     // the paper's l, in model units (> 0)
+  int level = 10;              // tessellation level 1..64
+  int samples = 0;             // sampling density s; 0: nu + nv + nw of the lattice (at least 3)
+  bool knotBoxClip = false;    // the 2015 clipping (computed on the CPU, records uploaded once)
+  bool split = false;          // deform as four dispatches (per-step timings) instead of the fused kernel
+  double creaseAngleDeg = 40;  // for a mesh without normals: dihedral angle above which an edge is a crease
+};
+
+// Times of the last precompute() or deform(): GPU time where the device measures it, else wall time.
+struct SessionTimings {
+  double pnMs = 0, clipMs = 0, deformMs = 0;
+  double wallMs = 0;                        // host wall time of the call, including the wait for the device
+  std::vector<DispatchTiming> dispatches;   // every dispatch of the call, in order (labels: pn, clip_count, ...)
+};
+
+class DeformSession {
+ public:
+  // Prepares the mesh (topology, creases from its normals, clip triangles) and runs precompute().
+  // The lattice fixes the degrees, counts, knots and box that later deform() calls must keep.
+  // Throws an input Error for bad options and a device Error when the device refuses the work.
+  DeformSession(Backend& backend, const Mesh& mesh, const Lattice& lattice, const DeformSessionOptions& options);
+  ~DeformSession();
+  DeformSession(const DeformSession&) = delete;
+  DeformSession& operator=(const DeformSession&) = delete;
+
+  // Runs the pre-compute stage again (PN triangles and clipping; the records stay on the device).
+  const SessionTimings& precompute();
+  // Deforms with the lattice's current control points into the chunks' buffers (undefined before the
+  // first call); an input Error if the lattice's structure differs from the session's.
+  const SessionTimings& deform(const Lattice& lattice);
+  const SessionTimings& timings() const { return timings_; }
+
+  // Sub-triangles in groups whose buffers each fit one storage binding. Tessellation buffer layout
+  // (patch_output.h): per patch p of the chunk, tessVertexCount(level) real4 positions at
+  // 2 * nv * p, then nv real4 unit normals; w = 0. Patches: SFFD_PATCH_STRIDE real4 per patch.
+  struct Chunk {
+    size_t first = 0, count = 0;   // sub-triangles [first, first + count)
+    BufferId tess = 0, patches = 0;
+  };
+  const std::vector<Chunk>& chunks() const { return chunks_; }
+  size_t subTriangles() const { return subCount_; }
+  int level() const { return options_.level; }
+  const DeformSessionOptions& options() const { return options_; }
+  Backend& backend() { return backend_; }
+
+  // Host copies, downloaded on demand: the sub-triangle records of the last precompute() (for
+  // pre-images and error analysis) and the output of the last deform().
+  SubTriangleRecords records();
+  SmoothOutput output();
+
+ private:
+  struct Impl;
+  Backend& backend_;
+  DeformSessionOptions options_;
+  std::unique_ptr<Impl> impl_;
+  std::vector<Chunk> chunks_;
+  size_t subCount_ = 0;
+  SessionTimings timings_;
+};
+
+}  // namespace sffd

@@ -1,0 +1,167 @@
+// DeformSession (the device-resident path of view and bench) on every GPU backend against the CPU
+// reference in the strict variant: bit-identical records and output, across re-deforms, chunking,
+// the split kernels and knot-box clipping.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <random>
+#include <sstream>
+
+#include "backends/backend_select.h"
+#include "backends/backend_test_support.h"
+#include "pipelines/deform_session.h"
+#include <sffd/error.h>
+#include "kernels/clip/knot_box_clip.h"
+#include "model/lattice_pack.h"
+#include "kernels/pn/pn_triangles.h"
+#include "kernels/clip/regular_clip.h"
+#include "kernels/smooth/smooth_deform.h"
+#include "kernels/clip/split_pattern_table.h"
+#include "backends/vulkan/vk_backend.h"
+
+using namespace sffd;
+
+namespace {
+
+Lattice latticeFor(const Mesh& m, unsigned seed, double amount) {
+  glm::dvec3 lo(1e300), hi(-1e300);
+  for (const glm::dvec3& p : m.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
+  Lattice L = makeIdentityLattice(lo - 0.01, hi + 0.01, {5, 5, 5}, {2, 2, 2});
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-amount, amount);
+  for (auto& p : L.controlPoints) p += glm::dvec3(u(rng), u(rng), u(rng));
+  return L;
+}
+
+// The CPU reference of the whole smooth job in the strict float order.
+struct Reference {
+  SubTriangleRecords subs;
+  SmoothOutput out;
+};
+Reference reference(const Mesh& m, const Lattice& L, const DeformSessionOptions& o) {
+  const KernelVariant strict{true, false};
+  PreparedMesh P = prepareMesh(m);
+  PnOutput pn = pnTrianglesCpu(P, strict);
+  Reference r;
+  r.subs = o.knotBoxClip ? recordsFromSubTriangles(P, pn, clipAgainstKnotBoxes(m, L), strict)
+                         : regularClipCpu(P, pn, buildClipTriangles(m, o.edgeLength, splitPatternTable().nmax()), o.edgeLength, strict);
+  r.out = smoothDeformCpu(packLattice(L), r.subs, makeFitTable(6), o.level, strict);
+  return r;
+}
+
+class DeformSessionTest : public ::testing::TestWithParam<std::string> {
+ protected:
+  OpenedBackend open() { return sffd::testing::openForTest(GetParam()); }
+};
+
+TEST_P(DeformSessionTest, StrictSessionEqualsCpuReferenceAcrossRedeforms) {
+  OpenedBackend b = open();
+  for (auto [file, l] : {std::pair{"/acaffd/cube2.obj", 0.5}, std::pair{"/acaffd/rabbit_cym.obj", 0.05}}) {
+    SCOPED_TRACE(file);
+    Mesh m = readMesh(std::string(SFFD_SHARED_DATA) + file);
+    Lattice A = latticeFor(m, 1, 0.1), B = latticeFor(m, 2, 0.2);
+    DeformSessionOptions o;
+    o.variant = {true, false};
+    o.edgeLength = l;
+    o.level = 4;
+    DeformSession s(*b.gpu, m, A, o);
+    Reference ra = reference(m, A, o), rb = reference(m, B, o);
+    ASSERT_EQ(s.subTriangles(), ra.subs.size());
+    SubTriangleRecords recs = s.records();
+    EXPECT_EQ(recs.headers, ra.subs.headers);
+    EXPECT_EQ(recs.records, ra.subs.records);
+    s.deform(A);
+    SmoothOutput a1 = s.output();
+    EXPECT_EQ(a1.patches, ra.out.patches);
+    EXPECT_EQ(a1.tess, ra.out.tess);
+    s.deform(B);
+    EXPECT_EQ(s.output().tess, rb.out.tess);
+    s.deform(A);
+    EXPECT_EQ(s.output().tess, a1.tess);
+    EXPECT_GT(s.timings().deformMs, 0.0);
+    s.precompute();   // again: the same records
+    EXPECT_EQ(s.records().records, ra.subs.records);
+  }
+  EXPECT_EQ(vk::validationMessageCount(), 0u);
+}
+
+TEST_P(DeformSessionTest, ChunkedSplitAndKnotBoxSessionsEqualCpuReference) {
+  OpenedBackend b = open();
+  Mesh m = readMesh(std::string(SFFD_SHARED_DATA) + "/acaffd/sphere.obj");
+  Lattice A = latticeFor(m, 3, 0.15);
+  DeformSessionOptions o;
+  o.variant = {true, false};
+  o.edgeLength = 0.3;
+  o.level = 3;
+  Reference ra = reference(m, A, o);
+  setenv("SFFD_MAX_CHUNK_SUBTRIANGLES", "97", 1);
+  {
+    DeformSession s(*b.gpu, m, A, o);
+    EXPECT_GT(s.chunks().size(), 2u);
+    s.deform(A);
+    EXPECT_EQ(s.output().tess, ra.out.tess);
+  }
+  unsetenv("SFFD_MAX_CHUNK_SUBTRIANGLES");
+  o.split = true;
+  {
+    DeformSession s(*b.gpu, m, A, o);
+    const SessionTimings& t = s.deform(A);
+    EXPECT_EQ(t.dispatches.size(), 4u);
+    EXPECT_EQ(s.output().patches, ra.out.patches);
+  }
+  o.split = false;
+  o.knotBoxClip = true;
+  Reference rk = reference(m, A, o);
+  DeformSession k(*b.gpu, m, A, o);
+  k.deform(A);
+  EXPECT_EQ(k.subTriangles(), rk.subs.size());
+  EXPECT_EQ(k.output().tess, rk.out.tess);
+  EXPECT_EQ(vk::validationMessageCount(), 0u);
+}
+
+// A lattice too large for the deform kernels' parameter block is read from the storage buffers:
+// the same bits.
+TEST_P(DeformSessionTest, LatticeTooLargeToInlineGivesTheSameOutput) {
+  OpenedBackend b = open();
+  Mesh m = readMesh(std::string(SFFD_SHARED_DATA) + "/acaffd/sphere.obj");
+  glm::dvec3 lo(1e300), hi(-1e300);
+  for (const glm::dvec3& p : m.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
+  Lattice big = makeIdentityLattice(lo - 0.01, hi + 0.01, {12, 12, 12}, {2, 2, 2});
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-0.03, 0.03);
+  for (auto& p : big.controlPoints) p += glm::dvec3(u(rng), u(rng), u(rng));
+  ASSERT_EQ(deformParamsFor(packLattice(big), false).lattice.break_offset.w, 0u) << "the lattice should not fit inline";
+  DeformSessionOptions o;
+  o.variant = {true, false};
+  o.edgeLength = 0.3;
+  o.level = 3;
+  DeformSession s(*b.gpu, m, big, o);
+  s.deform(big);
+  EXPECT_EQ(s.output().tess, reference(m, big, o).out.tess);
+  EXPECT_EQ(vk::validationMessageCount(), 0u);
+}
+
+TEST_P(DeformSessionTest, RefusesALatticeOfAnotherStructureAndBadOptions) {
+  OpenedBackend b = open();
+  Mesh m = readMesh(std::string(SFFD_SHARED_DATA) + "/acaffd/cube2.obj");
+  Lattice A = latticeFor(m, 1, 0.1);
+  DeformSession s(*b.gpu, m, A, {});
+  Lattice other = makeIdentityLattice({-1, -1, -1}, {1, 1, 1}, {4, 5, 5}, {2, 2, 2});
+  try {
+    s.deform(other);
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Input);
+  }
+  DeformSessionOptions bad;
+  bad.edgeLength = 0;
+  EXPECT_THROW(DeformSession(*b.gpu, m, A, bad), Error);
+  bad.edgeLength = 0.2;
+  bad.level = 65;
+  EXPECT_THROW(DeformSession(*b.gpu, m, A, bad), Error);
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, DeformSessionTest, ::testing::ValuesIn(sffd::testing::requiredBackends()),
+                         [](const auto& info) { return sffd::testing::backendTestName(info.param); });
+
+}  // namespace
