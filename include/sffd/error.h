@@ -1,18 +1,25 @@
-// sffd::Error: the one exception type that reaches the command line. Its kind decides the exit status
-// documented in CONTRACT.md (2 bad input or usage, 3 missing or unusable device, 1 anything else).
+// sffd/error.h: sffd::Error, the one exception type the library throws. Its kind says whose the
+// problem is; the command-line tool turns it into its exit status (2 bad input or usage, 3 missing
+// or unusable device, 1 anything else, cancelled included). what() is one line, "file:line: what"
+// when a line of an input file is at fault.
 #pragma once
 #include <stdexcept>
 #include <string>
 
 namespace sffd {
 
-enum class ErrorKind { Input = 2, Device = 3, Internal = 1 };
+enum class ErrorKind {
+  Input = 2,      // bad input data or options
+  Device = 3,     // no usable device, or the device refused the work (out of memory, lost)
+  Internal = 1,   // anything else
+  Cancelled = 4,  // a progress callback returned false (the tool exits 1)
+};
 
 class Error : public std::runtime_error {
  public:
   Error(ErrorKind kind, const std::string& what) : std::runtime_error(what), kind_(kind) {}
   ErrorKind kind() const { return kind_; }
-  int exitStatus() const { return static_cast<int>(kind_); }
+  int exitStatus() const { return kind_ == ErrorKind::Cancelled ? 1 : static_cast<int>(kind_); }
 
  private:
   ErrorKind kind_;

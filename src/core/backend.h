@@ -9,6 +9,8 @@
 #include <string_view>
 #include <vector>
 
+#include <sffd/device.h>
+
 namespace sffd {
 
 // Arithmetic variant of a kernel (see kernels/common/prelude.glsl).
@@ -16,23 +18,6 @@ struct KernelVariant {
   bool strict = false;   // every operation precise, fixed order: bit-identical across APIs
   bool f64 = false;      // double-precision arithmetic and storage
   bool operator==(const KernelVariant&) const = default;
-};
-
-struct DeviceLimits {
-  uint64_t maxStorageBufferRange = 128u << 20;   // bytes one storage binding may cover
-  uint64_t storageOffsetAlignment = 256;         // alignment of a storage binding's offset
-  uint32_t maxWorkGroupCount[3] = {65535, 65535, 65535};
-  bool float64 = false;                          // kernels in the f64 variant can run
-  bool timestamps = false;                       // per-dispatch GPU times are measured
-};
-
-struct DeviceInfo {
-  std::string api;       // "vulkan" or "gl"
-  std::string provider;  // how it was reached: "vulkan", "egl", "osmesa", "glfw"
-  std::string name;      // device name as the driver reports it
-  std::string driver;    // driver / API version string
-  std::string type;      // "discrete", "integrated", "virtual", "cpu", "other"
-  DeviceLimits limits;
 };
 
 using BufferId = uint32_t;

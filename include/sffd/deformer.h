@@ -1,0 +1,124 @@
+// sffd/deformer.h: one object for every method. A Deformer prepares a mesh for a lattice's
+// structure once on a device (for smooth FFD: PN triangles and the split into near-regular
+// sub-triangles, kept on the device), then deform() bends it for the lattice's current control
+// points as often as asked, uploading only the lattice.
+//
+//   sffd::Device device = sffd::Device::open();
+//   sffd::Mesh mesh = sffd::readMesh("model.obj");
+//   sffd::Lattice lattice = sffd::fitLattice(mesh);
+//   sffd::Deformer deformer(device, mesh, lattice, {.method = sffd::Method::Smooth, .edgeLength = 0.05});
+//   lattice.controlPoints[7].z += 0.2;
+//   deformer.deform(lattice);
+//   sffd::writeMesh("out.obj", deformer.result());
+//
+// Methods (docs/METHOD.md):
+//   Smooth    the improved smooth FFD: every triangle split into near-regular sub-triangles, each a
+//             cubic triangular Bezier patch fitted to the exactly deformed surface, with a deformed
+//             normal field, creases kept sharp, tessellated at level `tess`.
+//   Accurate  the exact image: knot-box sub-triangles as triangular Bezier patches of degree
+//             nu+nv+nw (the reference the other methods are measured against).
+//   Classic   vertices and normals only, the input's topology kept (as PyGeM and Blender do).
+#pragma once
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <sffd/device.h>
+#include <sffd/lattice.h>
+#include <sffd/mesh.h>
+
+namespace sffd {
+
+enum class Method { Smooth, Accurate, Classic };
+enum class Clip { Regular, KnotBox };        // sub-triangle clipping of smooth FFD (accurate: always KnotBox)
+enum class Precision { Auto, Float, Double };  // Auto: double for Classic and Accurate where the device has it
+
+// What a progress callback is told: the stage ("prepare", "pn", "clip", "deform", "download") and
+// the fraction of the whole call done, 0..1. Returning false cancels: the call throws an Error of
+// kind ErrorKind::Cancelled and the Deformer stays usable for the work already done before it.
+struct Progress {
+  const char* stage = "";
+  double fraction = 0;
+};
+using ProgressCallback = std::function<bool(const Progress&)>;
+
+struct DeformOptions {
+  Method method = Method::Smooth;
+  Clip clip = Clip::Regular;
+  double edgeLength = 0;         // the paper's l, in model units; 0: a tenth of the mesh's largest extent
+  int tess = 10;                 // tessellation level of each patch, 1..64 (66 vertices, 100 triangles at 10)
+  int samples = 0;               // smooth: sampling density s of the fit; 0: nu+nv+nw (at least 3)
+  bool strict = false;           // strict kernels: bit-identical on every device, the CPU included
+  Precision precision = Precision::Auto;
+  bool split = false;            // smooth: the deform step as four dispatches (per-step timings)
+  double creaseAngleDeg = 40;    // meshes without normals: dihedral angle above which an edge is a crease
+  uint64_t memoryLimit = 0;      // bytes of host memory a job may plan for; 0: physical memory
+  size_t maxChunkElements = 0;   // 0: chunks as large as the device allows (smaller only to test chunking)
+  ProgressCallback progress;     // called during long work; may be empty
+};
+
+// Times of the last call. GPU time where the device measures it, else host wall time.
+struct Timings {
+  double pnMs = 0, clipMs = 0, deformMs = 0;
+  double wallMs = 0;                                    // the whole call, waiting included
+  std::vector<std::pair<std::string, double>> steps;   // every dispatch by label (split: deform.sample, ...)
+};
+
+// A range of a device buffer holding results, as the interop headers hand it out
+// (sffd::vulkan::bufferOf, sffd::opengl::bufferOf).
+struct OutputChunk {
+  size_t firstPatch = 0, patchCount = 0;   // Smooth/Accurate: the sub-triangles whose tessellation it holds
+  uint32_t buffer = 0;                     // internal id; see the interop headers
+  uint64_t offset = 0, bytes = 0;
+};
+
+class Deformer {
+ public:
+  // Prepares `mesh` for lattices with the structure of `lattice` (degrees, counts, knots, frame) on
+  // `device`, which must outlive the Deformer. Throws an input Error for bad options or a mesh that
+  // cannot be deformed, a device Error when the device refuses the work.
+  Deformer(Device& device, const Mesh& mesh, const Lattice& lattice, const DeformOptions& options = {});
+  Deformer(Device& device, const MeshView& mesh, const Lattice& lattice, const DeformOptions& options = {});
+  Deformer(Deformer&&) noexcept;
+  Deformer& operator=(Deformer&&) noexcept;
+  ~Deformer();
+
+  // Deforms with the lattice's current control points; an input Error if its structure differs
+  // from the one the Deformer was made for. The results below are those of the last call.
+  const Timings& deform(const Lattice& lattice);
+  // Times of the preparation (pn, clip) and of the last deform().
+  const Timings& timings() const;
+
+  // The result as `sffd deform` writes it: Smooth and Accurate, the tessellated patches with shared
+  // boundary vertices welded (a closed input gives a closed output); Classic, the input's vertices
+  // moved, their normals mapped, its topology kept. Downloaded on each call.
+  Mesh result() const;
+  // Smooth: per sub-triangle 20 control points (x, y, z, 0) x 4 doubles: 10 of the geometry patch,
+  // then 10 of the normal patch, in the order docs/METHOD.md gives (what `deform --patches` writes).
+  std::vector<double> patchControlPoints() const;
+  size_t subTriangles() const;   // Smooth, Accurate: the patches made; Classic: 0
+
+  // The last deform()'s output where it lives on the device, for drawing from it without a copy.
+  // Smooth and Accurate: per patch, tessVertexCount(tess) positions then as many unit normals, each 4
+  // reals (w = 0; float, or double in double precision). Classic: per vertex a position (w: 1 inside
+  // the lattice box, 0 outside), then per vertex a normal, 4 reals each.
+  std::vector<OutputChunk> deviceOutput() const;
+  bool doublePrecision() const;   // whether the reals above are doubles
+  const DeformOptions& options() const;
+  Device& device() const;
+
+  struct Impl;
+  Impl& internal();   // for the command-line tool's analysis; not part of the stable API
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+// Vertices and triangles of one patch tessellated at level L: (L+1)(L+2)/2 and L^2.
+int tessVertexCount(int level);
+int tessTriangleCount(int level);
+
+}  // namespace sffd

@@ -1,0 +1,74 @@
+// sffd/device.h: where the kernels run. A Device is opened by name (Vulkan, OpenGL, the CPU
+// reference) with the documented fallback for "auto", or adopts a device or context the application
+// already owns (<sffd/vulkan.h>, <sffd/opengl.h>). Every method runs on every device: the CPU
+// reference is a device like the others, and in strict mode all of them give the same bits.
+//
+//   sffd::Device device = sffd::Device::open({.name = "auto"});
+//   std::printf("%s on %s\n", device.label().c_str(), device.info().name.c_str());
+#pragma once
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace sffd {
+
+class Backend;   // the internal compute interface a Device wraps
+
+struct DeviceLimits {
+  uint64_t maxStorageBufferRange = 128u << 20;   // bytes one storage binding may cover
+  uint64_t storageOffsetAlignment = 256;         // alignment of a storage binding's offset
+  uint32_t maxWorkGroupCount[3] = {65535, 65535, 65535};
+  bool float64 = false;                          // kernels in the f64 variant can run
+  bool timestamps = false;                       // per-dispatch GPU times are measured
+};
+
+struct DeviceInfo {
+  std::string api;       // "vulkan", "gl" or "cpu"
+  std::string provider;  // how it was reached: "vulkan", "egl", "osmesa", "glfw", "cpu", "adopted"
+  std::string name;      // device name as the driver reports it
+  std::string driver;    // driver / API version string
+  std::string type;      // "discrete", "integrated", "virtual", "cpu", "other"
+  DeviceLimits limits;
+};
+
+struct DeviceRequest {
+  // auto (Vulkan, then GL through EGL then OSMesa, then the CPU), vulkan, gl, gl-egl, gl-osmesa,
+  // gl-glfw, cpu.
+  std::string name = "auto";
+  std::string deviceSubstring;   // the first device whose name contains it (case-insensitive)
+  bool validation = false;       // Vulkan: VK_LAYER_KHRONOS_validation
+};
+
+// One device that can be opened here, as listDevices() reports it.
+struct DeviceEntry {
+  std::string label;   // the name that opens it: "vulkan", "gl-egl", "gl-osmesa", "cpu"
+  DeviceInfo info;
+};
+
+class Device {
+ public:
+  // Opens the device asked for; throws a device Error (ErrorKind::Device) when it is unusable. For
+  // "auto", devices that fail are skipped and `notes` receives one line for each.
+  static Device open(const DeviceRequest& request = {}, std::vector<std::string>* notes = nullptr);
+
+  Device(Device&&) noexcept;
+  Device& operator=(Device&&) noexcept;
+  ~Device();
+
+  const std::string& label() const;   // "vulkan", "gl-egl", "gl-osmesa", "gl-glfw", "gl-adopted", "vulkan-adopted", "cpu"
+  const DeviceInfo& info() const;
+
+  // Internal: the compute backend (src/core/backend.h). Not part of the stable API.
+  Backend& backend();
+  explicit Device(std::string label, std::unique_ptr<Backend> backend);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// Every device that can be opened here; `problems` receives one line per API that failed.
+std::vector<DeviceEntry> listDevices(std::vector<std::string>* problems = nullptr);
+
+}  // namespace sffd

@@ -1,0 +1,86 @@
+// sffd/lattice.h: the FFD lattice, a trivariate B-spline volume of any degree 1..5 per axis
+// (docs/METHOD.md), and lattice files.
+//
+// Plain data: control points in world space, knot vectors in lattice-parameter space, and an affine
+// frame mapping world points to parameters (the identity for native lattices, PyGeM's rotated box
+// for .prm lattices). Edit `controlPoints` and hand the lattice to Deformer::deform().
+#pragma once
+#include <array>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include <sffd/mesh.h>
+
+namespace sffd {
+
+
+enum class OutsideMode {
+  Extrapolate,   // points outside the box follow the nearest knot box's polynomial (continuous)
+  Keep,          // points outside the box are left unmoved (PyGeM)
+};
+
+struct Lattice {
+  std::array<int, 3> degree{2, 2, 2};
+  std::array<int, 3> counts{5, 5, 5};
+  // Full knot vectors, counts[a] + degree[a] + 1 non-decreasing values each, in parameter space.
+  std::array<std::vector<double>, 3> knots;
+  // counts[0]*counts[1]*counts[2] points, index (i*counts[1] + j)*counts[2] + k, world coordinates.
+  std::vector<glm::dvec3> controlPoints;
+  // World -> parameter frame: p = frameLinear * x + frameOffset.
+  glm::dmat3 frameLinear{1.0};
+  glm::dvec3 frameOffset{0.0};
+  OutsideMode outside = OutsideMode::Extrapolate;
+
+  size_t pointCount() const { return size_t(counts[0]) * counts[1] * counts[2]; }
+  size_t index(int i, int j, int k) const { return (size_t(i) * counts[1] + j) * counts[2] + k; }
+  // Parameter-space domain of axis a: [knots[degree], knots[counts]].
+  double domainLo(int a) const { return knots[a][degree[a]]; }
+  double domainHi(int a) const { return knots[a][counts[a]]; }
+};
+
+// Clamped uniform knot vector over [lo, hi]: (degree+1) copies of each end, uniform interior knots.
+std::vector<double> clampedUniformKnots(int count, int degree, double lo, double hi);
+
+// Checks degrees (1..5), counts > degree, knot vector sizes and monotonicity, a non-empty domain,
+// finite control points and an invertible frame. Throws an input Error naming `source`.
+void validateLattice(const Lattice& lattice, const std::string& source);
+
+// Same degrees, counts, knots, frame and outside rule (only the control points may differ): what a
+// deformation prepared for one lattice may reuse for the other.
+bool sameLatticeStructure(const Lattice& a, const Lattice& b);
+
+// Sets every control point to the world position of its Greville parameter: the identity map.
+void setIdentityControlPoints(Lattice& lattice);
+
+// An axis-aligned lattice over [lo, hi] with clamped uniform knots and identity control points.
+Lattice makeIdentityLattice(glm::dvec3 lo, glm::dvec3 hi, std::array<int, 3> counts, std::array<int, 3> degree);
+
+// An identity lattice around a mesh: its bounding box grown by `margin` times its largest extent
+// on every side (what `sffd lattice` makes; a margin keeps every vertex strictly inside and gives a
+// flat mesh a non-empty box).
+Lattice fitLattice(const Mesh& mesh, std::array<int, 3> counts = {5, 5, 5}, std::array<int, 3> degree = {2, 2, 2},
+                   double margin = 0.005);
+
+// Applies a preset deformation (twist, bend, taper, bulge, noise) of the given amount to the
+// control points, relative to the lattice box. Throws an input Error for an unknown name.
+void applyLatticePreset(Lattice& lattice, const std::string& name, double amount);
+
+struct LatticeReadOptions {
+  std::array<int, 3> npyDegree{2, 2, 2};   // .npy files carry no degree
+  // .npy files carry no box: the box is the bounding box of the mesh normalised by the caller
+  // (--normalize, 0.99 by default). Required for .npy.
+  bool haveMeshBox = false;
+  glm::dvec3 meshBoxLo{0.0}, meshBoxHi{0.0};
+};
+
+// Reads by extension: .json (native), .prm (PyGeM), .npy (an array of control points). Throws an
+// input Error ("file:line: what") on a bad file.
+Lattice readLattice(const std::string& path, const LatticeReadOptions& options = {});
+
+// Writes the native JSON format (shortest digits that read back to the same doubles) to a temporary
+// file renamed into place.
+void writeLatticeJson(const std::string& path, const Lattice& lattice);
+
+}  // namespace sffd
