@@ -25,14 +25,7 @@ int run(const ParsedArgs& args) {
     if (!(s > 0)) throw Error(ErrorKind::Input, "--normalize needs a positive scale");
     normalizeMesh(mesh, s);
   }
-  glm::dvec3 lo, hi;
-  meshBounds(mesh, lo, hi);
-  // A small margin keeps every vertex strictly inside and gives flat meshes a non-empty box.
-  double extent = std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z, 1e-12});
-  double margin = args.getDouble("--margin", 0.005) * extent;
-  lo -= glm::dvec3(margin);
-  hi += glm::dvec3(margin);
-  Lattice lattice = makeIdentityLattice(lo, hi, counts, degree);
+  Lattice lattice = fitLattice(mesh, counts, degree, args.getDouble("--margin", 0.005));
   if (args.has("--preset")) {
     std::string p = args.get("--preset");
     double amount = 1.0;

@@ -54,6 +54,22 @@ Lattice makeIdentityLattice(glm::dvec3 lo, glm::dvec3 hi, std::array<int, 3> cou
   return L;
 }
 
+Lattice fitLattice(const Mesh& mesh, std::array<int, 3> counts, std::array<int, 3> degree, double margin) {
+  if (mesh.positions.empty()) throw Error(ErrorKind::Input, "fitLattice: the mesh has no vertices");
+  if (!(margin >= 0) || !std::isfinite(margin)) throw Error(ErrorKind::Input, "fitLattice: the margin must be a finite number >= 0");
+  for (int a = 0; a < 3; ++a) {
+    if (degree[a] < 1 || degree[a] > 5) throw Error(ErrorKind::Input, "fitLattice: degrees must be in 1..5");
+    if (counts[a] <= degree[a]) throw Error(ErrorKind::Input, "fitLattice: counts must exceed the degree on every axis");
+  }
+  glm::dvec3 lo = mesh.positions[0], hi = lo;
+  for (const glm::dvec3& p : mesh.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
+  // A margin keeps every vertex strictly inside and gives a flat mesh a non-empty box.
+  const double extent = std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z, 1e-12});
+  lo -= glm::dvec3(margin * extent);
+  hi += glm::dvec3(margin * extent);
+  return makeIdentityLattice(lo, hi, counts, degree);
+}
+
 void validateLattice(const Lattice& L, const std::string& source) {
   static const char* axis = "uvw";
   for (int a = 0; a < 3; ++a) {
