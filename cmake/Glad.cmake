@@ -9,6 +9,8 @@ add_custom_command(
           --out-path ${SFFD_GLAD_DIR} c
   COMMENT "Generating the glad GL loader"
   VERBATIM)
-add_library(sffd_glad STATIC ${SFFD_GLAD_DIR}/src/gl.c)
+# An object library compiled into libsffd only: one copy of glad's entry-point table in any binary
+# (the renderer and viewer use the library's).
+add_library(sffd_glad OBJECT ${SFFD_GLAD_DIR}/src/gl.c)
 target_include_directories(sffd_glad PUBLIC ${SFFD_GLAD_DIR}/include)
 set_target_properties(sffd_glad PROPERTIES POSITION_INDEPENDENT_CODE ON)

@@ -16,6 +16,7 @@ file(MAKE_DIRECTORY ${SFFD_SPV_DIR})
 file(GLOB SFFD_KERNEL_INCLUDES CONFIGURE_DEPENDS ${SFFD_KERNEL_DIR}/*/*.glsl ${SFFD_KERNEL_DIR}/common/layout.h)
 
 add_executable(embed_kernels ${PROJECT_SOURCE_DIR}/tools/embed_kernels.cpp)
+target_compile_options(embed_kernels PRIVATE ${SFFD_WARNINGS})
 
 set(_spv_outputs)
 foreach(kernel IN LISTS SFFD_KERNELS)

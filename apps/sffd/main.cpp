@@ -22,7 +22,10 @@ static std::vector<cli::CommandSpec> commands() {
   return {cli::deformCommand(), cli::latticeCommand(), cli::devicesCommand(), cli::conformCommand(), cli::clipCommand(),
           cli::errorCommand(),
           cli::renderCommand(), cli::benchCommand(),
-          cli::viewCommand()};
+#if SFFD_WITH_VIEWER
+          cli::viewCommand(),
+#endif
+  };
 }
 
 static void usage(FILE* f) {

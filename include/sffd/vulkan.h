@@ -4,10 +4,11 @@
 // The application keeps ownership of everything it lends: sffd never destroys the instance, the
 // device or the queue, and waits for its own work before a Deformer or Device goes away. The queue
 // must not be used by another thread while an sffd call runs (Vulkan's external synchronisation).
-// sffd creates its own command pool, buffers, pipelines and descriptor sets on the device.
+// sffd creates (and destroys) its own command pool, buffers, pipelines, descriptor sets and query
+// pools on the device. Every sffd call that submits waits for its submission to complete.
 //
 //   sffd::vulkan::DeviceConfig config{instance, physicalDevice, device, queueFamily, queue,
-//                                     vkGetInstanceProcAddr};
+//                                     vkGetInstanceProcAddr, /*shaderFloat64Enabled=*/false};
 //   sffd::Device gpu = sffd::vulkan::adoptDevice(config);
 //   sffd::Deformer deformer(gpu, mesh, lattice, {.strict = true});
 //   deformer.deform(lattice);
@@ -23,9 +24,8 @@
 
 namespace sffd::vulkan {
 
-// The application's device, borrowed. The device must have been created with Vulkan 1.1 or later;
-// double-precision kernels run when the application enabled shaderFloat64, timings when the queue
-// family has timestamps.
+// The application's device, borrowed. The instance must have been created for Vulkan 1.1 or later;
+// timings are measured when the queue family has timestamps.
 struct DeviceConfig {
   VkInstance instance = VK_NULL_HANDLE;
   VkPhysicalDevice physicalDevice = VK_NULL_HANDLE;
@@ -33,6 +33,9 @@ struct DeviceConfig {
   uint32_t queueFamily = 0;             // a family with VK_QUEUE_COMPUTE_BIT
   VkQueue queue = VK_NULL_HANDLE;       // a queue of that family
   PFN_vkGetInstanceProcAddr getInstanceProcAddr = nullptr;   // null: sffd opens the system loader
+  // Vulkan cannot be asked which features a device was created with: say whether you enabled
+  // VkPhysicalDeviceFeatures::shaderFloat64 (double-precision kernels run only then).
+  bool shaderFloat64Enabled = false;
 };
 
 // A Device on the application's Vulkan device. Throws a device Error when the device cannot run the

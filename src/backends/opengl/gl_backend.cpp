@@ -1,7 +1,8 @@
 // OpenGL 4.3+ core compute driver (sffd::Backend) on a context from gl_context.h.
 // Every GL call goes through glad, whose entry points the context loads when it becomes current;
 // each public method activates the backend's context first, so backends of several providers can
-// live in one process.
+// live in one process, and restores the bindings it changes (gl_state.h), so that an application's
+// context can be shared (adopted contexts).
 #include "backends/opengl/gl_backend.h"
 
 #include <glad/gl.h>
@@ -16,6 +17,7 @@
 #include <utility>
 
 #include <sffd/error.h>
+#include "backends/opengl/gl_state.h"
 #include "core/kernel_registry.h"
 #include "kernels/common/shader_layout.h"
 
@@ -112,6 +114,8 @@ class GlBackend final : public Backend {
     uboAlign_ = static_cast<uint64_t>(std::max(uboAlign, 16));
     maxParams_ = static_cast<uint64_t>(std::max(maxBlock, 16384));
     uboSize_ = std::max<uint64_t>(kRingBytes, alignUp(maxParams_, uboAlign_));
+    StateGuard state;
+    state.buffer(GL_UNIFORM_BUFFER);
     glGenBuffers(1, &ubo_);
     glBindBuffer(GL_UNIFORM_BUFFER, ubo_);
     glBufferData(GL_UNIFORM_BUFFER, static_cast<GLsizeiptr>(uboSize_), nullptr, GL_STREAM_DRAW);
@@ -145,6 +149,8 @@ class GlBackend final : public Backend {
 
   BufferId createBuffer(uint64_t bytes) override {
     ctx_->activate();
+    StateGuard state;
+    state.buffer(GL_COPY_WRITE_BUFFER);
     GLuint name = 0;
     glGenBuffers(1, &name);
     glBindBuffer(GL_COPY_WRITE_BUFFER, name);
@@ -179,6 +185,8 @@ class GlBackend final : public Backend {
     if (bytes == 0) return;
     // Shader writes are incoherent: order them before this write.
     if (dirty_) glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    StateGuard state;
+    state.buffer(GL_COPY_WRITE_BUFFER);
     glBindBuffer(GL_COPY_WRITE_BUFFER, b.name);
     glBufferSubData(GL_COPY_WRITE_BUFFER, static_cast<GLintptr>(offset), static_cast<GLsizeiptr>(bytes), data);
     checkGl("upload");
@@ -192,6 +200,8 @@ class GlBackend final : public Backend {
       glMemoryBarrier(kAllBarriers);
       dirty_ = false;
     }
+    StateGuard state;
+    state.buffer(GL_COPY_READ_BUFFER);
     glBindBuffer(GL_COPY_READ_BUFFER, b.name);
     // Synchronous: waits for the dispatches that write the buffer.
     glGetBufferSubData(GL_COPY_READ_BUFFER, static_cast<GLintptr>(offset), static_cast<GLsizeiptr>(bytes), data);
@@ -220,6 +230,11 @@ class GlBackend final : public Backend {
     if (d.paramsSize > maxParams_)
       throw Error(ErrorKind::Internal, "gl: parameter block of " + what + " is larger than GL_MAX_UNIFORM_BLOCK_SIZE");
     uint64_t span = alignUp(std::max<uint64_t>(d.paramsSize, 16), 16);
+    StateGuard state;
+    state.program();
+    state.indexed(GL_UNIFORM_BUFFER, SFFD_BINDING_PARAMS);
+    for (const BufferBinding& bb : d.buffers)
+      if (bb.slot >= 1 && bb.slot <= SFFD_MAX_STORAGE_BINDINGS) state.indexed(GL_SHADER_STORAGE_BUFFER, bb.slot);
     glBindBuffer(GL_UNIFORM_BUFFER, ubo_);
     if (uboHead_ + span > uboSize_) {
       glBufferData(GL_UNIFORM_BUFFER, static_cast<GLsizeiptr>(uboSize_), nullptr, GL_STREAM_DRAW);

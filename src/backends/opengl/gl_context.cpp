@@ -62,6 +62,16 @@ Context::~Context() {
 bool Context::isCurrent() const { return tCurrent == this; }
 
 void Context::activate() {
+  if (adopted()) {
+    // The application's context: made current by the application only. The sffd context that was
+    // current here before is left alone (the application switched away from it itself).
+    if (!providerCurrent())
+      throw deviceError("gl-adopted: the adopted OpenGL context is not current on this thread");
+    if (tCurrent == this) return;
+    tCurrent = this;
+    loadGlad();
+    return;
+  }
   if (tCurrent == this && providerCurrent()) return;
   if (tCurrent) {
     tCurrent->release();
@@ -69,6 +79,10 @@ void Context::activate() {
   }
   makeCurrent();
   tCurrent = this;
+  loadGlad();
+}
+
+void Context::loadGlad() {
   // The GL entry points belong to the provider's library (OSMesa has its own copy of Mesa's GL):
   // reload them whenever another context becomes current.
   int version = gladLoadGLUserPtr(loadThrough, this);

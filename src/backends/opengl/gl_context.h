@@ -52,6 +52,9 @@ class Context {
   bool isCurrent() const;
   // The GL version glad found at the last activate(): major * 10 + minor (45 for 4.5).
   int glVersion() const { return glVersion_; }
+  // An application's context (adoptCurrentContext): activate() never switches to it or away from
+  // it, only checks that it is current here (a device Error otherwise) and loads glad through it.
+  virtual bool adopted() const { return false; }
 
  protected:
   // Provider primitives used by activate(): make current / make nothing current on this thread, and
@@ -64,6 +67,7 @@ class Context {
   void releaseIfCurrent();
 
  private:
+  void loadGlad();
   int glVersion_ = 0;
 };
 
@@ -79,6 +83,10 @@ struct GlfwWindowOptions {
   std::string title = "sffd";
 };
 std::unique_ptr<Context> createGlfwContext(const GlfwWindowOptions& options = {});
+
+// The context current on this thread, owned by the application, its entry points from `getProc`.
+// Throws a device Error when no context is current. (gl_context_adopted.cpp)
+std::unique_ptr<Context> adoptCurrentContext(GLProc (*getProc)(const char*));
 
 // The context of an explicit provider (Auto is refused: the driver walks the list itself).
 std::unique_ptr<Context> createContext(Provider provider);

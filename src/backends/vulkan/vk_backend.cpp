@@ -13,6 +13,7 @@
 #include "kernels/common/shader_layout.h"
 #include "backends/vulkan/vk_device.h"
 #include "backends/vulkan/vk_instance.h"
+#include "backends/vulkan/vk_interop.h"
 #include "backends/vulkan/vk_kernels.h"
 #include "backends/vulkan/vk_recorder.h"
 
@@ -43,6 +44,33 @@ PhysicalDevice selectDevice(const Instance& instance, const std::string& substri
   throw deviceError("No Vulkan device can run sffd (" + reasons + ").");
 }
 
+// The application's physical device as sffd sees it through the borrowed queue family: float64
+// only where the application enabled it, timestamps of that family.
+PhysicalDevice adoptedPhysical(const Instance& instance, const vulkan::DeviceConfig& c) {
+  if (!c.physicalDevice) throw deviceError("Vulkan: adoptDevice needs the application's VkPhysicalDevice");
+  const Api& api = instance.api();
+  PhysicalDevice pd = instance.describe(c.physicalDevice);
+  uint32_t count = 0;
+  api.vkGetPhysicalDeviceQueueFamilyProperties(c.physicalDevice, &count, nullptr);
+  std::vector<VkQueueFamilyProperties> families(count);
+  api.vkGetPhysicalDeviceQueueFamilyProperties(c.physicalDevice, &count, families.data());
+  if (c.queueFamily >= count || !(families[c.queueFamily].queueFlags & VK_QUEUE_COMPUTE_BIT))
+    throw deviceError("Vulkan: queue family " + std::to_string(c.queueFamily) + " of " + pd.info.name +
+                      " has no compute (adoptDevice needs VK_QUEUE_COMPUTE_BIT)");
+  if (!pd.unusable.empty() && pd.computeFamily != UINT32_MAX)
+    throw deviceError("The Vulkan device " + pd.info.name + " cannot run sffd: " + pd.unusable + ".");
+  VkPhysicalDeviceProperties props;
+  api.vkGetPhysicalDeviceProperties(c.physicalDevice, &props);
+  pd.computeFamily = c.queueFamily;
+  pd.timestampBits = families[c.queueFamily].timestampValidBits;
+  pd.unusable.clear();
+  pd.info.provider = "adopted";
+  pd.info.limits.float64 = pd.info.limits.float64 && c.shaderFloat64Enabled;
+  pd.info.limits.timestamps =
+      props.limits.timestampComputeAndGraphics && props.limits.timestampPeriod > 0 && pd.timestampBits > 0;
+  return pd;
+}
+
 // Stages and accesses of everything sffd records: kernels and copies.
 constexpr VkPipelineStageFlags kWorkStages = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT;
 constexpr VkAccessFlags kWorkWrites = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
@@ -57,10 +85,20 @@ class VulkanBackend final : public Backend {
         kernels_(device_),
         recorder_(device_, kernels_.setLayout()) {}
 
+  explicit VulkanBackend(const vulkan::DeviceConfig& c)
+      : instance_(c.instance, c.getInstanceProcAddr),
+        device_(instance_, adoptedPhysical(instance_, c), c.device, c.queue),
+        kernels_(device_),
+        recorder_(device_, kernels_.setLayout()) {}
+
   ~VulkanBackend() override {
     // Submissions are waited for, so nothing should be in flight (unless a wait failed);
-    // unsubmitted work is dropped with the command pool.
-    device_.api().vkDeviceWaitIdle(device_.handle());
+    // unsubmitted work is dropped with the command pool. A borrowed device's other queues are the
+    // application's: only our queue is waited for.
+    if (device_.owned())
+      device_.api().vkDeviceWaitIdle(device_.handle());
+    else
+      device_.api().vkQueueWaitIdle(device_.queue());
     for (Buffer& b : buffers_) device_.release(b.memory);
   }
 
@@ -200,6 +238,10 @@ class VulkanBackend final : public Backend {
 
   std::vector<DispatchTiming> takeTimings() override { return std::exchange(timings_, {}); }
 
+  VkBuffer vkBuffer(BufferId id) const {
+    return id == 0 || id > buffers_.size() || !buffers_[id - 1].live ? VK_NULL_HANDLE : buffers_[id - 1].memory.buffer;
+  }
+
  private:
   struct Buffer {
     Allocation memory;
@@ -255,5 +297,12 @@ std::vector<DeviceInfo> listDevices() {
 }
 
 std::unique_ptr<Backend> createBackend(const Options& options) { return std::make_unique<VulkanBackend>(options); }
+
+std::unique_ptr<Backend> adoptBackend(const vulkan::DeviceConfig& config) { return std::make_unique<VulkanBackend>(config); }
+
+VkBuffer vkBufferOf(const Backend& backend, BufferId buffer) {
+  const auto* vk = dynamic_cast<const VulkanBackend*>(&backend);
+  return vk ? vk->vkBuffer(buffer) : VK_NULL_HANDLE;
+}
 
 }  // namespace sffd::vk

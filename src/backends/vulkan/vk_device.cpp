@@ -19,20 +19,7 @@ constexpr VkMemoryPropertyFlags kExcluded = VK_MEMORY_PROPERTY_LAZILY_ALLOCATED_
 
 Device::Device(const Instance& instance, const PhysicalDevice& physical)
     : api_(instance.api()), info_(physical.info), family_(physical.computeFamily), timestampBits_(physical.timestampBits) {
-  api_.vkGetPhysicalDeviceProperties(physical.handle, &props_);
-  api_.vkGetPhysicalDeviceMemoryProperties(physical.handle, &memory_);
-
-  bool anyDeviceLocal = false;
-  // SFFD_VK_STAGING=1 treats the device as discrete even on unified memory, so that the staging
-  // path of real GPUs is exercised on lavapipe too.
-  unified_ = !envFlag("SFFD_VK_STAGING");
-  for (uint32_t i = 0; i < memory_.memoryTypeCount; ++i) {
-    VkMemoryPropertyFlags f = memory_.memoryTypes[i].propertyFlags;
-    if (!(f & VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT) || (f & kExcluded)) continue;
-    anyDeviceLocal = true;
-    if ((f & kMappable) != kMappable) unified_ = false;
-  }
-  unified_ = unified_ && anyDeviceLocal;
+  chooseMemory(physical.handle);
 
   float priority = 1.0f;
   auto queueInfo = vkStruct<VkDeviceQueueCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO);
@@ -65,7 +52,33 @@ Device::Device(const Instance& instance, const PhysicalDevice& physical)
   api_.vkGetDeviceQueue(device_, family_, 0, &queue_);
 }
 
-Device::~Device() { api_.vkDestroyDevice(device_, nullptr); }
+Device::Device(const Instance& instance, const PhysicalDevice& physical, VkDevice borrowed, VkQueue queue)
+    : api_(instance.api()), info_(physical.info), device_(borrowed), queue_(queue), family_(physical.computeFamily),
+      timestampBits_(physical.timestampBits), owned_(false) {
+  if (!borrowed || !queue) throw deviceError("Vulkan: adoptDevice needs the application's VkDevice and VkQueue");
+  chooseMemory(physical.handle);
+  api_.loadDevice(device_);
+}
+
+Device::~Device() {
+  if (owned_) api_.vkDestroyDevice(device_, nullptr);
+}
+
+void Device::chooseMemory(VkPhysicalDevice physical) {
+  api_.vkGetPhysicalDeviceProperties(physical, &props_);
+  api_.vkGetPhysicalDeviceMemoryProperties(physical, &memory_);
+  bool anyDeviceLocal = false;
+  // SFFD_VK_STAGING=1 treats the device as discrete even on unified memory, so that the staging
+  // path of real GPUs is exercised on lavapipe too.
+  unified_ = !envFlag("SFFD_VK_STAGING");
+  for (uint32_t i = 0; i < memory_.memoryTypeCount; ++i) {
+    VkMemoryPropertyFlags f = memory_.memoryTypes[i].propertyFlags;
+    if (!(f & VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT) || (f & kExcluded)) continue;
+    anyDeviceLocal = true;
+    if ((f & kMappable) != kMappable) unified_ = false;
+  }
+  unified_ = unified_ && anyDeviceLocal;
+}
 
 // Best memory type for a use among the buffer's allowed types: it must have the required flags;
 // each preferred flag present scores 4, each avoided flag present costs 1.

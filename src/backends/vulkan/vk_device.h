@@ -28,6 +28,9 @@ class Device {
  public:
   // Creates the device with shaderFloat64 enabled when the hardware has it.
   Device(const Instance& instance, const PhysicalDevice& physical);
+  // Borrows an application's device and queue (interop; never destroyed here): `physical` describes
+  // the queue's family, and its float64 limit says whether shaderFloat64 was enabled.
+  Device(const Instance& instance, const PhysicalDevice& physical, VkDevice borrowed, VkQueue queue);
   ~Device();
   Device(const Device&) = delete;
   Device& operator=(const Device&) = delete;
@@ -39,6 +42,7 @@ class Device {
   uint32_t timestampBits() const { return timestampBits_; }   // valid bits of the queue's timestamps
   const VkPhysicalDeviceProperties& properties() const { return props_; }
   const DeviceInfo& info() const { return info_; }
+  bool owned() const { return owned_; }
 
   // Throws a device Error when memory runs out.
   Allocation allocate(uint64_t bytes, VkBufferUsageFlags usage, MemoryUse use);
@@ -46,6 +50,7 @@ class Device {
 
  private:
   uint32_t memoryType(uint32_t allowedTypes, MemoryUse use) const;
+  void chooseMemory(VkPhysicalDevice physical);
 
   Api api_;
   DeviceInfo info_;
@@ -56,6 +61,7 @@ class Device {
   VkQueue queue_ = VK_NULL_HANDLE;
   uint32_t family_ = 0;
   uint32_t timestampBits_ = 0;
+  bool owned_ = true;
 };
 
 }  // namespace sffd::vk

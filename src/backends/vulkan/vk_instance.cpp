@@ -212,10 +212,19 @@ Instance::Instance(bool validation) : api_(Api::load()) {
   }
 }
 
+Instance::Instance(VkInstance borrowed, PFN_vkGetInstanceProcAddr getProc)
+    : api_(getProc ? Api::borrow(getProc) : Api::load()), instance_(borrowed), owned_(false) {
+  if (!borrowed) throw deviceError("Vulkan: adoptDevice needs the application's VkInstance");
+  api_.loadInstance(instance_, false);
+}
+
 Instance::~Instance() {
+  if (!owned_) return;
   if (messenger_) api_.vkDestroyDebugUtilsMessengerEXT(instance_, messenger_, nullptr);
   api_.vkDestroyInstance(instance_, nullptr);
 }
+
+PhysicalDevice Instance::describe(VkPhysicalDevice handle) const { return vk::describe(api_, handle); }
 
 std::vector<PhysicalDevice> Instance::physicalDevices() const {
   uint32_t count = 0;
@@ -228,7 +237,7 @@ std::vector<PhysicalDevice> Instance::physicalDevices() const {
   handles.resize(count);
 
   std::vector<PhysicalDevice> devices;
-  for (VkPhysicalDevice h : handles) devices.push_back(describe(api_, h));
+  for (VkPhysicalDevice h : handles) devices.push_back(describe(h));
   auto rank = [](const PhysicalDevice& d) {
     return std::find(std::begin(kTypeNames), std::end(kTypeNames), d.info.type) - std::begin(kTypeNames);
   };

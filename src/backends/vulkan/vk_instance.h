@@ -29,6 +29,9 @@ class Instance {
  public:
   // Throws a device Error when the loader, an ICD or Vulkan 1.1 is missing.
   explicit Instance(bool validation);
+  // Borrows an application's instance (interop): never destroyed here; entry points through
+  // `getProc`, or the system loader's when it is null.
+  Instance(VkInstance borrowed, PFN_vkGetInstanceProcAddr getProc);
   ~Instance();
   Instance(const Instance&) = delete;
   Instance& operator=(const Instance&) = delete;
@@ -38,11 +41,15 @@ class Instance {
   // Every physical device, sorted discrete, integrated, virtual, CPU, other (stable within a type).
   // Throws a device Error when there is none.
   std::vector<PhysicalDevice> physicalDevices() const;
+  // One physical device described, its first compute family picked.
+  PhysicalDevice describe(VkPhysicalDevice handle) const;
+  bool owned() const { return owned_; }
 
  private:
   Api api_;
   VkInstance instance_ = VK_NULL_HANDLE;
   VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
+  bool owned_ = true;
 };
 
 }  // namespace sffd::vk

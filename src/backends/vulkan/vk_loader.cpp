@@ -44,6 +44,17 @@ Api Api::load() {
   return api;
 }
 
+Api Api::borrow(PFN_vkGetInstanceProcAddr getProc) {
+  Api api;
+  api.vkGetInstanceProcAddr = getProc;
+  api.vkEnumerateInstanceVersion =
+      reinterpret_cast<PFN_vkEnumerateInstanceVersion>(getProc(nullptr, "vkEnumerateInstanceVersion"));
+#define SFFD_VK_LOAD(name) api.name = reinterpret_cast<PFN_##name>(getProc(nullptr, #name));
+  SFFD_VK_GLOBAL_FUNCTIONS(SFFD_VK_LOAD)
+#undef SFFD_VK_LOAD
+  return api;
+}
+
 void Api::loadInstance(VkInstance instance, bool debugUtils) {
 #define SFFD_VK_LOAD(name)                                                               \
   name = reinterpret_cast<PFN_##name>(vkGetInstanceProcAddr(instance, #name)); \

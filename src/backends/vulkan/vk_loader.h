@@ -39,6 +39,7 @@ namespace sffd::vk {
   X(vkDestroyDevice)                   \
   X(vkGetDeviceQueue)                  \
   X(vkDeviceWaitIdle)                  \
+  X(vkQueueWaitIdle)                   \
   X(vkCreateBuffer)                    \
   X(vkDestroyBuffer)                   \
   X(vkGetBufferMemoryRequirements)     \
@@ -98,6 +99,9 @@ struct Api {
   // Opens the loader library (env SFFD_VULKAN_LIBRARY overrides "libvulkan.so.1") and resolves the
   // global functions. Throws a device Error when the library or an entry point is missing.
   static Api load();
+  // The table of an application's loader (interop): everything resolved through `getProc`; the
+  // global functions are not required (sffd creates no instance then).
+  static Api borrow(PFN_vkGetInstanceProcAddr getProc);
   void loadInstance(VkInstance instance, bool debugUtils);
   void loadDevice(VkDevice device);
 };

@@ -162,10 +162,12 @@ std::vector<DispatchTiming> Recorder::submitAndWait() {
   const Api& api = device_.api();
   VkDevice dev = device_.handle();
 
-  // Device writes (kernels, copies) become visible to the host reading mapped memory after the wait.
+  // Device writes (kernels, copies) become visible to the host reading mapped memory after the wait,
+  // and to every later command on the queue (an adopting application's draws and copies).
   memoryBarrier(VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
-                VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT,
-                VK_ACCESS_HOST_READ_BIT);
+                VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT,
+                VK_PIPELINE_STAGE_HOST_BIT | VK_PIPELINE_STAGE_ALL_COMMANDS_BIT,
+                VK_ACCESS_HOST_READ_BIT | VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT);
   check(api.vkEndCommandBuffer(commands_), "vkEndCommandBuffer");
   auto si = vkStruct<VkSubmitInfo>(VK_STRUCTURE_TYPE_SUBMIT_INFO);
   si.commandBufferCount = 1;
