@@ -19,7 +19,7 @@ using namespace sffd;
 
 namespace {
 
-const std::string kData = SFFD_SHARED_DATA;
+const std::string kData = SFFD_TEST_DATA;
 
 int linearIndex(int d, int i, int k) { return (d - i) * (d - i + 1) / 2 + k; }
 
@@ -84,7 +84,7 @@ struct BezierBox {
 double angleBetween(const glm::dvec3& a, const glm::dvec3& b) { return std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b)); }
 
 // ---- meshes and lattices ----
-Mesh load(const std::string& name) { return readMesh(kData + "/acaffd/" + name); }
+Mesh load(const std::string& name) { return readMesh(kData + "/" + name); }
 
 Lattice boxLattice(const Mesh& m, std::array<int, 3> counts, std::array<int, 3> degree, double margin = 0.0) {
   glm::dvec3 lo = m.positions[0], hi = lo;
