@@ -1,4 +1,4 @@
-// End-to-end tests of `sffd error` (CONTRACT.md, docs/ACCURACY.md "Error metrics"): the JSON contract,
+// End-to-end tests of `sffd error` (docs/CLI.md, docs/ACCURACY.md "Error metrics"): the JSON contract,
 // accurate FFD measured against the exact FFD (about 0), classic FFD (positive), closed and open meshes.
 #include <gtest/gtest.h>
 

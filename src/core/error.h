@@ -1,5 +1,5 @@
 // sffd::Error: the one exception type that reaches the command line. Its kind decides the exit status
-// documented in CONTRACT.md (2 bad input or usage, 3 missing or unusable device, 1 anything else).
+// documented in docs/CLI.md (2 bad input or usage, 3 missing or unusable device, 1 anything else).
 #pragma once
 #include <stdexcept>
 #include <string>

@@ -1,4 +1,4 @@
-// Error analysis (error_metrics.h, ALGORITHM.md 5): statistics, the quadrature, the exact deformed
+// Error analysis (error_metrics.h, METHOD.md 5): statistics, the quadrature, the exact deformed
 // volume against exact values and against a very fine classic deformation, the errors of accurate and
 // classic FFD, and the .bpt reference on the exact surface.
 #include <gtest/gtest.h>

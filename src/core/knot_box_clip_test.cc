@@ -1,4 +1,4 @@
-// Knot-box clipping (knot_box_clip.h, ALGORITHM.md 2.1): the pieces tile each parent (area, winding),
+// Knot-box clipping (knot_box_clip.h, METHOD.md 2.1): the pieces tile each parent (area, winding),
 // each lies in one knot box, vertex descriptions are consistent, and shared parent edges are cut at
 // bitwise-identical places from both sides (no cracks, no T-junctions). Statistics for rabbit_cym.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// The FFD lattice: a trivariate B-spline volume of any degree 1..5 per axis (ALGORITHM.md 1).
+// The FFD lattice: a trivariate B-spline volume of any degree 1..5 per axis (METHOD.md 1).
 // Plain data: control points in world space, knot vectors in lattice-parameter space, and an affine
 // frame mapping world points to parameters (the identity for native lattices, PyGeM's rotated box
 // for .prm lattices).

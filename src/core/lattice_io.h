@@ -1,5 +1,5 @@
 // Lattice files: the native JSON format, PyGeM .prm and reference-implementation .npy
-// (CONTRACT.md "Inputs"), and the presets of `sffd lattice`.
+// (docs/CLI.md "Inputs"), and the presets of `sffd lattice`.
 #pragma once
 #include <string>
 

@@ -1,4 +1,4 @@
-// Mesh topology (mesh_topology.h, ALGORITHM.md 3.1-3.2): adjacency by welded position on the paper's
+// Mesh topology (mesh_topology.h, METHOD.md 3.1-3.2): adjacency by welded position on the paper's
 // own models, crease slots from split normals, non-manifold and degenerate input, and the crease-angle
 // fallback for meshes without normals.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// PN triangles (ALGORITHM.md 3.2, 3.5): interpolation of corners and normals, identical boundary
+// PN triangles (METHOD.md 3.2, 3.5): interpolation of corners and normals, identical boundary
 // curves across shared edges (smooth and crease), flat PN patches for the split-normal cube.
 #include <gtest/gtest.h>
 
@@ -65,7 +65,7 @@ TEST(PnTriangles, SharedEdgesGiveIdenticalCurves) {
 }
 
 TEST(PnTriangles, SplitNormalCubeIsFlat) {
-  // ALGORITHM.md 5: cube2's PN triangles are flat (crease projections fall on the edges).
+  // METHOD.md 5: cube2's PN triangles are flat (crease projections fall on the edges).
   Mesh m = readMesh(kData + "/cube2.obj");
   PnOutput o = pnTrianglesCpu(prepareMesh(m), {false, true});
   for (size_t t = 0; t < m.triangles.size(); ++t) {

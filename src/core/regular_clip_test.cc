@@ -1,4 +1,4 @@
-// Regular clipping (ALGORITHM.md 4.2): crack-free sub-triangles (the welded result of a closed mesh is
+// Regular clipping (METHOD.md 4.2): crack-free sub-triangles (the welded result of a closed mesh is
 // closed and consistently oriented), exact cover of every parent, pre-split of long edges.
 #include <gtest/gtest.h>
 
@@ -142,7 +142,7 @@ TEST(KnotBoxRecords, ClosedAndCoveredLikeRegular) {
 }
 
 TEST(RegularClip, FewerSliversThanKnotBoxAtComparableCounts) {
-  // ALGORITHM.md 4: the reason for the improved clipping. Rabbit, 5x5x5 knot boxes vs a regular
+  // METHOD.md 4: the reason for the improved clipping. Rabbit, 5x5x5 knot boxes vs a regular
   // split tuned to a similar sub-triangle count.
   Mesh m = readMesh(kData + "/torus.obj");
   glm::dvec3 lo(1e30), hi(-1e30);

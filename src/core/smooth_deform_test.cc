@@ -1,4 +1,4 @@
-// Smooth FFD deform stage (ALGORITHM.md 3.4, 3.5): the identity lattice reproduces the PN triangles;
+// Smooth FFD deform stage (METHOD.md 3.4, 3.5): the identity lattice reproduces the PN triangles;
 // closed inputs give closed, consistently oriented outputs (bitwise C0 along every shared edge).
 #include <gtest/gtest.h>
 
@@ -65,7 +65,7 @@ void expectClosedOutput(const Mesh& out) {
 }  // namespace
 
 TEST(SmoothDeform, FitTableMatchesTheClosedForm) {
-  // ALGORITHM.md 3.4: for s = 6 the centre weights on the raw interior samples are 18/41, 27/41, 36/41.
+  // METHOD.md 3.4: for s = 6 the centre weights on the raw interior samples are 18/41, 27/41, 36/41.
   FitTable F = makeFitTable(6);
   ASSERT_EQ(F.points, 10);
   double sum = 0;
