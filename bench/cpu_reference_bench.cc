@@ -94,7 +94,7 @@ BENCHMARK_TEMPLATE(BM_LatticeEvaluateWithNormal, float)->Unit(benchmark::kMillis
 
 // Classic FFD of torus.obj (every vertex and normal) on the CPU reference. Arg: 1 = double
 // (the oracle), 0 = float in the strict kernels' order. Items = vertices.
-void BM_ClassicFfdCpuRabbit(benchmark::State& state) {
+void BM_ClassicFfdCpuTorus(benchmark::State& state) {
   const Mesh& m = bench::model("torus.obj");
   PackedLattice P = packLattice(bench::deformedLattice(m, 5, 2));
   KernelVariant v{true, state.range(0) != 0};
@@ -105,7 +105,7 @@ void BM_ClassicFfdCpuRabbit(benchmark::State& state) {
   state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(m.positions.size()));
   state.counters["vertices"] = double(m.positions.size());
 }
-BENCHMARK(BM_ClassicFfdCpuRabbit)->ArgName("f64")->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ClassicFfdCpuTorus)->ArgName("f64")->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond);
 
 // The error analysis' exact reference: pre-image of a point of a teapot triangle on the exact
 // Bezier surface (.bpt), then its exact FFD (position and cofactor normal). Items = points.

@@ -307,6 +307,38 @@ def lattices(teapot):
     return lo, hi, g
 
 
+# ---------------------------------------------------------------------------------------------------
+# The demo's model: a coarse hexagonal prism (radius 0.5, height 3, 3 segments along z, flat caps) with
+# one normal per face, so every edge between faces is a crease. Coarse on purpose: classic FFD moves
+# its 26 vertices and leaves flat facets; smooth FFD bends the faces and keeps the creases sharp.
+
+def prism(sides=6, segs=3, height=3.0, radius=0.5):
+    ring = [(radius * math.cos(2 * math.pi * k / sides), radius * math.sin(2 * math.pi * k / sides)) for k in range(sides)]
+    V, N, F, idx = [], [], [], {}
+    for s in range(segs + 1):
+        for k in range(sides):
+            V.append((ring[k][0], ring[k][1], -height / 2 + height * s / segs))
+            idx[s, k] = len(V)
+    for k in range(sides):
+        a = 2 * math.pi * (k + 0.5) / sides
+        N.append((math.cos(a), math.sin(a), 0.0))
+        n = len(N)
+        for s in range(segs):
+            p00, p10, p11, p01 = idx[s, k], idx[s, (k + 1) % sides], idx[s + 1, (k + 1) % sides], idx[s + 1, k]
+            F += [((p00, n), (p10, n), (p11, n)), ((p00, n), (p11, n), (p01, n))]
+    N += [(0.0, 0.0, 1.0), (0.0, 0.0, -1.0)]
+    V += [(0.0, 0.0, height / 2), (0.0, 0.0, -height / 2)]
+    top, bottom, ct, cb = len(N) - 1, len(N), len(V) - 1, len(V)
+    for k in range(sides):
+        F.append(((ct, top), (idx[segs, k], top), (idx[segs, (k + 1) % sides], top)))
+        F.append(((cb, bottom), (idx[0, (k + 1) % sides], bottom), (idx[0, k], bottom)))
+    s = "# coarse hexagonal prism with face normals: every edge is a crease (tools/make_test_data.py)\n"
+    s += "".join("v %s %s %s\n" % tuple(num(round(c, 12)) for c in p) for p in V)
+    s += "".join("vn %s %s %s\n" % tuple(num(round(c, 12)) for c in p) for p in N)
+    s += "".join("f " + " ".join("%d//%d" % c for c in f) + "\n" for f in F)
+    emit(os.path.join(DEMO, "prism.obj"), s)
+
+
 def main():
     cubes()
     sphere()
@@ -316,6 +348,7 @@ def main():
     teapot_8x8()
     lattices(tp)
     # The demo's data (scripts/demo.sh) lives beside the program, not the tests.
+    prism()
     emit(os.path.join(DEMO, "teapot.bpt"), bpt_text(tp))
     emit(os.path.join(DEMO, "teapot_lattice.npy"), outputs[os.path.join(TESTS, "lattices", "teapot_bend.npy")])
     check = "--check" in sys.argv[1:]
