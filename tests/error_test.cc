@@ -1,4 +1,4 @@
-// End-to-end tests of `sffd error` (CONTRACT.md, docs/ACCURACY.md "Error metrics"): the JSON contract,
+// End-to-end tests of `sffd error` (docs/CLI.md, docs/ACCURACY.md "Error metrics"): the JSON contract,
 // accurate FFD measured against the exact FFD (about 0), classic FFD (positive), closed and open meshes.
 #include <gtest/gtest.h>
 
@@ -15,7 +15,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const std::string kAcaffd = std::string(SFFD_SHARED_DATA) + "/acaffd/";
+const std::string kData = std::string(SFFD_TEST_DATA) + "/";
 const std::string kSffd = SFFD_BINARY;
 
 struct Result {
@@ -49,8 +49,8 @@ void expectStats(const nlohmann::json& s) {
   EXPECT_LE(s["avg"].get<double>(), s["max"].get<double>());
 }
 
-const std::string kCube = kAcaffd + "cube2.obj -l " + kAcaffd + "lattices/cube2_control_points5.npy";
-const std::string kTeapot = kAcaffd + "t.bpt -l " + kAcaffd + "lattices/t_control_points1.npy --normalize 0.9090909";
+const std::string kCube = kData + "cube2.obj -l " + kData + "lattices/cube2_twist.npy";
+const std::string kTeapot = kData + "teapot.bpt -l " + kData + "lattices/teapot_bend.npy --normalize 0.9090909";
 
 }  // namespace
 

@@ -19,9 +19,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const std::string kData = SFFD_SHARED_DATA;
+const std::string kData = SFFD_TEST_DATA;
 const std::string kSffd = SFFD_BINARY;
-const std::string kSphere = kData + "/acaffd/sphere.obj";
+const std::string kSphere = kData + "/sphere.obj";
 
 struct Result {
   int status = -1;

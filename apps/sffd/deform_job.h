@@ -16,7 +16,7 @@ struct DeformRun {
   Mesh mesh;                               // the result as `deform` writes it
   std::optional<PatchVertices> patches;    // smooth and accurate: the tessellation with pre-images
   // Smooth: per patch SFFD_PATCH_STRIDE control points (x, y, z, 0): 10 geometry then 10 normal, in
-  // the linear index order of ALGORITHM.md 0 (what `deform --patches` writes).
+  // the linear index order of METHOD.md 0 (what `deform --patches` writes).
   std::vector<double> patchControlPoints;
   size_t subTriangles = 0;
   double pnMs = 0, clipMs = 0, deformMs = 0;   // per stage: GPU time where measured, else wall time

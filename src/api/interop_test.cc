@@ -34,7 +34,7 @@ struct Job {
 
 Job strictJob() {
   Job j;
-  j.mesh = readMesh(std::string(SFFD_SHARED_DATA) + "/acaffd/cube2.obj");
+  j.mesh = readMesh(std::string(SFFD_TEST_DATA) + "/cube2.obj");
   glm::dvec3 lo(1e300), hi(-1e300);
   for (const glm::dvec3& p : j.mesh.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
   j.lattice = makeIdentityLattice(lo - 0.01, hi + 0.01, {4, 4, 4}, {2, 2, 2});
