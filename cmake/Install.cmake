@@ -25,6 +25,7 @@ if(SFFD_LIB_TYPE STREQUAL "STATIC_LIBRARY")
 endif()
 # Relocatable: the prefix is found from the .pc file's own place (cmake --install --prefix P).
 file(RELATIVE_PATH SFFD_PC_UP /r/${CMAKE_INSTALL_LIBDIR}/pkgconfig /r)
+string(REGEX REPLACE "/$" "" SFFD_PC_UP "${SFFD_PC_UP}")
 configure_file(${PROJECT_SOURCE_DIR}/cmake/sffd.pc.in ${PROJECT_BINARY_DIR}/sffd.pc @ONLY)
 install(FILES ${PROJECT_BINARY_DIR}/sffd.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig COMPONENT development)
 
