@@ -13,45 +13,18 @@
 #include <nlohmann/json.hpp>
 
 #include "model/mesh.h"
+#include "tests/support/cli_runner.h"
 
 namespace fs = std::filesystem;
 
 namespace {
 
 const std::string kData = SFFD_TEST_DATA;
-const std::string kSffd = SFFD_BINARY;
 
-struct RunResult {
-  int status = -1;
-  std::string out, err;
-};
-
-// Runs sffd with the given arguments (shell-quoted by the caller) and an optional environment prefix.
-RunResult runSffd(const std::string& args, const std::string& env = "") {
-  fs::path dir = fs::temp_directory_path() / ("sffd_cli_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  std::string outFile = (dir / "stdout").string(), errFile = (dir / "stderr").string();
-  std::string cmd = env + " " + kSffd + " " + args + " >" + outFile + " 2>" + errFile;
-  int raw = std::system(cmd.c_str());
-  RunResult r;
-  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : 128;
-  auto slurp = [](const std::string& p) {
-    std::ifstream f(p);
-    std::stringstream ss;
-    ss << f.rdbuf();
-    return ss.str();
-  };
-  r.out = slurp(outFile);
-  r.err = slurp(errFile);
-  return r;
-}
-
-fs::path tempDir(const std::string& name) {
-  fs::path d = fs::temp_directory_path() / ("sffd_test_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+using sffd::test::RunResult;
+using sffd::test::runSffd;
+using sffd::test::slurp;
+using sffd::test::tempDir;
 
 std::vector<glm::dvec3> readPoints(const std::string& path) {
   std::ifstream f(path);
