@@ -7,6 +7,8 @@ add_custom_command(
   COMMAND ${GLAD_EXECUTABLE} --quiet --reproducible --api gl:core=4.5
           --extensions GL_ARB_gl_spirv,GL_ARB_spirv_extensions,GL_KHR_debug
           --out-path ${SFFD_GLAD_DIR} c
+  COMMAND ${CMAKE_COMMAND} -DHEADER=${SFFD_GLAD_DIR}/include/glad/gl.h -P ${PROJECT_SOURCE_DIR}/cmake/GladPrefix.cmake
+  DEPENDS ${PROJECT_SOURCE_DIR}/cmake/GladPrefix.cmake
   COMMENT "Generating the glad GL loader"
   VERBATIM)
 # An object library compiled into libsffd only: one copy of glad's entry-point table in any binary

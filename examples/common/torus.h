@@ -35,11 +35,11 @@ inline sffd::Mesh torus(int rings = 24, int sides = 12, double R = 1.0, double r
 inline size_t compareClassicChunk(const sffd::OutputChunk& chunk, const std::vector<unsigned char>& bytes,
                                   const sffd::Mesh& expected) {
   size_t bad = 0;
-  for (size_t i = 0; i < chunk.patchCount; ++i) {
+  for (size_t i = 0; i < chunk.count; ++i) {
     float p[4], n[4];
     std::memcpy(p, bytes.data() + 16 * i, 16);
     std::memcpy(n, bytes.data() + bytes.size() / 2 + 16 * i, 16);
-    const glm::dvec3 &ep = expected.positions[chunk.firstPatch + i], &en = expected.normals[chunk.firstPatch + i];
+    const glm::dvec3 &ep = expected.positions[chunk.first + i], &en = expected.normals[chunk.first + i];
     for (int a = 0; a < 3; ++a) bad += (double(p[a]) != ep[a]) + (double(n[a]) != en[a]);
   }
   return bad;

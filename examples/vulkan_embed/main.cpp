@@ -25,9 +25,11 @@ struct App {
   uint32_t family = 0;
 
   App() {
-    VkApplicationInfo ai{VK_STRUCTURE_TYPE_APPLICATION_INFO};
+    VkApplicationInfo ai{};
+    ai.sType = VK_STRUCTURE_TYPE_APPLICATION_INFO;
     ai.apiVersion = VK_API_VERSION_1_1;   // sffd needs 1.1
-    VkInstanceCreateInfo ci{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
+    VkInstanceCreateInfo ci{};
+    ci.sType = VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO;
     ci.pApplicationInfo = &ai;
     VK_CHECK(vkCreateInstance(&ci, nullptr, &instance));
     uint32_t n = 1;
@@ -38,11 +40,13 @@ struct App {
     vkGetPhysicalDeviceQueueFamilyProperties(physical, &count, families.data());
     while (family < count && !(families[family].queueFlags & VK_QUEUE_COMPUTE_BIT)) ++family;
     float priority = 1;
-    VkDeviceQueueCreateInfo qi{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
+    VkDeviceQueueCreateInfo qi{};
+    qi.sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO;
     qi.queueFamilyIndex = family;
     qi.queueCount = 1;
     qi.pQueuePriorities = &priority;
-    VkDeviceCreateInfo di{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
+    VkDeviceCreateInfo di{};
+    di.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO;
     di.queueCreateInfoCount = 1;
     di.pQueueCreateInfos = &qi;
     VK_CHECK(vkCreateDevice(physical, &di, nullptr, &device));
@@ -55,7 +59,8 @@ struct App {
 
   // Copies a range of a buffer into host memory: staging buffer, copy command, fence.
   std::vector<unsigned char> read(const sffd::vulkan::BufferRange& range) {
-    VkBufferCreateInfo bi{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+    VkBufferCreateInfo bi{};
+    bi.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO;
     bi.size = range.size;
     bi.usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT;
     VkBuffer staging;
@@ -65,7 +70,8 @@ struct App {
     VkPhysicalDeviceMemoryProperties mp;
     vkGetPhysicalDeviceMemoryProperties(physical, &mp);
     const VkMemoryPropertyFlags want = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
-    VkMemoryAllocateInfo mi{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+    VkMemoryAllocateInfo mi{};
+    mi.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
     mi.allocationSize = req.size;
     while (!((req.memoryTypeBits >> mi.memoryTypeIndex) & 1) ||
            (mp.memoryTypes[mi.memoryTypeIndex].propertyFlags & want) != want)
@@ -74,30 +80,37 @@ struct App {
     VK_CHECK(vkAllocateMemory(device, &mi, nullptr, &memory));
     VK_CHECK(vkBindBufferMemory(device, staging, memory, 0));
 
-    VkCommandPoolCreateInfo pi{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+    VkCommandPoolCreateInfo pi{};
+
+    pi.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO;
     pi.queueFamilyIndex = family;
     VkCommandPool pool;
     VK_CHECK(vkCreateCommandPool(device, &pi, nullptr, &pool));
-    VkCommandBufferAllocateInfo ca{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+    VkCommandBufferAllocateInfo ca{};
+    ca.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
     ca.commandPool = pool;
     ca.commandBufferCount = 1;
     VkCommandBuffer cmd;
     VK_CHECK(vkAllocateCommandBuffers(device, &ca, &cmd));
-    VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+    VkCommandBufferBeginInfo begin{};
+    begin.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
     VK_CHECK(vkBeginCommandBuffer(cmd, &begin));
     // sffd's writes are already visible to later commands on this queue (<sffd/vulkan.h>).
     VkBufferCopy region{range.offset, 0, range.size};
     vkCmdCopyBuffer(cmd, range.buffer, staging, 1, &region);
-    VkMemoryBarrier toHost{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    VkMemoryBarrier toHost{};
+    toHost.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
     toHost.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
     toHost.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
     vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &toHost, 0, nullptr, 0,
                          nullptr);
     VK_CHECK(vkEndCommandBuffer(cmd));
-    VkFenceCreateInfo fi{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+    VkFenceCreateInfo fi{};
+    fi.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
     VkFence fence;
     VK_CHECK(vkCreateFence(device, &fi, nullptr, &fence));
-    VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+    VkSubmitInfo si{};
+    si.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
     si.commandBufferCount = 1;
     si.pCommandBuffers = &cmd;
     VK_CHECK(vkQueueSubmit(queue, 1, &si, fence));

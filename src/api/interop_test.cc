@@ -7,6 +7,7 @@
 #include <GLFW/glfw3.h>
 #include <glad/gl.h>
 
+#include <cstdio>
 #include <cstring>
 #include <vector>
 
@@ -60,9 +61,19 @@ void expectStrictSession(Backend& backend, const Job& j) {
 
 // ---- Vulkan: the test is the application; it creates and destroys its instance and device ----
 
+// Validation messages about the application's instance (layer on, as an application debugging would).
+size_t gAppValidationMessages = 0;
+VKAPI_ATTR VkBool32 VKAPI_CALL countMessage(VkDebugUtilsMessageSeverityFlagBitsEXT, VkDebugUtilsMessageTypeFlagsEXT,
+                                            const VkDebugUtilsMessengerCallbackDataEXT* data, void*) {
+  ++gAppValidationMessages;
+  std::fprintf(stderr, "validation: %s\n", data->pMessage);
+  return VK_FALSE;
+}
+
 struct AppVulkan {
   vk::Api api = vk::Api::load();
   VkInstance instance = VK_NULL_HANDLE;
+  VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
   VkPhysicalDevice physical = VK_NULL_HANDLE;
   VkDevice device = VK_NULL_HANDLE;
   VkQueue queue = VK_NULL_HANDLE;
@@ -74,8 +85,24 @@ struct AppVulkan {
     app.apiVersion = VK_API_VERSION_1_2;
     auto ci = vk::vkStruct<VkInstanceCreateInfo>(VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO);
     ci.pApplicationInfo = &app;
-    vk::check(api.vkCreateInstance(&ci, nullptr, &instance), "vkCreateInstance");
-    api.loadInstance(instance, false);
+    const char* layer = "VK_LAYER_KHRONOS_validation";
+    const char* extension = VK_EXT_DEBUG_UTILS_EXTENSION_NAME;
+    ci.enabledLayerCount = ci.enabledExtensionCount = 1;
+    ci.ppEnabledLayerNames = &layer;
+    ci.ppEnabledExtensionNames = &extension;
+    bool validation = api.vkCreateInstance(&ci, nullptr, &instance) == VK_SUCCESS;
+    if (!validation) {   // no layer installed: the test runs without it
+      ci.enabledLayerCount = ci.enabledExtensionCount = 0;
+      vk::check(api.vkCreateInstance(&ci, nullptr, &instance), "vkCreateInstance");
+    }
+    api.loadInstance(instance, validation);
+    if (validation) {
+      auto mi = vk::vkStruct<VkDebugUtilsMessengerCreateInfoEXT>(VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT);
+      mi.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+      mi.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT;
+      mi.pfnUserCallback = countMessage;
+      vk::check(api.vkCreateDebugUtilsMessengerEXT(instance, &mi, nullptr, &messenger), "messenger");
+    }
     uint32_t n = 1;
     VkResult r = api.vkEnumeratePhysicalDevices(instance, &n, &physical);
     if (r < 0 || n == 0) throw deviceError("no Vulkan device");
@@ -104,6 +131,7 @@ struct AppVulkan {
   }
   ~AppVulkan() {
     api.vkDestroyDevice(device, nullptr);
+    if (messenger) api.vkDestroyDebugUtilsMessengerEXT(instance, messenger, nullptr);
     api.vkDestroyInstance(instance, nullptr);
   }
   vulkan::DeviceConfig config(bool float64) const {
@@ -113,24 +141,28 @@ struct AppVulkan {
 
 TEST(VulkanInterop, AdoptedDeviceRunsStrictSessionAndStaysTheApplications) {
   Job j = strictJob();
-  AppVulkan app;
-  for (bool viaLoader : {false, true}) {
-    vulkan::DeviceConfig c = app.config(false);
-    if (viaLoader) c.getInstanceProcAddr = nullptr;   // sffd opens the system loader itself
-    std::unique_ptr<Backend> b = vk::adoptBackend(c);
-    EXPECT_EQ(b->info().provider, "adopted");
-    EXPECT_FALSE(b->info().limits.float64);   // not enabled by the config, whatever the device has
-    expectStrictSession(*b, j);
-    BufferId id = b->createBuffer(64);
-    EXPECT_NE(vk::vkBufferOf(*b, id), VK_NULL_HANDLE);
-    EXPECT_EQ(vk::vkBufferOf(*b, id + 100), VK_NULL_HANDLE);
+  {
+    AppVulkan app;
+    for (bool viaLoader : {false, true}) {
+      vulkan::DeviceConfig c = app.config(false);
+      if (viaLoader) c.getInstanceProcAddr = nullptr;   // sffd opens the system loader itself
+      std::unique_ptr<Backend> b = vk::adoptBackend(c);
+      EXPECT_EQ(b->info().provider, "adopted");
+      EXPECT_FALSE(b->info().limits.float64);   // not enabled by the config, whatever the device has
+      expectStrictSession(*b, j);
+      BufferId id = b->createBuffer(64);
+      EXPECT_NE(vk::vkBufferOf(*b, id), VK_NULL_HANDLE);
+      EXPECT_EQ(vk::vkBufferOf(*b, id + 100), VK_NULL_HANDLE);
+    }
+    // The device and its queue are still the application's, and usable.
+    EXPECT_EQ(app.api.vkQueueWaitIdle(app.queue), VK_SUCCESS);
+    EXPECT_EQ(app.api.vkDeviceWaitIdle(app.device), VK_SUCCESS);
+    if (app.f64) {
+      EXPECT_TRUE(vk::adoptBackend(app.config(true))->info().limits.float64);
+    }
   }
-  // The device and its queue are still the application's, and usable.
-  EXPECT_EQ(app.api.vkQueueWaitIdle(app.queue), VK_SUCCESS);
-  EXPECT_EQ(app.api.vkDeviceWaitIdle(app.device), VK_SUCCESS);
-  if (app.f64) {
-    EXPECT_TRUE(vk::adoptBackend(app.config(true))->info().limits.float64);
-  }
+  // None, the application's vkDestroyDevice included (it reports objects sffd left behind).
+  EXPECT_EQ(gAppValidationMessages, 0u);
 }
 
 TEST(VulkanInterop, QueueFamilyWithoutComputeIsRefused) {
