@@ -1,6 +1,6 @@
 # The install test: installs the build tree into a fresh prefix, checks what was installed, then
 # configures, builds and runs tests/consumer against it (find_package) and asks pkg-config.
-# cmake -DBUILD_DIR=... -DWORK_DIR=... -DSOURCE_DIR=... -DGENERATOR=... -DCXX=... -P run.cmake
+# cmake -DBUILD_DIR=... -DWORK_DIR=... -DSOURCE_DIR=... -DGENERATOR=... -DCXX=... [-DSANITIZE=ON] -P run.cmake
 function(run)
   execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
   if(NOT rc EQUAL 0)
@@ -28,8 +28,13 @@ foreach(f include/sffd/sffd.h lib/cmake/sffd/sffdConfig.cmake lib/cmake/sffd/sff
 endforeach()
 run(${prefix}/bin/sffd --help)   # the tool finds the installed library
 
+# A sanitizer build of sffd (SFFD_SANITIZE) needs its runtime first in the application too.
+set(flags "")
+if(SANITIZE)
+  set(flags -DCMAKE_CXX_FLAGS=-fsanitize=address,undefined -DCMAKE_EXE_LINKER_FLAGS=-fsanitize=address,undefined)
+endif()
 run(${CMAKE_COMMAND} -S ${SOURCE_DIR} -B ${WORK_DIR}/build -G ${GENERATOR} -DCMAKE_CXX_COMPILER=${CXX}
-    -DCMAKE_PREFIX_PATH=${prefix} -DCMAKE_BUILD_TYPE=Release)
+    -DCMAKE_PREFIX_PATH=${prefix} -DCMAKE_BUILD_TYPE=Release ${flags})
 run(${CMAKE_COMMAND} --build ${WORK_DIR}/build)
 run(${WORK_DIR}/build/app)
 message(STATUS "consumer: ${out}")
