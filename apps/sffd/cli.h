@@ -71,6 +71,9 @@ OpenedBackend openBackendFromArgs(const ParsedArgs& args);
 bool wantDouble(const ParsedArgs& args, const DeviceInfo& info, bool autoDouble);
 
 void note(const ParsedArgs& args, const std::string& line);   // stderr unless --quiet
+// Reads a mesh and prints what the reader repaired or skipped (sffd: warning: ..., even with --quiet:
+// it is about the input).
+Mesh readMeshWarning(const std::string& path, const MeshReadOptions& options = {});
 
 // Refuses a target edge length that is not positive, or so small that the sub-triangles would
 // exceed kMaxSubTriangles (the message gives the estimate).

@@ -1,4 +1,4 @@
-// sffd lattice MESH -o LATTICE.json: an identity lattice fitted to a mesh, optionally deformed by a preset.
+// sffd lattice MESH -o LATTICE: an identity lattice fitted to a mesh, optionally deformed by a preset, written in the format its extension names.
 #include <algorithm>
 #include <charconv>
 
@@ -19,7 +19,7 @@ int run(const ParsedArgs& args) {
     if (counts[a] <= degree[a]) throw Error(ErrorKind::Input, "--counts must exceed --degree on every axis");
     if (counts[a] > 64) throw Error(ErrorKind::Input, "--counts above 64 per axis is not supported by `sffd lattice`");
   }
-  Mesh mesh = readMesh(args.positional[0]);
+  Mesh mesh = readMeshWarning(args.positional[0]);
   if (args.has("--normalize")) {
     double s = args.getDouble("--normalize", 1.0);
     if (!(s > 0)) throw Error(ErrorKind::Input, "--normalize needs a positive scale");
@@ -38,7 +38,7 @@ int run(const ParsedArgs& args) {
     }
     applyLatticePreset(lattice, p, amount);
   }
-  writeLatticeJson(out, lattice);
+  writeLattice(out, lattice);
   note(args, "wrote " + out);
   return 0;
 }
@@ -46,10 +46,10 @@ int run(const ParsedArgs& args) {
 }  // namespace
 
 CommandSpec latticeCommand() {
-  return {"lattice", "MESH -o LATTICE.json [options]",
+  return {"lattice", "MESH -o LATTICE.json|.npy|.prm [options]",
           "Makes an identity lattice fitted to the mesh's bounding box, optionally deformed by a preset.",
           {
-              {"--output|-o", "FILE", "lattice to write (.json)"},
+              {"--output|-o", "FILE", "lattice to write: .json (native), .npy (control points), .prm (PyGeM; one Bezier box)"},
               {"--counts", "U,V,W", "control points per axis (default 5,5,5)"},
               {"--degree", "U,V,W", "B-spline degree per axis, 1..5 (default 2,2,2)"},
               {"--preset", "NAME[:AMOUNT]", "twist, bend, taper, bulge or noise, with an optional amount (default 1)"},

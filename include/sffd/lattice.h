@@ -79,6 +79,12 @@ struct LatticeReadOptions {
 // input Error ("file:line: what") on a bad file.
 Lattice readLattice(const std::string& path, const LatticeReadOptions& options = {});
 
+// Writes the format the extension names: .json (native, everything), .npy (the control points only, an
+// array (mu, mv, mw, 3) of float64, read back with the .npy conventions) or .prm (PyGeM's: only a
+// lattice of one Bezier box on a rotated rectangular box; points outside are then left unmoved).
+// Throws an input Error for another extension or a lattice the format cannot hold.
+void writeLattice(const std::string& path, const Lattice& lattice);
+
 // Writes the native JSON format (shortest digits that read back to the same doubles) to a temporary
 // file renamed into place.
 void writeLatticeJson(const std::string& path, const Lattice& lattice);

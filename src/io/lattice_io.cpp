@@ -338,6 +338,15 @@ Lattice readLatticeBytes(const std::string& path, std::string text, const Lattic
 // not the clamped uniform one over the box (the others then as []), "frame" only when it is not the
 // identity; "outside" and "control_points" always.
 
+void writeLattice(const std::string& path, const Lattice& lattice) {
+  const std::string ext = io::lowerExtension(path);
+  if (ext == ".json") return writeLatticeJson(path, lattice);
+  if (ext == ".npy") return latticeio::writeNpy(path, lattice);
+  if (ext == ".prm") return latticeio::writePrm(path, lattice);
+  throw inputError(path, 0, "cannot write lattice format " + (ext.empty() ? std::string("(no extension)") : io::quoted(ext)) +
+                                "; expected .json, .npy or .prm");
+}
+
 void writeLatticeJson(const std::string& path, const Lattice& L) {
   validateLattice(L, path);
   glm::dvec3 lo, hi;

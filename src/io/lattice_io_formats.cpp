@@ -7,6 +7,7 @@
 #include <numbers>
 
 #include <sffd/error.h>
+#include "io/atomic_file.h"
 #include "io/io_util.h"
 #include "io/lattice_io_internal.h"
 
@@ -340,6 +341,98 @@ Lattice readNpy(const std::string& path, const std::string& text, const LatticeR
     }
   validateLattice(L, path);
   return L;
+}
+
+
+// ---------------------------------------------------------------------------------------------------
+// Writers of the .npy and .prm forms (readers above: what they write reads back to the same lattice
+// under the reader's conventions).
+
+void writeNpy(const std::string& path, const Lattice& L) {
+  validateLattice(L, path);
+  // numpy format 1.0: magic, header length, a Python dict literal padded with spaces to a multiple of
+  // 64 bytes (with the magic and length) and ended by a newline; then the array, little-endian float64.
+  std::string dict = "{'descr': '<f8', 'fortran_order': False, 'shape': (" + std::to_string(L.counts[0]) + ", " +
+                     std::to_string(L.counts[1]) + ", " + std::to_string(L.counts[2]) + ", 3), }";
+  const size_t unpadded = 10 + dict.size() + 1;
+  dict.append((64 - unpadded % 64) % 64, ' ');
+  dict += '\n';
+  std::string bytes = "\x93NUMPY";
+  bytes += char(1), bytes += char(0);
+  bytes += char(dict.size() & 0xff), bytes += char(dict.size() >> 8);
+  bytes += dict;
+  for (const glm::dvec3& p : L.controlPoints)
+    for (int c = 0; c < 3; ++c) {
+      double v = p[c];
+      char b[8];
+      std::memcpy(b, &v, 8);   // little-endian hosts only (x86-64, arm64)
+      bytes.append(b, 8);
+    }
+  writeFileAtomically(path, [&](std::ostream& os) { os.write(bytes.data(), std::streamsize(bytes.size())); }, true);
+}
+
+void writePrm(const std::string& path, const Lattice& L) {
+  validateLattice(L, path);
+  // PyGeM's lattice is one Bernstein box: degree counts-1 on every axis, no interior knots.
+  for (int a = 0; a < 3; ++a) {
+    const auto& k = L.knots[a];
+    bool oneBox = L.degree[a] == L.counts[a] - 1;
+    for (size_t i = 0; oneBox && i < k.size(); ++i) oneBox = k[i] == (i < k.size() / 2 ? k.front() : k.back());
+    if (!oneBox)
+      throw inputError(path, 0, "a .prm lattice is one Bezier box (degree = counts - 1, no interior knots) on every axis; "
+                                "this lattice is not: write .json");
+  }
+  // World box: x = origin + A s, s in [0,1]^3, with A = R diag(length) and R = Rx Ry Rz (the reader's).
+  const glm::dmat3 inv = glm::inverse(L.frameLinear);
+  glm::dvec3 lo, hi;
+  for (int a = 0; a < 3; ++a) lo[a] = L.domainLo(a), hi[a] = L.domainHi(a);
+  const glm::dvec3 origin = inv * (lo - L.frameOffset);
+  glm::dmat3 A = inv;
+  for (int c = 0; c < 3; ++c) A[c] *= hi[c] - lo[c];
+  glm::dvec3 length;
+  glm::dmat3 R = A;
+  for (int c = 0; c < 3; ++c) length[c] = glm::length(A[c]), R[c] /= length[c];
+  // Angles of R = Rx(x) Ry(y) Rz(z), glm's m[col][row]: R02 = sin y, R12 = -sin x cos y, R22 = cos x cos y,
+  // R01 = -cos y sin z, R00 = cos y cos z.
+  const double ay = std::asin(std::clamp(R[2][0], -1.0, 1.0)), ax = std::atan2(-R[2][1], R[2][2]),
+               az = std::atan2(-R[1][0], R[0][0]);
+  const glm::dmat3 back = rotationX(ax) * rotationY(ay) * rotationZ(az);
+  double off = 0;
+  for (int c = 0; c < 3; ++c) off = std::max(off, glm::length(back[c] - R[c]));
+  if (!(off < 1e-9))
+    throw inputError(path, 0, "the lattice's box is not a rotated rectangular box, which is all a .prm file can hold: write .json");
+  if (L.outside != OutsideMode::Keep) {
+    // PyGeM leaves points outside the box unmoved; the lattice asked to extrapolate them. Said in the file.
+  }
+  const double deg = 180.0 / std::numbers::pi;
+  auto num = [](double v) {
+    std::string s;
+    io::appendNumber(s, v, 0);
+    return s;
+  };
+  static const char* xyz[3] = {"x", "y", "z"};
+  std::string t = "[Box info]\n# Written by sffd: PyGeM's FFD parameters (points outside the box are left unmoved).\n";
+  for (int a = 0; a < 3; ++a) t += std::string("n control points ") + xyz[a] + ": " + std::to_string(L.counts[a]) + "\n";
+  for (int a = 0; a < 3; ++a) t += std::string("box length ") + xyz[a] + ": " + num(length[a]) + "\n";
+  for (int a = 0; a < 3; ++a) t += std::string("box origin ") + xyz[a] + ": " + num(origin[a]) + "\n";
+  const double angle[3] = {ax * deg, ay * deg, az * deg};
+  for (int a = 0; a < 3; ++a) t += std::string("rotation angle ") + xyz[a] + ": " + num(angle[a]) + "\n";
+  // Displacements normalised by the box: mu = A^-1 (P - origin) - s.
+  const glm::dmat3 Ainv = glm::inverse(A);
+  t += "\n[Parameters weights]\n";
+  for (int a = 0; a < 3; ++a) {
+    t += std::string("parameter ") + xyz[a] + ":";
+    bool first = true;
+    for (int i = 0; i < L.counts[0]; ++i)
+      for (int j = 0; j < L.counts[1]; ++j)
+        for (int k = 0; k < L.counts[2]; ++k) {
+          const glm::dvec3 s(double(i) / (L.counts[0] - 1), double(j) / (L.counts[1] - 1), double(k) / (L.counts[2] - 1));
+          const glm::dvec3 mu = Ainv * (L.controlPoints[L.index(i, j, k)] - origin) - s;
+          t += (first ? " " : "    ") + std::to_string(i) + " " + std::to_string(j) + " " + std::to_string(k) + " " + num(mu[a]) + "\n";
+          first = false;
+        }
+  }
+  writeFileAtomically(path, [&](std::ostream& os) { os << t; }, true);
 }
 
 }  // namespace sffd::latticeio

@@ -13,6 +13,10 @@ Lattice readJson(const std::string& path, const std::string& text);
 Lattice readPrm(const std::string& path, const std::string& text);
 Lattice readNpy(const std::string& path, const std::string& text, const LatticeReadOptions& options);
 
+// The .npy (control points only, float64) and .prm (PyGeM; one Bezier box, a rotated box) forms.
+void writeNpy(const std::string& path, const Lattice& lattice);
+void writePrm(const std::string& path, const Lattice& lattice);
+
 // Most control points a lattice file may ask for (checked before anything is allocated).
 constexpr size_t kMaxControlPoints = size_t(1) << 24;
 
