@@ -7,6 +7,8 @@
 #include <GLFW/glfw3.h>
 #include <glad/gl.h>
 
+#include <dlfcn.h>
+
 #include <cstdio>
 #include <cstring>
 #include <vector>
@@ -268,6 +270,37 @@ TEST(GlInterop, AdoptedContextRunsStrictSessionRestoringTheApplicationsBindings)
   glDeleteShader(shader);
   glfwDestroyWindow(window);
   glfwTerminate();
+}
+
+// The other window system: an EGL surfaceless context (made here by sffd's provider, then treated
+// as the application's), recognised through libEGL's eglGetCurrentContext.
+TEST(GlInterop, AdoptedEglContextIsCheckedThroughEgl) {
+  std::unique_ptr<gl::Context> egl;
+  try {
+    egl = gl::createEglContext();   // current on return
+  } catch (const Error& e) {
+    GTEST_SKIP() << e.what();
+  }
+  void* lib = dlopen("libEGL.so.1", RTLD_NOW | RTLD_NOLOAD);
+  ASSERT_NE(lib, nullptr);
+  auto getProc = reinterpret_cast<gl::GLProc (*)(const char*)>(dlsym(lib, "eglGetProcAddress"));
+  Job j = strictJob();
+  std::unique_ptr<Backend> b = gl::createBackendOn(gl::adoptCurrentContext(getProc));
+  expectStrictSession(*b, j);
+  egl->activate();   // sffd's own context object: the same EGL context, still current
+  b->finish();
+  // The application makes nothing current: refused. (sffd's deactivateCurrent() would not do it:
+  // it never releases an adopted context.)
+  auto display = reinterpret_cast<void* (*)()>(dlsym(lib, "eglGetCurrentDisplay"))();
+  auto makeCurrent = reinterpret_cast<unsigned (*)(void*, void*, void*, void*)>(dlsym(lib, "eglMakeCurrent"));
+  gl::Context::deactivateCurrent();
+  b->finish();
+  ASSERT_TRUE(makeCurrent(display, nullptr, nullptr, nullptr));
+  EXPECT_THROW(b->finish(), Error);
+  egl->activate();
+  b->finish();
+  b.reset();
+  dlclose(lib);
 }
 
 }  // namespace
