@@ -277,7 +277,7 @@ SubTriangleRecords clipRun(Backend& backend, const PreparedMesh& M, const PnOutp
 }  // namespace
 
 SubTriangleRecords regularClip(Backend& backend, const PreparedMesh& mesh, const PnOutput& pn,
-                                  const ClipTriangles& clip, double l, KernelVariant variant) {
+                               const ClipTriangles& clip, double l, KernelVariant variant) {
   if (variant.f64 && !backend.info().limits.float64)
     throw deviceError(backend.info().name + " has no double-precision shader support; use --precision float");
   auto t0 = std::chrono::steady_clock::now();

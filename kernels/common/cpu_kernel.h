@@ -35,7 +35,8 @@ struct CpuKernelArgs {
   template <class T>
   std::span<T> array(uint32_t slot, uint64_t count = 0) const {
     const Range& r = slots[slot];
-    if (!r.data || r.bytes / sizeof(T) < count)
+    if (!r.data) fail("slot " + std::to_string(slot) + " is not bound");
+    if (r.bytes / sizeof(T) < count)
       fail("slot " + std::to_string(slot) + " holds " + std::to_string(r.bytes / sizeof(T)) + " elements, the dispatch needs " +
            std::to_string(count));
     return {reinterpret_cast<T*>(r.data), size_t(r.bytes / sizeof(T))};

@@ -84,7 +84,7 @@ void deformRun(Backend& backend, const PackedLattice& P, const SubTriangleRecord
 }  // namespace
 
 SmoothOutput smoothDeform(Backend& backend, const PackedLattice& lattice, const SubTriangleRecords& subs,
-                             const FitTable& fit, int level, KernelVariant variant, bool split) {
+                          const FitTable& fit, int level, KernelVariant variant, bool split) {
   if (variant.f64 && !backend.info().limits.float64)
     throw deviceError(backend.info().name + " has no double-precision shader support; use --precision float");
   SmoothOutput out;
