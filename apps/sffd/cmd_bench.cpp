@@ -17,14 +17,7 @@
 #include "apps/sffd/deform_job.h"
 #include "pipelines/deform_session.h"
 #include <sffd/error.h>
-#include "kernels/clip/knot_box_clip.h"
-#include "model/lattice_pack.h"
-#include "model/mesh_topology.h"
 #include "pipelines/patch_output.h"
-#include "kernels/pn/pn_triangles.h"
-#include "kernels/clip/regular_clip.h"
-#include "kernels/smooth/smooth_deform.h"
-#include "kernels/clip/split_pattern_table.h"
 #include "core/wall_clock.h"
 
 namespace sffd::cli {

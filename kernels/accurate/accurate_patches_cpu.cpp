@@ -38,10 +38,10 @@ void accurateThreads(const CpuKernelArgs& a, uint64_t first, uint64_t last) {
           "accurate: patch shape out of range");
   const uint64_t subs = uint64_t(p.range.x) + p.range.y, per = stage == SFFD_ACC_STAGE_TESSELLATE ? nv : m;
   const Real* corners = a.array<const Real>(SFFD_BINDING_ACC_CORNERS, 4 * SFFD_ACC_CORNER_STRIDE * subs).data();
-  Real* samples = a.array<Real>(SFFD_BINDING_ACC_SAMPLES, 4 * m * subs).data();
   const uint64_t end = std::min<uint64_t>(last, per * p.range.y);
   if (stage == SFFD_ACC_STAGE_SAMPLES) {
     LatticeEvaluator<Real> eval = boundLattice<Real>(a, p.lattice);
+    Real* samples = a.array<Real>(SFFD_BINDING_ACC_SAMPLES, 4 * m * subs).data();
     for (uint64_t t = first; t < end; ++t) {
       const uint32_t local = uint32_t(t / per), e = uint32_t(t - uint64_t(local) * per), s = p.range.x + local;
       const Real* c = &corners[4 * SFFD_ACC_CORNER_STRIDE * size_t(s)];
@@ -53,6 +53,7 @@ void accurateThreads(const CpuKernelArgs& a, uint64_t first, uint64_t last) {
     }
   } else if (stage == SFFD_ACC_STAGE_PATCHES) {
     const Real* matrix = a.array<const Real>(SFFD_BINDING_ACC_MATRIX, uint64_t(m) * m).data();
+    const Real* samples = a.array<const Real>(SFFD_BINDING_ACC_SAMPLES, 4 * m * subs).data();
     Real* patches = a.array<Real>(SFFD_BINDING_ACC_PATCHES, 4 * m * subs).data();
     for (uint64_t t = first; t < end; ++t) {
       const uint32_t local = uint32_t(t / per), e = uint32_t(t - uint64_t(local) * per), s = p.range.x + local;
