@@ -70,7 +70,8 @@ class ThreadPool {
     Job job(k, args, threads, std::max<uint64_t>(1, groups / (8 * uint64_t(workers))) * SFFD_LOCAL_SIZE);
     {
       std::lock_guard<std::mutex> lock(mutex_);
-      while (threads_.size() + 1 < workers) threads_.emplace_back([this] { serve(); });
+      // A new thread takes part from this job on: it starts from the generation before it.
+      while (threads_.size() + 1 < workers) threads_.emplace_back([this, seen = generation_] { serve(seen); });
       job_ = &job;
       seats_ = workers - 1;
       ++generation_;
@@ -108,9 +109,8 @@ class ThreadPool {
     }
   };
 
-  void serve() {
+  void serve(uint64_t seen) {
     std::unique_lock<std::mutex> lock(mutex_);
-    uint64_t seen = generation_;
     for (;;) {
       wake_.wait(lock, [&] { return quit_ || (job_ && seats_ > 0 && generation_ != seen); });
       if (quit_) return;
