@@ -7,6 +7,7 @@
 #include <map>
 #include <string>
 
+#include "backends/cpu/cpu_backend.h"
 #include "model/lattice.h"
 #include "io/lattice_io.h"
 #include "model/mesh.h"
@@ -14,6 +15,12 @@
 namespace sffd::bench {
 
 inline const std::string kDataDir = std::string(SFFD_TEST_DATA) + "/";
+
+// The CPU backend the benchmarks run the kernels on.
+inline Backend& cpuBackend() {
+  static const std::unique_ptr<Backend> backend = cpu::createBackend();
+  return *backend;
+}
 
 inline void meshBox(const Mesh& m, glm::dvec3& lo, glm::dvec3& hi) {
   lo = glm::dvec3(1e300), hi = glm::dvec3(-1e300);

@@ -1,14 +1,14 @@
-// The smooth-FFD pipeline on the CPU reference, stage by stage, on the teapot (teapot.bpt, 36 patches,
-// 7200 triangles) and the bumpy torus (torus.obj, 8400 triangles), both normalised to a largest
+// The smooth-FFD pipeline on the CPU backend, stage by stage, on the teapot (teapot.bpt, 36 patches,
+// 7200 triangles) and the torus (torus.obj, 8400 triangles), both normalised to a largest
 // half-extent of 1/1.1 and clipped with target edge length l = 0.2 (the call sequence of
 // apps/sffd/smooth_job.cpp). At l = 0.2 every edge of both models is shorter than l, so regular
 // clipping yields one sub-triangle per triangle; the `fine` cases use l = 0.02, where the split
 // patterns really subdivide (several segments an edge), to measure clipping and deform at scale:
-// prepareMesh -> pnTrianglesCpu (K1) -> buildClipTriangles + regularClipCpu (K2) -> smoothDeformCpu
+// prepareMesh -> pnTriangles (K1) -> buildClipTriangles + regularClip (K2) -> smoothDeform
 // (K3, tessellation levels 1, 5, 10) with makeFitTable(6). Each stage is timed alone on the cached
 // output of the previous ones, so a regression points at one stage. Items are triangles for the
-// pre-compute stages and sub-triangles for clip output and deform. smoothDeformCpu runs on a thread
-// pool (SFFD_CPU_THREADS, default all cores), so it is measured in wall time (UseRealTime).
+// pre-compute stages and sub-triangles for clip output and deform. The CPU backend runs every kernel
+// on all cores (SFFD_CPU_THREADS), so the kernels are measured in wall time (UseRealTime).
 #include <benchmark/benchmark.h>
 
 #include <map>
@@ -50,9 +50,9 @@ const Stages& stages(int model, bool f64, int fine = 0) {
     KernelVariant v{false, f64};
     s->mesh = &bench::model(kModels[model]);
     s->prepared = prepareMesh(*s->mesh);
-    s->pn = pnTrianglesCpu(s->prepared, v);
+    s->pn = pnTriangles(bench::cpuBackend(), s->prepared, v);
     s->clip = buildClipTriangles(*s->mesh, l, splitPatternTable().nmax());
-    s->subs = regularClipCpu(s->prepared, s->pn, s->clip, l, v);
+    s->subs = regularClip(bench::cpuBackend(), s->prepared, s->pn, s->clip, l, v);
     s->lattice = packLattice(bench::deformedLattice(*s->mesh, 5, 2));
     s->fit = makeFitTable(6);
   }
@@ -80,13 +80,13 @@ void BM_PnTrianglesCpu(benchmark::State& state) {
   const bool f64 = state.range(1) != 0;
   const Stages& s = stages(model, f64);
   for (auto _ : state) {
-    PnOutput pn = pnTrianglesCpu(s.prepared, {false, f64});
+    PnOutput pn = pnTriangles(bench::cpuBackend(), s.prepared, {false, f64});
     benchmark::DoNotOptimize(pn.records.data());
   }
   state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(s.prepared.triangleCount()));
   setModelLabel(state, model);
 }
-BENCHMARK(BM_PnTrianglesCpu)->ArgNames({"model", "f64"})->ArgsProduct({{0, 1}, {1, 0}})->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_PnTrianglesCpu)->ArgNames({"model", "f64"})->ArgsProduct({{0, 1}, {1, 0}})->UseRealTime()->Unit(benchmark::kMillisecond);
 
 // Args: model, fine. The pre-split into clip triangles of at most Nmax segments an edge. Items =
 // triangles.
@@ -116,7 +116,7 @@ void BM_RegularClipCpu(benchmark::State& state) {
   const Stages& s = stages(model, f64, fine);
   size_t subs = 0;
   for (auto _ : state) {
-    SubTriangleRecords R = regularClipCpu(s.prepared, s.pn, s.clip, kEdgeLengths[fine], {false, f64});
+    SubTriangleRecords R = regularClip(bench::cpuBackend(), s.prepared, s.pn, s.clip, kEdgeLengths[fine], {false, f64});
     subs = R.size();
     benchmark::DoNotOptimize(R.records.data());
   }
@@ -129,6 +129,7 @@ BENCHMARK(BM_RegularClipCpu)
     ->ArgsProduct({{0, 1}, {1, 0}, {0}})
     ->Args({0, 1, 1})
     ->Args({0, 0, 1})
+    ->UseRealTime()
     ->Unit(benchmark::kMillisecond);
 
 // The sampling-lattice fit table (closed-form constrained least squares), degree s.
@@ -153,7 +154,7 @@ void BM_SmoothDeformCpu(benchmark::State& state) {
   const bool f64 = state.range(2) != 0;
   const Stages& s = stages(model, f64, int(state.range(3)));
   for (auto _ : state) {
-    SmoothOutput out = smoothDeformCpu(s.lattice, s.subs, s.fit, level, {false, f64});
+    SmoothOutput out = smoothDeform(bench::cpuBackend(), s.lattice, s.subs, s.fit, level, {false, f64});
     benchmark::DoNotOptimize(out.tess.data());
   }
   state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(s.subs.size()));

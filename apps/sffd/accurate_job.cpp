@@ -1,5 +1,5 @@
 // --method accurate: knot-box clipping (CPU), then the exact Bezier patches of degree nu+nv+nw and their
-// tessellation (kernel accurate_patches, or the CPU reference). Double precision by default where the
+// tessellation (kernel accurate_patches). Double precision by default where the
 // device has it: accurate FFD is the reference the other methods are measured against.
 #include <chrono>
 
@@ -31,11 +31,9 @@ DeformRun runAccurate(const ParsedArgs& args, Job& job, OpenedBackend& backend) 
   const uint64_t nv = uint64_t(tessVertexCount(level)), m = uint64_t(triangleControlPoints(aj.degree));
   JobEstimate est;
   est.hostBytes = aj.count() * (nv * (8 + 9 + 8) * 8 + nv * 64 + m * 32 + tessTriangleCount(level) * 12);
-  const DeviceLimits* limits = backend.gpu ? &backend.info.limits : nullptr;
-  checkJobFits(est, packed, run.variant.f64 ? 8 : 4, limits);
+  checkJobFits(est, packed, run.variant.f64 ? 8 : 4, &backend.info.limits);
 
-  AccurateOutput out = backend.gpu ? accurateFfdGpu(*backend.gpu, aj, packed, run.variant)
-                                   : accurateFfdCpu(aj, packed, run.variant);
+  AccurateOutput out = accurateFfd(*backend.backend, aj, packed, run.variant);
   run.deformMs = stageMs(out.timings, out.wallMs);
   run.patches = accuratePatchVertices(aj, out);
   run.mesh = weldPatchVertices(*run.patches);

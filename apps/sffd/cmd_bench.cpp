@@ -1,5 +1,5 @@
 // sffd bench MESH -l LATTICE: per-stage times of smooth FFD (the paper's Tables 1 and 2) on each
-// backend asked. GPU backends run the device-resident DeformSession, the path `view` uses: the
+// backend asked, each running the device-resident DeformSession, the path `view` uses: the
 // pre-compute (PN + clip) and the deform stage are timed apart, from GPU timestamps (Vulkan
 // timestamp queries, GL timestamp pairs) with the host wall time beside them; the first,
 // cold run (kernel compilation) is reported apart; then --warmup runs, then --repeat timed runs.
@@ -17,14 +17,7 @@
 #include "apps/sffd/deform_job.h"
 #include "pipelines/deform_session.h"
 #include <sffd/error.h>
-#include "kernels/clip/knot_box_clip.h"
-#include "model/lattice_pack.h"
-#include "model/mesh_topology.h"
 #include "pipelines/patch_output.h"
-#include "kernels/pn/pn_triangles.h"
-#include "kernels/clip/regular_clip.h"
-#include "kernels/smooth/smooth_deform.h"
-#include "kernels/clip/split_pattern_table.h"
 #include "core/wall_clock.h"
 
 namespace sffd::cli {
@@ -76,12 +69,12 @@ void addStages(Series& s, const SessionTimings& pre, const SessionTimings& def) 
   for (const auto& [k, v] : steps) s.add(k, v);
 }
 
-BackendResult benchGpu(OpenedBackend& b, const Job& job, const BenchSettings& S) {
+BackendResult benchBackend(OpenedBackend& b, const Job& job, const BenchSettings& S) {
   BackendResult r;
   r.label = b.label;
   r.device = b.info.name;
   auto t0 = std::chrono::steady_clock::now();
-  DeformSession session(*b.gpu, job.mesh, job.lattice, S.session);
+  DeformSession session(*b.backend, job.mesh, job.lattice, S.session);
   session.deform(job.lattice);
   r.coldMs = msSince(t0);
   r.subTriangles = session.subTriangles();
@@ -93,43 +86,6 @@ BackendResult benchGpu(OpenedBackend& b, const Job& job, const BenchSettings& S)
     r.host.add("precompute", p.wallMs);
     r.host.add("deform", d.wallMs);
   }
-  r.peakRss = peakRssMb();
-  return r;
-}
-
-// The CPU reference (one thread, double or the strict float order), timed by wall clock.
-BackendResult benchCpu(const Job& job, const BenchSettings& S) {
-  BackendResult r;
-  r.label = "cpu";
-  r.device = std::string("CPU reference, ") + (S.session.variant.f64 ? "double" : "float") + ", " +
-             std::to_string(cpuThreadCount()) + " threads";
-  const DeformSessionOptions& o = S.session;
-  Mesh mesh = job.mesh;
-  if (!mesh.normalsFromFile) applyCreaseAngle(mesh, o.creaseAngleDeg);
-  PreparedMesh prepared = prepareMesh(mesh);
-  ClipTriangles clip = o.knotBoxClip ? ClipTriangles{} : buildClipTriangles(mesh, o.edgeLength, splitPatternTable().nmax());
-  std::vector<SubTriangle> knotBox = o.knotBoxClip ? clipAgainstKnotBoxes(mesh, job.lattice) : std::vector<SubTriangle>{};
-  FitTable fit = makeFitTable(o.samples);
-  auto once = [&](bool record) {
-    auto t0 = std::chrono::steady_clock::now();
-    PnOutput pn = pnTrianglesCpu(prepared, o.variant);
-    SubTriangleRecords subs = o.knotBoxClip ? recordsFromSubTriangles(prepared, pn, knotBox, o.variant)
-                                            : regularClipCpu(prepared, pn, clip, o.edgeLength, o.variant);
-    double preMs = msSince(t0);
-    SmoothOutput out = smoothDeformCpu(packLattice(job.lattice), subs, fit, o.level, o.variant);
-    r.subTriangles = subs.size();
-    if (!record) return;
-    r.stages.add("pn", pn.wallMs);
-    r.stages.add("clip", subs.wallMs);
-    r.stages.add("deform", out.wallMs);
-    r.stages.add("total", pn.wallMs + subs.wallMs + out.wallMs);
-    r.host.add("precompute", preMs);
-    r.host.add("deform", out.wallMs);
-  };
-  auto t0 = std::chrono::steady_clock::now();
-  once(false);
-  r.coldMs = msSince(t0);
-  for (int i = 0; i < S.warmup + S.repeat; ++i) once(i >= S.warmup);
   r.peakRss = peakRssMb();
   return r;
 }
@@ -167,17 +123,12 @@ int run(const ParsedArgs& args) {
 
   std::vector<BackendResult> results;
   for (const std::string& name : names) {
-    if (name == "cpu") {
-      results.push_back(benchCpu(job, S));
-      continue;
-    }
     BackendRequest req;
     req.name = name;
     req.device = args.get("--device");
     std::vector<std::string> notes;
     OpenedBackend b = openBackend(req, &notes);
-    if (!b.gpu) throw Error(ErrorKind::Device, "backend '" + name + "' gave no GPU device");
-    results.push_back(benchGpu(b, job, S));
+    results.push_back(benchBackend(b, job, S));
   }
 
   const size_t subs = results.empty() ? 0 : results.front().subTriangles;

@@ -84,7 +84,7 @@ int run(const ParsedArgs& args) {
   variant.f64 = wantDouble(args, backend.info, /*autoDouble=*/false);
 
   PreparedMesh prepared = prepareMesh(job.mesh);
-  PnOutput pn = backend.gpu ? pnTrianglesGpu(*backend.gpu, prepared, variant) : pnTrianglesCpu(prepared, variant);
+  PnOutput pn = pnTriangles(*backend.backend, prepared, variant);
   SubTriangleRecords subs;
   size_t presplit = 0, clipTriangles = 0;
   auto tc = std::chrono::steady_clock::now();
@@ -92,8 +92,7 @@ int run(const ParsedArgs& args) {
     ClipTriangles C = buildClipTriangles(job.mesh, l, splitPatternTable().nmax());
     presplit = C.presplitParents;
     clipTriangles = C.triangles.size();
-    subs = backend.gpu ? regularClipGpu(*backend.gpu, prepared, pn, C, l, variant)
-                       : regularClipCpu(prepared, pn, C, l, variant);
+    subs = regularClip(*backend.backend, prepared, pn, C, l, variant);
   } else {
     // The 2015 method runs on the CPU reference (it is the baseline, not a production path).
     subs = recordsFromSubTriangles(prepared, pn, clipAgainstKnotBoxes(job.mesh, job.lattice), variant);

@@ -68,18 +68,16 @@ int run(const ParsedArgs& args) {
     OpenedBackend b = openBackend(req);
     BackendRun r;
     r.label = b.label;
-    r.isCpu = !b.gpu;
-    // The CPU reference runs in the kernels' precision (in float, in the strict kernels' operation
+    r.isCpu = b.info.api == "cpu";
+    // The CPU backend runs in the kernels' precision (in float, in the strict kernels' operation
     // order): conformance compares the same arithmetic on the same inputs. Accuracy against the
     // double reference is a separate matter (docs/CONFORMANCE.md).
-    KernelVariant cpuVariant{true, variant.f64};
-    ClassicOutput classic = b.gpu ? classicFfdGpu(*b.gpu, job.mesh, packed, variant) : classicFfdCpu(job.mesh, packed, cpuVariant);
+    ClassicOutput classic = classicFfd(*b.backend, job.mesh, packed, variant);
     r.buffers.push_back({"classic.positions", std::move(classic.positions)});
     r.buffers.push_back({"classic.normals", std::move(classic.normals)});
-    PnOutput pn = b.gpu ? pnTrianglesGpu(*b.gpu, prepared, variant) : pnTrianglesCpu(prepared, cpuVariant);
+    PnOutput pn = pnTriangles(*b.backend, prepared, variant);
     // Each backend clips from its own PN records: the whole pre-compute stage is compared.
-    SubTriangleRecords subs = b.gpu ? regularClipGpu(*b.gpu, prepared, pn, clip, l, variant)
-                                    : regularClipCpu(prepared, pn, clip, l, cpuVariant);
+    SubTriangleRecords subs = regularClip(*b.backend, prepared, pn, clip, l, variant);
     r.buffers.push_back({"pn.records", std::move(pn.records)});
     r.buffers.push_back({"clip.headers", std::vector<double>(subs.headers.begin(), subs.headers.end())});
     r.buffers.push_back({"clip.records", std::move(subs.records)});

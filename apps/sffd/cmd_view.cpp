@@ -86,26 +86,24 @@ int run(const ParsedArgs& args) {
   const std::string name = args.get("--backend", "gl");
   OpenedBackend backend;
   if (name == "auto" || name == "gl" || name == "gl-glfw") {
-    backend.gpu = gl::createBackendOn(cfg.window);
-    backend.info = backend.gpu->info();
+    backend.backend = gl::createBackendOn(cfg.window);
+    backend.info = backend.backend->info();
     backend.label = "gl-glfw";
     cfg.zeroCopy = true;
   } else {
     backend = openBackendFromArgs(args);
   }
-  cfg.gpu = backend.gpu.get();
+  cfg.gpu = backend.backend.get();
   cfg.backendLabel = backend.label;
   note(args, "view: " + cfg.meshName + " on " + backend.label + " (" + backend.info.name + ")");
-  if (backend.gpu) {
-    DeformSessionOptions so;
-    so.variant.strict = args.has("--strict");
-    so.edgeLength = l;
-    so.level = cfg.level;
-    so.samples = args.getInt("--samples", 0);
-    so.split = args.has("--split");
-    so.creaseAngleDeg = args.getDouble("--crease-angle", 40.0);
-    cfg.session = so;
-  }
+  DeformSessionOptions so;
+  so.variant.strict = args.has("--strict");
+  so.edgeLength = l;
+  so.level = cfg.level;
+  so.samples = args.getInt("--samples", 0);
+  so.split = args.has("--split");
+  so.creaseAngleDeg = args.getDouble("--crease-angle", 40.0);
+  cfg.session = so;
   const Mesh raw = job.mesh;
   cfg.host = [&args, &backend, &raw, &job](const Lattice& lattice, const std::string& method, const std::string& clip) {
     ParsedArgs a = args;

@@ -20,11 +20,10 @@ DeformRun runClassic(const ParsedArgs& args, Job& job, OpenedBackend& backend) {
   run.variant.strict = args.has("--strict");
   run.variant.f64 = wantDouble(args, backend.info, /*autoDouble=*/true);
   PackedLattice packed = packLattice(job.lattice);
-  const DeviceLimits* limits = backend.gpu ? &backend.info.limits : nullptr;
+  const DeviceLimits* limits = &backend.info.limits;
   int realBytes = run.variant.f64 ? 8 : 4;
   checkJobFits(estimateClassicJob(job.mesh, packed, realBytes, limits), packed, realBytes, limits);
-  ClassicOutput result = backend.gpu ? classicFfdGpu(*backend.gpu, job.mesh, packed, run.variant)
-                                     : classicFfdCpu(job.mesh, packed, run.variant);
+  ClassicOutput result = classicFfd(*backend.backend, job.mesh, packed, run.variant);
   run.mesh = applyClassicOutput(job.mesh, result);
   run.deformMs = stageMs(result.timings, result.wallMs);
   return run;

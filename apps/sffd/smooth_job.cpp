@@ -4,12 +4,8 @@
 #include "apps/sffd/deform_job.h"
 #include "pipelines/deform_session.h"
 #include <sffd/error.h>
-#include "kernels/clip/knot_box_clip.h"
-#include "model/lattice_pack.h"
 #include "model/mesh_topology.h"
-#include "kernels/clip/regular_clip.h"
 #include "kernels/smooth/smooth_deform.h"
-#include "kernels/clip/split_pattern_table.h"
 
 namespace sffd::cli {
 
@@ -35,45 +31,28 @@ DeformRun runSmooth(const ParsedArgs& args, Job& job, OpenedBackend& backend) {
 
   bool split = args.has("--split");
   bool knotBox = args.get("--clip", "regular") == "knot-box";
-  SubTriangleRecords subs;
-  SmoothOutput out;
-  if (Backend* gpu = backend.gpu.get()) {
-    // The device-resident path that `view` and `bench` use: no host round trip between the stages.
-    DeformSessionOptions o;
-    o.variant = run.variant;
-    o.edgeLength = l;
-    o.level = level;
-    o.samples = std::max(3, s);
-    o.knotBoxClip = knotBox;
-    o.split = split;
-    o.creaseAngleDeg = args.getDouble("--crease-angle", 40.0);
-    DeformSession session(*gpu, job.mesh, job.lattice, o);
-    run.pnMs = session.timings().pnMs;
-    run.clipMs = session.timings().clipMs;
-    const SessionTimings& t = session.deform(job.lattice);
-    run.deformMs = t.deformMs;
-    if (split)
-      for (const DispatchTiming& d : t.dispatches) {
-        auto it = std::find_if(run.stepMs.begin(), run.stepMs.end(), [&](const auto& p) { return p.first == d.label; });
-        if (it == run.stepMs.end()) run.stepMs.push_back({d.label, 0.0}), it = run.stepMs.end() - 1;
-        it->second += std::max(d.gpuMs, 0.0);
-      }
-    subs = session.records();
-    out = session.output();
-  } else {
-    PreparedMesh prepared = prepareMesh(job.mesh);
-    PnOutput pn = pnTrianglesCpu(prepared, run.variant);
-    run.pnMs = stageMs(pn.timings, pn.wallMs);
-    if (knotBox) {
-      subs = recordsFromSubTriangles(prepared, pn, clipAgainstKnotBoxes(job.mesh, job.lattice), run.variant);
-    } else {
-      ClipTriangles C = buildClipTriangles(job.mesh, l, splitPatternTable().nmax());
-      subs = regularClipCpu(prepared, pn, C, l, run.variant);
+  // The device-resident path that `view` and `bench` use: no host round trip between the stages.
+  DeformSessionOptions o;
+  o.variant = run.variant;
+  o.edgeLength = l;
+  o.level = level;
+  o.samples = std::max(3, s);
+  o.knotBoxClip = knotBox;
+  o.split = split;
+  o.creaseAngleDeg = args.getDouble("--crease-angle", 40.0);
+  DeformSession session(*backend.backend, job.mesh, job.lattice, o);
+  run.pnMs = session.timings().pnMs;
+  run.clipMs = session.timings().clipMs;
+  const SessionTimings& t = session.deform(job.lattice);
+  run.deformMs = t.deformMs;
+  if (split)
+    for (const DispatchTiming& d : t.dispatches) {
+      auto it = std::find_if(run.stepMs.begin(), run.stepMs.end(), [&](const auto& p) { return p.first == d.label; });
+      if (it == run.stepMs.end()) run.stepMs.push_back({d.label, 0.0}), it = run.stepMs.end() - 1;
+      it->second += std::max(d.gpuMs, 0.0);
     }
-    run.clipMs = stageMs(subs.timings, subs.wallMs);
-    out = smoothDeformCpu(packLattice(job.lattice), subs, makeFitTable(std::max(3, s)), level, run.variant);
-    run.deformMs = stageMs(out.timings, out.wallMs);
-  }
+  SubTriangleRecords subs = session.records();
+  SmoothOutput out = session.output();
   run.subTriangles = subs.size();
   run.patches = patchVerticesOf(subs, out);
   run.patchControlPoints = std::move(out.patches);

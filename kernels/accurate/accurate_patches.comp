@@ -19,7 +19,7 @@
 // Why not one thread per sub-triangle: llvmpipe and lavapipe end an invocation after 65535 loop
 // iterations in all (gallivm's LP_MAX_TGSI_LOOP_ITERATIONS, shared by every loop of the shader), which a
 // whole patch at --tess 38 already exceeds; here an invocation runs at most a few hundred.
-// The C++ twin is kernels/accurate/accurate_patches.cpp (AccurateTwin): the same operations in the same order.
+// The C++ twin is kernels/accurate/accurate_patches_cpu.cpp: the same operations in the same order.
 #extension GL_GOOGLE_include_directive : require
 #include "../common/prelude.glsl"
 #include "../common/lattice_eval.glsl"

@@ -9,7 +9,7 @@
 
 #include <sffd/error.h>
 #include "core/job_budget.h"
-#include "kernels/common/lattice_eval.h"
+#include "model/lattice_pack.h"
 #include "core/wall_clock.h"
 
 namespace sffd {
@@ -160,67 +160,6 @@ AccurateJob makeAccurateJob(const Mesh& mesh, const Lattice& lattice, std::vecto
 
 namespace {
 
-// The C++ twin of kernels/accurate/accurate_patches.comp. Keep the two in step, operation for operation.
-template <class Real>
-struct AccurateTwin {
-  const LatticeEvaluator<Real>& eval;
-  const gpu::LatticeParams& L;
-
-  static RVec3<Real> flatPoint(RVec3<Real> c0, RVec3<Real> c1, RVec3<Real> c2, uint32_t i, uint32_t j, uint32_t k, uint32_t d) {
-    Real l0 = Real(i) / Real(d);
-    Real l1 = Real(j) / Real(d);
-    Real l2 = Real(k) / Real(d);
-    return (c0 * l0 + c1 * l1) + c2 * l2;
-  }
-
-  RVec3<Real> latticeValue(RVec3<Real> x) const {
-    LatticeSampleT<Real> S = eval.evaluate(x);
-    if (!S.inside && L.degree.w == SFFD_OUTSIDE_KEEP) return x;
-    return S.value;
-  }
-
-  // One sub-triangle: control points (m), positions and normals (nv) as 4 reals each.
-  void run(const Real* corners, uint32_t n, uint32_t m, uint32_t Lv, const std::vector<Real>& matrix,
-           const std::vector<Real>& basis, double* cpOut, double* posOut, double* nrmOut) const {
-    RVec3<Real> c0{corners[0], corners[1], corners[2]}, c1{corners[4], corners[5], corners[6]},
-        c2{corners[8], corners[9], corners[10]}, nf{corners[12], corners[13], corners[14]};
-    RVec3<Real> cp[SFFD_ACC_MAX_CP];
-    for (uint32_t k = 0; k < m; ++k) cp[k] = RVec3<Real>{};
-    uint32_t l = 0;
-    for (uint32_t r = 0; r <= n; ++r)
-      for (uint32_t q = 0; q <= r; ++q) {
-        RVec3<Real> S = latticeValue(flatPoint(c0, c1, c2, n - r, r - q, q, n));
-        size_t row = size_t(l) * m;
-        for (uint32_t k = 0; k < m; ++k) cp[k] = cp[k] + S * matrix[row + k];
-        ++l;
-      }
-    for (uint32_t k = 0; k < m; ++k) cpOut[4 * k] = cp[k].x, cpOut[4 * k + 1] = cp[k].y, cpOut[4 * k + 2] = cp[k].z, cpOut[4 * k + 3] = 0;
-
-    for (uint32_t r = 0; r <= Lv; ++r)
-      for (uint32_t q = 0; q <= r; ++q) {
-        uint32_t v = r * (r + 1) / 2 + q;
-        uint32_t i = Lv - r, j = r - q, k = q;
-        RVec3<Real> x = flatPoint(c0, c1, c2, i, j, k, Lv);
-        LatticeSampleT<Real> S = eval.evaluate(x);
-        bool keep = !S.inside && L.degree.w == SFFD_OUTSIDE_KEEP;
-        RVec3<Real> pos;
-        if (i == 0 || j == 0 || k == 0) {
-          pos = keep ? x : S.value;
-        } else {
-          size_t b = size_t(v) * m;
-          for (uint32_t kk = 0; kk < m; ++kk) pos = pos + cp[kk] * basis[b + kk];
-        }
-        RVec3<Real> nrm = keep ? nf : eval.cofactorNormal(S, nf);
-        if (!(sdot(nrm, nrm) > Real(0))) nrm = nf;
-        RVec3<Real> un = snormalize(nrm);
-        double* p = posOut + 4 * size_t(v);
-        double* o = nrmOut + 4 * size_t(v);
-        p[0] = pos.x, p[1] = pos.y, p[2] = pos.z, p[3] = 0;
-        o[0] = un.x, o[1] = un.y, o[2] = un.z, o[3] = 0;
-      }
-  }
-};
-
 // A_n^{-1} transposed (sample-major), as the kernel reads it.
 template <class Real>
 std::vector<Real> kernelMatrix(int n) {
@@ -233,26 +172,7 @@ std::vector<Real> kernelMatrix(int n) {
 }
 
 template <class Real>
-void accurateCpu(const AccurateJob& job, const PackedLattice& P, AccurateOutput& out) {
-  std::vector<Real> frame = convertReals<Real>(P.frame), coeffs = convertReals<Real>(P.coeffs);
-  LatticeEvaluator<Real> eval(P.params, frame, coeffs);
-  AccurateTwin<Real> twin{eval, P.params};
-  const uint32_t n = uint32_t(job.degree), m = uint32_t(triangleControlPoints(job.degree));
-  const uint32_t Lv = uint32_t(job.level), nv = uint32_t(tessVertexCount(job.level));
-  std::vector<Real> matrix = kernelMatrix<Real>(job.degree);
-  std::vector<Real> basis = convertReals<Real>(tessellationBasis(job.degree, job.level));
-  std::vector<Real> corners = convertReals<Real>(job.corners);
-  const size_t ns = job.count();
-  out.controlPoints.resize(ns * m * 4);
-  out.positions.resize(ns * nv * 4);
-  out.normals.resize(ns * nv * 4);
-  for (size_t s = 0; s < ns; ++s)
-    twin.run(&corners[4 * SFFD_ACC_CORNER_STRIDE * s], n, m, Lv, matrix, basis, &out.controlPoints[4 * m * s], &out.positions[4 * nv * s],
-             &out.normals[4 * nv * s]);
-}
-
-template <class Real>
-void accurateGpu(Backend& backend, const AccurateJob& job, const PackedLattice& P, KernelVariant variant, AccurateOutput& out) {
+void accurateRun(Backend& backend, const AccurateJob& job, const PackedLattice& P, KernelVariant variant, AccurateOutput& out) {
   const DeviceLimits& lim = backend.info().limits;
   const uint32_t n = uint32_t(job.degree), m = uint32_t(triangleControlPoints(job.degree));
   const uint32_t nv = uint32_t(tessVertexCount(job.level));
@@ -328,24 +248,14 @@ void accurateGpu(Backend& backend, const AccurateJob& job, const PackedLattice& 
 
 }  // namespace
 
-AccurateOutput accurateFfdCpu(const AccurateJob& job, const PackedLattice& lattice, KernelVariant variant) {
-  AccurateOutput out;
-  auto t0 = std::chrono::steady_clock::now();
-  if (variant.f64) accurateCpu<double>(job, lattice, out);
-  else accurateCpu<float>(job, lattice, out);
-  out.wallMs = msSince(t0);
-  out.timings.push_back({"accurate_patches", out.wallMs});
-  return out;
-}
-
-AccurateOutput accurateFfdGpu(Backend& backend, const AccurateJob& job, const PackedLattice& lattice, KernelVariant variant) {
+AccurateOutput accurateFfd(Backend& backend, const AccurateJob& job, const PackedLattice& lattice, KernelVariant variant) {
   if (variant.f64 && !backend.info().limits.float64)
     throw deviceError(backend.info().name + " has no double-precision shader support; use --precision float");
   AccurateOutput out;
   auto t0 = std::chrono::steady_clock::now();
   if (job.count() > 0) {
-    if (variant.f64) accurateGpu<double>(backend, job, lattice, variant, out);
-    else accurateGpu<float>(backend, job, lattice, variant, out);
+    if (variant.f64) accurateRun<double>(backend, job, lattice, variant, out);
+    else accurateRun<float>(backend, job, lattice, variant, out);
   }
   out.wallMs = msSince(t0);
   return out;

@@ -5,10 +5,11 @@
 // P = A_n^{-1} S, A_n[l][k] = B^n_k(l/n) (linear index order of METHOD.md 0). Each patch is then
 // tessellated at level L (patch_output.h).
 //
-// Runs on a GPU backend (kernel kernels/accurate/accurate_patches.comp, three dispatches per chunk: a thread per
-// sample, per control point and per tessellation vertex, because llvmpipe ends an invocation after
-// 65535 loop iterations in all, which one thread per patch exceeds at --tess 38) or on the CPU reference (the same operations in C++, templated on the arithmetic type: double is the oracle,
-// float in the strict kernels' order matches the strict kernels bit for bit).
+// Kernel kernels/accurate/accurate_patches.comp, three dispatches per chunk: a thread per sample, per
+// control point and per tessellation vertex, because llvmpipe ends an invocation after 65535 loop
+// iterations in all, which one thread per patch exceeds at --tess 38. Its C++ twin, run by the CPU
+// backend, is accurate_patches_cpu.cpp (double is the oracle; float in the strict kernels' order
+// matches the strict kernels bit for bit).
 //
 // Tessellation: interior vertices are B^n(lambda)·P. Boundary vertices are R(x_flat(lambda)), the
 // value the patch interpolates exactly there, computed from bits both sub-triangles of a shared edge
@@ -74,14 +75,18 @@ struct AccurateOutput {
   double wallMs = 0;
 };
 
-// The CPU reference: double arithmetic when variant.f64, else float in the strict kernels' order.
-AccurateOutput accurateFfdCpu(const AccurateJob& job, const PackedLattice& lattice, KernelVariant variant);
-// The GPU kernel, chunked within the device's binding and group-count limits
+// The kernel on a backend, chunked within the device's binding and group-count limits
 // (SFFD_MAX_CHUNK_PATCHES forces smaller chunks, for tests).
-AccurateOutput accurateFfdGpu(Backend& backend, const AccurateJob& job, const PackedLattice& lattice, KernelVariant variant);
+AccurateOutput accurateFfd(Backend& backend, const AccurateJob& job, const PackedLattice& lattice, KernelVariant variant);
 
 // Per patch its parent, per tessellation vertex its pre-image barycentrics in the parent
 // (sum_i lambda_i lam_i), its position and normal.
 PatchVertices accuratePatchVertices(const AccurateJob& job, const AccurateOutput& out);
+
+struct CpuKernelArgs;
+namespace cpu {
+// CPU entry of kernel accurate_patches (accurate_patches_cpu.cpp).
+void accuratePatches(const CpuKernelArgs& args, uint64_t first, uint64_t last);
+}  // namespace cpu
 
 }  // namespace sffd

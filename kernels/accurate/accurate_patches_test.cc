@@ -8,6 +8,7 @@
 #include <map>
 #include <random>
 
+#include "backends/backend_test_support.h"
 #include "kernels/accurate/accurate_patches.h"
 #include <sffd/error.h>
 #include "kernels/clip/knot_box_clip.h"
@@ -107,7 +108,7 @@ struct AccRun {
 AccRun runAccurateCpu(const Mesh& mesh, const Lattice& L, KernelVariant v, int level = 10) {
   AccRun r;
   r.job = makeAccurateJob(mesh, L, clipAgainstKnotBoxes(mesh, L), level);
-  r.out = accurateFfdCpu(r.job, packLattice(L), v);
+  r.out = accurateFfd(sffd::testing::cpuBackend(), r.job, packLattice(L), v);
   r.pv = accuratePatchVertices(r.job, r.out);
   return r;
 }
@@ -393,5 +394,5 @@ TEST(AccurateFfd, PatchDegreeAndLevelAreChecked) {
   EXPECT_THROW(makeAccurateJob(mesh, L, {}, 0), Error);
   EXPECT_THROW(makeAccurateJob(mesh, L, {}, 65), Error);
   AccurateJob empty = makeAccurateJob(mesh, L, {}, 10);
-  EXPECT_EQ(accurateFfdCpu(empty, packLattice(L), {false, true}).positions.size(), 0u);
+  EXPECT_EQ(accurateFfd(sffd::testing::cpuBackend(), empty, packLattice(L), {false, true}).positions.size(), 0u);
 }

@@ -5,39 +5,14 @@
 #include <cstdlib>
 
 #include <sffd/error.h>
-#include "kernels/common/lattice_eval.h"
+#include "kernels/common/cpu_kernel.h"
 #include "core/wall_clock.h"
 
 namespace sffd {
 namespace {
 
 template <class Real>
-void classicCpu(const Mesh& mesh, const PackedLattice& P, ClassicOutput& out) {
-  std::vector<Real> frame = convertReals<Real>(P.frame), coeffs = convertReals<Real>(P.coeffs);
-  LatticeEvaluator<Real> eval(P.params, frame, coeffs);
-  size_t n = mesh.positions.size();
-  out.positions.resize(4 * n);
-  out.normals.resize(4 * n);
-  for (size_t v = 0; v < n; ++v) {
-    RVec3<Real> x{Real(mesh.positions[v].x), Real(mesh.positions[v].y), Real(mesh.positions[v].z)};
-    RVec3<Real> nr{Real(mesh.normals[v].x), Real(mesh.normals[v].y), Real(mesh.normals[v].z)};
-    LatticeSampleT<Real> S = eval.evaluate(x);
-    RVec3<Real> px = x, pn = nr;
-    Real inside = 0;
-    if (S.inside || P.params.degree.w != SFFD_OUTSIDE_KEEP) {
-      px = S.value;
-      pn = snormalize(eval.cofactorNormal(S, nr));
-      inside = S.inside ? 1 : 0;
-    }
-    double* po = &out.positions[4 * v];
-    double* no = &out.normals[4 * v];
-    po[0] = px.x, po[1] = px.y, po[2] = px.z, po[3] = inside;
-    no[0] = pn.x, no[1] = pn.y, no[2] = pn.z, no[3] = 0;
-  }
-}
-
-template <class Real>
-void classicGpu(Backend& backend, const Mesh& mesh, const PackedLattice& P, KernelVariant variant, ClassicOutput& out) {
+void classicRun(Backend& backend, const Mesh& mesh, const PackedLattice& P, KernelVariant variant, ClassicOutput& out) {
   const DeviceLimits& lim = backend.info().limits;
   const size_t n = mesh.positions.size();
   const size_t vertexBytes = 4 * sizeof(Real);
@@ -101,25 +76,49 @@ void classicGpu(Backend& backend, const Mesh& mesh, const PackedLattice& P, Kern
 
 }  // namespace
 
-ClassicOutput classicFfdCpu(const Mesh& mesh, const PackedLattice& lattice, KernelVariant variant) {
-  ClassicOutput out;
-  auto t0 = std::chrono::steady_clock::now();
-  if (variant.f64) classicCpu<double>(mesh, lattice, out);
-  else classicCpu<float>(mesh, lattice, out);
-  out.wallMs = msSince(t0);
-  out.timings.push_back({"classic_ffd", out.wallMs});
-  return out;
-}
-
-ClassicOutput classicFfdGpu(Backend& backend, const Mesh& mesh, const PackedLattice& lattice, KernelVariant variant) {
+ClassicOutput classicFfd(Backend& backend, const Mesh& mesh, const PackedLattice& lattice, KernelVariant variant) {
   if (variant.f64 && !backend.info().limits.float64)
     throw deviceError(backend.info().name + " has no double-precision shader support; use --precision float");
   ClassicOutput out;
   auto t0 = std::chrono::steady_clock::now();
-  if (variant.f64) classicGpu<double>(backend, mesh, lattice, variant, out);
-  else classicGpu<float>(backend, mesh, lattice, variant, out);
+  if (variant.f64) classicRun<double>(backend, mesh, lattice, variant, out);
+  else classicRun<float>(backend, mesh, lattice, variant, out);
   out.wallMs = msSince(t0);
   return out;
+}
+
+namespace {
+
+// The twin of classic_ffd.comp's main().
+template <class Real>
+void classicThreads(const CpuKernelArgs& a, uint64_t first, uint64_t last) {
+  const auto& p = a.paramsAs<gpu::ClassicParams>();
+  LatticeEvaluator<Real> eval = boundLattice<Real>(a, p.lattice);
+  const uint64_t n = 4 * (uint64_t(p.range.x) + p.range.y);
+  const Real* posIn = a.array<const Real>(SFFD_BINDING_CLASSIC_POS_IN, n).data();
+  const Real* nrmIn = a.array<const Real>(SFFD_BINDING_CLASSIC_NRM_IN, n).data();
+  Real* posOut = a.array<Real>(SFFD_BINDING_CLASSIC_POS_OUT, n).data();
+  Real* nrmOut = a.array<Real>(SFFD_BINDING_CLASSIC_NRM_OUT, n).data();
+  for (uint64_t t = first; t < std::min<uint64_t>(last, p.range.y); ++t) {
+    const size_t v = 4 * size_t(p.range.x + uint32_t(t));
+    RVec3<Real> x{posIn[v], posIn[v + 1], posIn[v + 2]}, nr{nrmIn[v], nrmIn[v + 1], nrmIn[v + 2]};
+    LatticeSampleT<Real> S = eval.evaluate(x);
+    RVec3<Real> px = x, pn = nr;
+    Real inside = 0;
+    if (S.inside || p.lattice.degree.w != SFFD_OUTSIDE_KEEP) {
+      px = S.value;
+      pn = snormalize(eval.cofactorNormal(S, nr));
+      inside = S.inside ? 1 : 0;
+    }
+    posOut[v] = px.x, posOut[v + 1] = px.y, posOut[v + 2] = px.z, posOut[v + 3] = inside;
+    nrmOut[v] = pn.x, nrmOut[v + 1] = pn.y, nrmOut[v + 2] = pn.z, nrmOut[v + 3] = 0;
+  }
+}
+
+}  // namespace
+
+void cpu::classicFfd(const CpuKernelArgs& a, uint64_t first, uint64_t last) {
+  a.variant.f64 ? classicThreads<double>(a, first, last) : classicThreads<float>(a, first, last);
 }
 
 Mesh applyClassicOutput(const Mesh& input, const ClassicOutput& out) {

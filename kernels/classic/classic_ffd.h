@@ -1,6 +1,6 @@
 // Classic FFD (Sederberg & Parry 1986; PyGeM, Blender): every vertex and its normal through the lattice
-// volume, nothing else (METHOD.md 6). Runs on a GPU backend (kernel kernels/classic/classic_ffd.comp) or on
-// the CPU reference (lattice_eval.h) with the same inputs and output layout.
+// volume, nothing else (METHOD.md 6). Kernel kernels/classic/classic_ffd.comp; its C++ twin is
+// lattice_eval.h, run by the CPU backend through cpu::classicFfd.
 #pragma once
 #include <string>
 #include <vector>
@@ -19,10 +19,14 @@ struct ClassicOutput {
   double wallMs = 0;
 };
 
-// The CPU reference: double arithmetic when variant.f64, else float in the strict kernels' order.
-ClassicOutput classicFfdCpu(const Mesh& mesh, const PackedLattice& lattice, KernelVariant variant);
-// The GPU kernel, chunked within the device's binding and group-count limits.
-ClassicOutput classicFfdGpu(Backend& backend, const Mesh& mesh, const PackedLattice& lattice, KernelVariant variant);
+// The kernel on a backend, chunked within the device's binding and group-count limits.
+ClassicOutput classicFfd(Backend& backend, const Mesh& mesh, const PackedLattice& lattice, KernelVariant variant);
+
+struct CpuKernelArgs;
+namespace cpu {
+// CPU entry of kernel classic_ffd (kernels/common/cpu_kernel.h).
+void classicFfd(const CpuKernelArgs& args, uint64_t first, uint64_t last);
+}  // namespace cpu
 
 // Copies the deformed positions and normals into a mesh with the input's vertex order and connectivity.
 Mesh applyClassicOutput(const Mesh& input, const ClassicOutput& out);

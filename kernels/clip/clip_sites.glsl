@@ -1,5 +1,5 @@
 // kernels/clip/clip_sites.glsl: regular clipping by the split-pattern table (Lu & Feng; METHOD.md 4.2),
-// shared by the kernels clip_count and clip_write. The C++ twin is kernels/clip/regular_clip.cpp.
+// shared by the kernels clip_count and clip_write. The C++ twin is kernels/clip/clip_sites_cpu.cpp.
 //
 // Crack-freeness rests on three rules: (1) edge lengths and counts are computed from the endpoint with
 // the lower weld id; (2) a boundary vertex's parameter along its edge is read from the table, whose

@@ -109,9 +109,10 @@ struct ParentT {
 // corner c on the sub-edge towards corner c+2, slot 2c+1 towards c+1; `parentEdgeOf(c, d)` gives the
 // parent edge the sub-edge (c, d) lies on, or -1. Where that parent edge is a crease, the slot holds
 // the neighbour's PN normal (w = 1); elsewhere the corner's own PN normal (w = 0).
-template <class Real, class ParentEdgeOf>
+// `Out`: the record's storage type (Real in a kernel's buffer, double on the host).
+template <class Real, class Out, class ParentEdgeOf>
 void storeSubTriangle(const ParentT<Real>& par, const SiteT<Real> site[3], const SiteValueT<Real> val[3],
-                      ParentEdgeOf parentEdgeOf, double* rec, uint32_t* hdr) {
+                      ParentEdgeOf parentEdgeOf, Out* rec, uint32_t* hdr) {
   auto put = [&](int slot, RVec3<Real> v, Real w) {
     rec[4 * slot] = v.x, rec[4 * slot + 1] = v.y, rec[4 * slot + 2] = v.z, rec[4 * slot + 3] = w;
   };

@@ -177,177 +177,8 @@ const PackedTable& packedTable() {
 
 namespace {
 
-// ---------------------------------------------------------------- the CPU twin of clip_count / clip_write
-
 template <class Real>
-struct ClipCpu {
-  const PackedTable& table;
-  const std::vector<uint32_t>& meshTriangles;
-  std::vector<Real> positions, normals, slots, pn, clipReals;
-  const std::vector<uint32_t>& clipHeaders;
-  Real l;
-
-  RVec3<Real> v3(const std::vector<Real>& a, size_t i) const { return {a[4 * i], a[4 * i + 1], a[4 * i + 2]}; }
-
-  struct Setup {
-    int perm[3];
-    bool odd;
-    uint32_t count[3];
-    uint32_t entry[4];
-  };
-
-  Setup setup(size_t ct) const {
-    const uint32_t* welds = &clipHeaders[8 * ct + 4];
-    RVec3<Real> corner[3];
-    for (int c = 0; c < 3; ++c) corner[c] = v3(clipReals, SFFD_CLIP_REAL_STRIDE * ct + 3 + c);
-    uint32_t n[3], nmax = table.nmax;
-    for (int e = 0; e < 3; ++e) {
-      int a = e, b = (e + 1) % 3;
-      if (welds[b] < welds[a]) std::swap(a, b);
-      RVec3<Real> d = corner[b] - corner[a];
-      Real len = std::sqrt(sdot(d, d));
-      Real q = len / l;
-      Real segs = std::ceil(q);
-      n[e] = uint32_t(std::clamp(segs, Real(1), Real(nmax)));
-    }
-    int ord[3] = {0, 1, 2};
-    for (int i = 0; i < 2; ++i)
-      for (int j = 0; j < 2 - i; ++j) {
-        int x = ord[j], y = ord[j + 1];
-        if (n[y] < n[x] || (n[y] == n[x] && y < x)) ord[j] = y, ord[j + 1] = x;
-      }
-    Setup S;
-    int ea = ord[0], eb = ord[1];
-    if (eb == (ea + 1) % 3) S.perm[0] = ea, S.perm[1] = (ea + 1) % 3, S.perm[2] = (ea + 2) % 3, S.odd = false;
-    else S.perm[0] = (ea + 1) % 3, S.perm[1] = ea, S.perm[2] = (ea + 2) % 3, S.odd = true;
-    for (int i = 0; i < 3; ++i) S.count[i] = n[ord[i]];
-    uint32_t cc = std::min(S.count[2], S.count[0] + S.count[1]);
-    uint32_t key = ((S.count[0] - 1) * nmax + (S.count[1] - 1)) * nmax + (cc - 1);
-    for (int i = 0; i < 4; ++i) S.entry[i] = table.words[4 * key + i];
-    return S;
-  }
-
-  ParentT<Real> parent(uint32_t id) const {
-    ParentT<Real> p;
-    p.id = id;
-    for (int c = 0; c < 3; ++c) {
-      p.verts[c] = meshTriangles[8 * id + c];
-      p.welds[c] = meshTriangles[8 * id + 4 + c];
-      p.V[c] = v3(positions, p.verts[c]);
-      p.N[c] = v3(normals, p.verts[c]);
-    }
-    p.pn = &pn[size_t(id) * SFFD_PN_STRIDE * 4];
-    p.slot = &slots[size_t(id) * SFFD_SLOT_NORMAL_STRIDE * 4];
-    return p;
-  }
-
-  SiteT<Real> cornerSite(size_t ct, int c) const {
-    SiteT<Real> s;
-    s.kind = (clipHeaders[8 * ct + 1] >> (8 * c)) & 255u;
-    size_t i = SFFD_CLIP_REAL_STRIDE * ct + c;
-    s.lam = v3(clipReals, i);
-    s.t = clipReals[4 * i + 3];
-    return s;
-  }
-
-  SiteT<Real> patternSite(size_t ct, const Setup& S, uint32_t edge, uint32_t step, RVec3<Real> lamCanon) const {
-    if (edge < 3 && step == 0) return cornerSite(ct, S.perm[edge]);
-    RVec3<Real> lamLocal;
-    lamLocal[S.perm[0]] = lamCanon.x;
-    lamLocal[S.perm[1]] = lamCanon.y;
-    lamLocal[S.perm[2]] = lamCanon.z;
-    size_t base = SFFD_CLIP_REAL_STRIDE * ct;
-    SiteT<Real> s;
-    if (edge < 3) {
-      int a = S.perm[edge], b = S.perm[(edge + 1) % 3];
-      const uint32_t* welds = &clipHeaders[8 * ct + 4];
-      int lo = welds[a] <= welds[b] ? a : b, hi = lo == a ? b : a;
-      Real tl = lamLocal[hi];
-      int ce = (b == (a + 1) % 3) ? a : b;
-      const Real* ep = &clipReals[4 * (base + 6 + ce)];
-      if (ep[0] >= Real(0)) {
-        Real tLo = lo == ce ? ep[1] : ep[2], tHi = lo == ce ? ep[2] : ep[1];
-        s.kind = 3 + uint32_t(ep[0]);
-        s.t = tLo + (tHi - tLo) * tl;
-        s.lam = {};
-      } else {
-        RVec3<Real> lamLo = v3(clipReals, base + lo), lamHi = v3(clipReals, base + hi);
-        s.kind = 6;
-        s.t = 0;
-        s.lam = lamLo + (lamHi - lamLo) * tl;
-      }
-      return s;
-    }
-    s.kind = 6;
-    s.t = 0;
-    s.lam = (v3(clipReals, base) * lamLocal.x + v3(clipReals, base + 1) * lamLocal.y) + v3(clipReals, base + 2) * lamLocal.z;
-    return s;
-  }
-
-  static uint32_t sharedCanonicalEdge(uint32_t ea, uint32_t ja, uint32_t eb, uint32_t jb) {
-    if (ea > 2 || eb > 2) return 3;
-    if (ea == eb) return ea;
-    if (ja == 0 && eb == (ea + 2) % 3) return eb;
-    if (jb == 0 && ea == (eb + 2) % 3) return ea;
-    return 3;
-  }
-
-  void write(size_t ct, size_t out0, SubTriangleRecords& R) const {
-    Setup S = setup(ct);
-    ParentT<Real> par = parent(clipHeaders[8 * ct]);
-    for (uint32_t k = 0; k < S.entry[3]; ++k) {
-      uint32_t idx[3], edge[3], step[3];
-      for (int c = 0; c < 3; ++c) {
-        uint32_t i = 3 * (S.entry[2] + k) + c;
-        uint32_t word = table.words[table.triangleWord + i / 2];
-        idx[c] = (i % 2 == 0) ? (word & 65535u) : (word >> 16);
-      }
-      if (S.odd) std::swap(idx[1], idx[2]);
-      SiteT<Real> site[3];
-      SiteValueT<Real> val[3];
-      for (int c = 0; c < 3; ++c) {
-        size_t v = table.vertexWord + 4 * (size_t(S.entry[0]) + idx[c]);
-        float lf[3];
-        std::memcpy(lf, &table.words[v], 12);
-        uint32_t w = table.words[v + 3];
-        edge[c] = w & 255u;
-        step[c] = w >> 16;
-        site[c] = patternSite(ct, S, edge[c], step[c], RVec3<Real>{Real(lf[0]), Real(lf[1]), Real(lf[2])});
-        val[c] = par.evaluate(site[c]);
-      }
-      size_t o = out0 + k;
-      auto parentEdgeOf = [&](int c, int d) {
-        uint32_t ce = sharedCanonicalEdge(edge[c], step[c], edge[d], step[d]);
-        if (ce >= 3) return -1;
-        int a = S.perm[ce], b = S.perm[(ce + 1) % 3];
-        int le = (b == (a + 1) % 3) ? a : b;
-        Real pe = clipReals[4 * (SFFD_CLIP_REAL_STRIDE * ct + 6 + le)];
-        return pe >= Real(0) ? int(pe) : -1;
-      };
-      storeSubTriangle(par, site, val, parentEdgeOf, &R.records[o * SFFD_SUB_STRIDE * 4], &R.headers[4 * o]);
-    }
-  }
-};
-
-template <class Real>
-SubTriangleRecords clipCpu(const PreparedMesh& M, const PnOutput& pn, const ClipTriangles& clip, double l) {
-  PackedClip pc = packClip(clip);
-  ClipCpu<Real> C{packedTable(), M.triangles, convertReals<Real>(M.positions), convertReals<Real>(M.normals),
-                  convertReals<Real>(M.slotNormals), convertReals<Real>(pn.records), convertReals<Real>(pc.reals),
-                  pc.headers, Real(float(l))};
-  size_t n = clip.triangles.size();
-  std::vector<size_t> offsets(n + 1, 0);
-  for (size_t i = 0; i < n; ++i) offsets[i + 1] = offsets[i] + C.setup(i).entry[3];
-  SubTriangleRecords R;
-  R.headers.assign(4 * offsets[n], 0);
-  R.records.assign(offsets[n] * SFFD_SUB_STRIDE * 4, 0.0);
-  for (size_t i = 0; i < n; ++i) C.write(i, offsets[i], R);
-  return R;
-}
-
-
-template <class Real>
-SubTriangleRecords clipGpu(Backend& backend, const PreparedMesh& M, const PnOutput& pn, const ClipTriangles& clip,
+SubTriangleRecords clipRun(Backend& backend, const PreparedMesh& M, const PnOutput& pn, const ClipTriangles& clip,
                            double l, KernelVariant variant) {
   const DeviceLimits& lim = backend.info().limits;
   const PackedTable& T = packedTable();
@@ -445,26 +276,13 @@ SubTriangleRecords clipGpu(Backend& backend, const PreparedMesh& M, const PnOutp
 
 }  // namespace
 
-SubTriangleRecords regularClipCpu(const PreparedMesh& mesh, const PnOutput& pn, const ClipTriangles& clip, double l,
-                                  KernelVariant variant) {
-  auto t0 = std::chrono::steady_clock::now();
-  SubTriangleRecords R = variant.f64 ? clipCpu<double>(mesh, pn, clip, l) : clipCpu<float>(mesh, pn, clip, l);
-  R.wallMs = msSince(t0);
-  R.timings.push_back({"clip", R.wallMs});
-  return R;
-}
-
-}  // namespace sffd
-
-namespace sffd {
-
-SubTriangleRecords regularClipGpu(Backend& backend, const PreparedMesh& mesh, const PnOutput& pn,
-                                  const ClipTriangles& clip, double l, KernelVariant variant) {
+SubTriangleRecords regularClip(Backend& backend, const PreparedMesh& mesh, const PnOutput& pn,
+                               const ClipTriangles& clip, double l, KernelVariant variant) {
   if (variant.f64 && !backend.info().limits.float64)
     throw deviceError(backend.info().name + " has no double-precision shader support; use --precision float");
   auto t0 = std::chrono::steady_clock::now();
-  SubTriangleRecords R = variant.f64 ? clipGpu<double>(backend, mesh, pn, clip, l, variant)
-                                     : clipGpu<float>(backend, mesh, pn, clip, l, variant);
+  SubTriangleRecords R = variant.f64 ? clipRun<double>(backend, mesh, pn, clip, l, variant)
+                                     : clipRun<float>(backend, mesh, pn, clip, l, variant);
   R.wallMs = msSince(t0);
   return R;
 }

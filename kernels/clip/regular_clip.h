@@ -42,13 +42,11 @@ struct SubTriangleRecords {
   size_t size() const { return headers.size() / 4; }
 };
 
-// Regular clipping on the CPU reference (double, or float in the strict kernels' order) and on a GPU.
-SubTriangleRecords regularClipCpu(const PreparedMesh& mesh, const PnOutput& pn, const ClipTriangles& clip, double l,
-                                  KernelVariant variant);
-SubTriangleRecords regularClipGpu(Backend& backend, const PreparedMesh& mesh, const PnOutput& pn,
-                                  const ClipTriangles& clip, double l, KernelVariant variant);
+// Regular clipping on a backend: clip_count, the exclusive scan on the host, clip_write in chunks.
+SubTriangleRecords regularClip(Backend& backend, const PreparedMesh& mesh, const PnOutput& pn, const ClipTriangles& clip,
+                               double l, KernelVariant variant);
 
-// Records of sub-triangles given by their parent sites (knot-box clipping), on the CPU reference.
+// Records of sub-triangles given by their parent sites (knot-box clipping), on the host (clip_sites.h).
 SubTriangleRecords recordsFromSubTriangles(const PreparedMesh& mesh, const PnOutput& pn,
                                            const std::vector<SubTriangle>& subs, KernelVariant variant);
 
@@ -64,5 +62,12 @@ struct PackedTable {
   uint32_t nmax = 0, vertexWord = 0, triangleWord = 0;
 };
 const PackedTable& packedTable();
+
+struct CpuKernelArgs;
+namespace cpu {
+// CPU entries of kernels clip_count and clip_write (clip_sites_cpu.cpp).
+void clipCount(const CpuKernelArgs& args, uint64_t first, uint64_t last);
+void clipWrite(const CpuKernelArgs& args, uint64_t first, uint64_t last);
+}  // namespace cpu
 
 }  // namespace sffd

@@ -5,6 +5,7 @@
 #include <cstring>
 #include <map>
 
+#include "backends/backend_test_support.h"
 #include "kernels/clip/knot_box_clip.h"
 #include "model/lattice.h"
 #include "kernels/clip/regular_clip.h"
@@ -25,10 +26,10 @@ glm::dvec3 rec(const SubTriangleRecords& R, size_t s, int slot) {
 
 SubTriangleRecords clipMesh(const Mesh& m, double l, KernelVariant v, ClipTriangles* clipOut = nullptr) {
   PreparedMesh P = prepareMesh(m);
-  PnOutput pn = pnTrianglesCpu(P, v);
+  PnOutput pn = pnTriangles(sffd::testing::cpuBackend(), P, v);
   ClipTriangles C = buildClipTriangles(m, l, splitPatternTable().nmax());
   if (clipOut) *clipOut = C;
-  return regularClipCpu(P, pn, C, l, v);
+  return regularClip(sffd::testing::cpuBackend(), P, pn, C, l, v);
 }
 
 // Welds sub-triangle corners by the exact bits of `slot` and checks every edge is used exactly twice,
@@ -133,7 +134,7 @@ TEST(KnotBoxRecords, ClosedAndCoveredLikeRegular) {
     for (const auto& p : m.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
     Lattice L = makeIdentityLattice(lo, hi, {5, 5, 5}, {2, 2, 2});
     PreparedMesh P = prepareMesh(m);
-    PnOutput pn = pnTrianglesCpu(P, {false, true});
+    PnOutput pn = pnTriangles(sffd::testing::cpuBackend(), P, {false, true});
     SubTriangleRecords R = recordsFromSubTriangles(P, pn, clipAgainstKnotBoxes(m, L), {false, true});
     EXPECT_GT(R.size(), m.triangles.size());
     expectClosed(R, SFFD_SUB_XPN);
@@ -148,10 +149,10 @@ TEST(RegularClip, FewerSliversThanKnotBoxAtComparableCounts) {
   glm::dvec3 lo(1e30), hi(-1e30);
   for (const auto& p : m.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
   PreparedMesh P = prepareMesh(m);
-  PnOutput pn = pnTrianglesCpu(P, {false, true});
+  PnOutput pn = pnTriangles(sffd::testing::cpuBackend(), P, {false, true});
   SubTriangleRecords kb = recordsFromSubTriangles(P, pn, clipAgainstKnotBoxes(m, makeIdentityLattice(lo, hi, {5, 5, 5}, {2, 2, 2})), {false, true});
   double l = 0.05 * glm::length(hi - lo);
-  SubTriangleRecords rg = regularClipCpu(P, pn, buildClipTriangles(m, l, splitPatternTable().nmax()), l, {false, true});
+  SubTriangleRecords rg = regularClip(sffd::testing::cpuBackend(), P, pn, buildClipTriangles(m, l, splitPatternTable().nmax()), l, {false, true});
   auto stats = [](const SubTriangleRecords& R) {
     std::vector<std::array<glm::dvec3, 3>> t(R.size());
     for (size_t s = 0; s < R.size(); ++s)

@@ -22,8 +22,11 @@ class LatticeEvaluator {
  public:
   static constexpr int kMax = SFFD_MAX_DEGREE + 1;
 
-  LatticeEvaluator(const gpu::LatticeParams& params, const std::vector<Real>& frame, const std::vector<Real>& coeffs)
+  // frame: the lattice frame buffer's reals; coeffs: 4 reals per Bezier coefficient (layout.h).
+  LatticeEvaluator(const gpu::LatticeParams& params, const Real* frame, const Real* coeffs)
       : L_(params), frame_(frame), coeffs_(coeffs) {}
+  LatticeEvaluator(const gpu::LatticeParams& params, const std::vector<Real>& frame, const std::vector<Real>& coeffs)
+      : LatticeEvaluator(params, frame.data(), coeffs.data()) {}
 
   // The largest i with breaks[i] <= t, clamped to [0, n-1] (counted, as the kernels do).
   uint32_t span(uint32_t first, uint32_t n, Real t) const {
@@ -127,8 +130,8 @@ class LatticeEvaluator {
 
  private:
   gpu::LatticeParams L_;
-  const std::vector<Real>& frame_;
-  const std::vector<Real>& coeffs_;
+  const Real* frame_;
+  const Real* coeffs_;
 };
 
 }  // namespace sffd

@@ -6,6 +6,7 @@
 
 #include <sffd/error.h>
 #include "model/lattice_pack.h"
+#include "kernels/common/cpu_kernel.h"
 #include "kernels/pn/pn_eval.h"
 #include "kernels/common/shader_layout.h"
 #include "core/wall_clock.h"
@@ -13,37 +14,46 @@
 namespace sffd {
 namespace {
 
+// The twin of pn_triangles.comp's main().
 template <class Real>
-void pnCpu(const PreparedMesh& M, PnOutput& out) {
-  const size_t nt = M.triangleCount();
-  out.records.assign(nt * SFFD_PN_STRIDE * 4, 0.0);
-  auto vec = [](const std::vector<double>& a, size_t i) { return RVec3<Real>{Real(a[4 * i]), Real(a[4 * i + 1]), Real(a[4 * i + 2])}; };
-  for (size_t t = 0; t < nt; ++t) {
-    RVec3<Real> V[3], N[3], first[6], second[6];
+void pnThreads(const CpuKernelArgs& a, uint64_t first, uint64_t last) {
+  const auto& p = a.paramsAs<gpu::PnParams>();
+  const uint64_t nt = uint64_t(p.range.x) + p.range.y;
+  std::span<const Real> pos = a.array<const Real>(SFFD_BINDING_MESH_POSITIONS), nrm = a.array<const Real>(SFFD_BINDING_MESH_NORMALS);
+  const uint32_t* tri = a.array<const uint32_t>(SFFD_BINDING_MESH_TRIANGLES, 4 * SFFD_MESH_TRIANGLE_STRIDE * nt).data();
+  const Real* slots = a.array<const Real>(SFFD_BINDING_MESH_SLOT_NORMALS, 4 * SFFD_SLOT_NORMAL_STRIDE * nt).data();
+  Real* out = a.array<Real>(SFFD_BINDING_PN_OUT, 4 * SFFD_PN_STRIDE * nt).data();
+  auto vec = [](const Real* r) { return RVec3<Real>{r[0], r[1], r[2]}; };
+  for (uint64_t t = first; t < std::min<uint64_t>(last, p.range.y); ++t) {
+    const size_t tr = p.range.x + uint32_t(t);
+    RVec3<Real> V[3], N[3], nFirst[6], nSecond[6];
     bool crease[6];
     uint32_t weld[3];
     for (int c = 0; c < 3; ++c) {
-      V[c] = vec(M.positions, M.triangles[8 * t + c]);
-      N[c] = vec(M.normals, M.triangles[8 * t + c]);
-      weld[c] = M.triangles[8 * t + 4 + c];
+      const uint32_t id = tri[8 * tr + c];
+      a.check(4 * uint64_t(id) + 4 <= std::min(pos.size(), nrm.size()), "a triangle's vertex id is outside the vertex buffers");
+      V[c] = vec(&pos[4 * size_t(id)]);
+      N[c] = vec(&nrm[4 * size_t(id)]);
+      weld[c] = tri[8 * tr + 4 + c];
     }
     for (int s = 0; s < 6; ++s) {
-      first[s] = vec(M.slotNormals, 12 * t + 2 * s);
-      crease[s] = Real(M.slotNormals[48 * t + 8 * s + 3]) > Real(0.5);
-      second[s] = vec(M.slotNormals, 12 * t + 2 * s + 1);
+      const Real* f = &slots[4 * (SFFD_SLOT_NORMAL_STRIDE * tr + 2 * s)];
+      nFirst[s] = vec(f);
+      crease[s] = f[3] > Real(0.5);
+      nSecond[s] = vec(f + 4);
     }
-    PnPatchT<Real> P = pnBuild(V, N, first, crease, second, weld);
-    double* o = &out.records[t * SFFD_PN_STRIDE * 4];
-    for (int i = 0; i < 10; ++i) o[4 * i] = P.cp[i].x, o[4 * i + 1] = P.cp[i].y, o[4 * i + 2] = P.cp[i].z;
+    PnPatchT<Real> P = pnBuild(V, N, nFirst, crease, nSecond, weld);
+    Real* o = &out[4 * SFFD_PN_STRIDE * tr];
+    for (int i = 0; i < 10; ++i) o[4 * i] = P.cp[i].x, o[4 * i + 1] = P.cp[i].y, o[4 * i + 2] = P.cp[i].z, o[4 * i + 3] = 0;
     for (int i = 0; i < 6; ++i) {
-      double* q = o + 4 * (SFFD_PN_NORMALS + i);
-      q[0] = P.n[i].x, q[1] = P.n[i].y, q[2] = P.n[i].z;
+      Real* q = o + 4 * (SFFD_PN_NORMALS + i);
+      q[0] = P.n[i].x, q[1] = P.n[i].y, q[2] = P.n[i].z, q[3] = 0;
     }
   }
 }
 
 template <class Real>
-void pnGpu(Backend& backend, const PreparedMesh& M, KernelVariant variant, PnOutput& out) {
+void pnRun(Backend& backend, const PreparedMesh& M, KernelVariant variant, PnOutput& out) {
   const DeviceLimits& lim = backend.info().limits;
   const size_t nt = M.triangleCount(), nv = M.positions.size() / 4;
   const uint64_t vertexBytes = nv * 4 * sizeof(Real);
@@ -96,27 +106,21 @@ void pnGpu(Backend& backend, const PreparedMesh& M, KernelVariant variant, PnOut
 
 }  // namespace
 
-PnOutput pnTrianglesCpu(const PreparedMesh& mesh, KernelVariant variant) {
-  PnOutput out;
-  auto t0 = std::chrono::steady_clock::now();
-  if (variant.f64) pnCpu<double>(mesh, out);
-  else pnCpu<float>(mesh, out);
-  out.wallMs = msSince(t0);
-  out.timings.push_back({"pn", out.wallMs});
-  return out;
-}
-
-PnOutput pnTrianglesGpu(Backend& backend, const PreparedMesh& mesh, KernelVariant variant) {
+PnOutput pnTriangles(Backend& backend, const PreparedMesh& mesh, KernelVariant variant) {
   if (variant.f64 && !backend.info().limits.float64)
     throw deviceError(backend.info().name + " has no double-precision shader support; use --precision float");
   PnOutput out;
   auto t0 = std::chrono::steady_clock::now();
   if (mesh.triangleCount() > 0) {
-    if (variant.f64) pnGpu<double>(backend, mesh, variant, out);
-    else pnGpu<float>(backend, mesh, variant, out);
+    if (variant.f64) pnRun<double>(backend, mesh, variant, out);
+    else pnRun<float>(backend, mesh, variant, out);
   }
   out.wallMs = msSince(t0);
   return out;
+}
+
+void cpu::pnTriangles(const CpuKernelArgs& a, uint64_t first, uint64_t last) {
+  a.variant.f64 ? pnThreads<double>(a, first, last) : pnThreads<float>(a, first, last);
 }
 
 }  // namespace sffd

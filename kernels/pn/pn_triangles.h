@@ -1,6 +1,6 @@
 // Kernel K1 "PN triangles" (Vlachos et al. 2001 with the sharp-feature rule of Cui & Feng 2015;
 // METHOD.md 3.2): per original triangle, the cubic PN geometry patch and quadratic normal patch.
-// Runs on a GPU backend (kernels/pn/pn_triangles.comp) or on the CPU reference (pn_eval.h).
+// Kernel kernels/pn/pn_triangles.comp; its C++ twin is pn_eval.h, run by the CPU backend through cpu::pnTriangles.
 #pragma once
 #include <vector>
 
@@ -15,7 +15,12 @@ struct PnOutput {
   double wallMs = 0;
 };
 
-PnOutput pnTrianglesCpu(const PreparedMesh& mesh, KernelVariant variant);
-PnOutput pnTrianglesGpu(Backend& backend, const PreparedMesh& mesh, KernelVariant variant);
+PnOutput pnTriangles(Backend& backend, const PreparedMesh& mesh, KernelVariant variant);
+
+struct CpuKernelArgs;
+namespace cpu {
+// CPU entry of kernel pn_triangles (kernels/common/cpu_kernel.h).
+void pnTriangles(const CpuKernelArgs& args, uint64_t first, uint64_t last);
+}  // namespace cpu
 
 }  // namespace sffd

@@ -2,6 +2,7 @@
 // curves across shared edges (smooth and crease), flat PN patches for the split-normal cube.
 #include <gtest/gtest.h>
 
+#include "backends/backend_test_support.h"
 #include "kernels/pn/pn_triangles.h"
 #include "kernels/pn/pn_eval.h"
 #include "kernels/common/shader_layout.h"
@@ -27,7 +28,7 @@ std::array<glm::dvec3, 4> edgeCurve(const PnOutput& o, size_t t, int e) {
 
 void expectSharedEdgesIdentical(const Mesh& mesh, KernelVariant variant) {
   PreparedMesh P = prepareMesh(mesh);
-  PnOutput o = pnTrianglesCpu(P, variant);
+  PnOutput o = pnTriangles(sffd::testing::cpuBackend(), P, variant);
   size_t checked = 0;
   for (size_t t = 0; t < mesh.triangles.size(); ++t)
     for (int e = 0; e < 3; ++e) {
@@ -45,7 +46,7 @@ void expectSharedEdgesIdentical(const Mesh& mesh, KernelVariant variant) {
 
 TEST(PnTriangles, InterpolatesCornersAndNormals) {
   Mesh m = readMesh(kData + "/sphere.obj");
-  PnOutput o = pnTrianglesCpu(prepareMesh(m), {false, true});
+  PnOutput o = pnTriangles(sffd::testing::cpuBackend(), prepareMesh(m), {false, true});
   for (size_t t = 0; t < m.triangles.size(); ++t) {
     const int corner[3] = {0, 6, 9}, normal[3] = {0, 3, 5};
     for (int c = 0; c < 3; ++c) {
@@ -67,7 +68,7 @@ TEST(PnTriangles, SharedEdgesGiveIdenticalCurves) {
 TEST(PnTriangles, SplitNormalCubeIsFlat) {
   // METHOD.md 5: cube2's PN triangles are flat (crease projections fall on the edges).
   Mesh m = readMesh(kData + "/cube2.obj");
-  PnOutput o = pnTrianglesCpu(prepareMesh(m), {false, true});
+  PnOutput o = pnTriangles(sffd::testing::cpuBackend(), prepareMesh(m), {false, true});
   for (size_t t = 0; t < m.triangles.size(); ++t) {
     glm::dvec3 a = m.positions[m.triangles[t][0]], b = m.positions[m.triangles[t][1]], c = m.positions[m.triangles[t][2]];
     glm::dvec3 n = glm::normalize(glm::cross(b - a, c - a));
@@ -82,7 +83,7 @@ TEST(PnTriangles, SmoothEdgePointIsVlachos) {
   m.normals = {glm::normalize(glm::dvec3(-0.3, 0, 1)), glm::normalize(glm::dvec3(0.2, 0.1, 1)), {0, 0, 1}};
   m.weldId = {0, 1, 2};
   m.triangles = {{0, 1, 2}};
-  PnOutput o = pnTrianglesCpu(prepareMesh(m), {false, true});
+  PnOutput o = pnTriangles(sffd::testing::cpuBackend(), prepareMesh(m), {false, true});
   glm::dvec3 V0 = m.positions[0], V1 = m.positions[1], N0 = m.normals[0];
   glm::dvec3 want = (2.0 * V0 + V1 - glm::dot(V1 - V0, N0) * N0) / 3.0;
   EXPECT_NEAR(glm::length(at(o, 0, 1) - want), 0, 1e-15);

@@ -1,6 +1,6 @@
 // kernels/smooth/smooth_deform.glsl: the steps of the smooth-FFD deform stage (METHOD.md 3.4) as
 // functions, shared by the fused kernel deform_smooth and the split kernels deform_step_*; the C++
-// twin is kernels/smooth/smooth_deform.cpp. Both forms call the same functions, so they agree.
+// twin is kernels/smooth/smooth_deform_cpu.cpp. Both forms call the same functions, so they agree.
 //
 // Bitwise C0: everything on a sub-edge is computed from that edge's data in an order both patches
 // share (sums of two products are commutative; near-corner control points use one expression from the

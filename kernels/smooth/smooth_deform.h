@@ -1,7 +1,7 @@
 // Kernel K3 "deform" of smooth FFD (Cui & Feng 2015, improved by Lu & Feng; METHOD.md 3.4): each
 // sub-triangle becomes a cubic triangular Bezier patch fitted to the exactly deformed surface, with a
-// cubic normal patch, creases kept sharp, tessellated at level L. GPU kernel kernels/smooth/deform_smooth.comp;
-// the C++ twin here, templated on the arithmetic type.
+// cubic normal patch, creases kept sharp, tessellated at level L. Kernels kernels/smooth/deform_smooth.comp
+// (fused) and deform_step_*.comp (split); their C++ twin and CPU entries are smooth_deform_cpu.cpp.
 #pragma once
 #include <vector>
 
@@ -30,19 +30,15 @@ struct SmoothOutput {
   double wallMs = 0;
 };
 
-// Threads the CPU reference's deform stage uses: every core, or SFFD_CPU_THREADS.
-unsigned cpuThreadCount();
-
-SmoothOutput smoothDeformCpu(const PackedLattice& lattice, const SubTriangleRecords& subs, const FitTable& fit,
-                             int level, KernelVariant variant);
-// split: one dispatch per step (deform.sample: steps 1, 2, 4; deform.fit: 3; deform.adjust: 5;
-// deform.tessellate: 6), for per-step timings; the same output as the fused kernel.
-SmoothOutput smoothDeformGpu(Backend& backend, const PackedLattice& lattice, const SubTriangleRecords& subs,
-                             const FitTable& fit, int level, KernelVariant variant, bool split = false);
+// The deform stage on a backend, chunked within its limits. split: one dispatch per step (deform.sample:
+// steps 1, 2, 4; deform.fit: 3; deform.adjust: 5; deform.tessellate: 6), for per-step timings; the same
+// output as the fused kernel.
+SmoothOutput smoothDeform(Backend& backend, const PackedLattice& lattice, const SubTriangleRecords& subs,
+                          const FitTable& fit, int level, KernelVariant variant, bool split = false);
 
 // The deform stage's dispatches over `count` sub-triangles (params.range set by the caller): the
 // fused kernel, or with `split` the four step kernels (`samples` then holds their intermediate data).
-// Shared by smoothDeformGpu and DeformSession.
+// Shared by smoothDeform and DeformSession.
 struct DeformBuffers {
   BufferId coeffs = 0, frame = 0, fit = 0, headers = 0, records = 0, patches = 0, tess = 0, samples = 0;
 };
@@ -52,5 +48,15 @@ void dispatchDeform(Backend& backend, const gpu::DeformParams& params, const Def
 // The tessellation with each vertex's pre-image in its parent triangle (for the writers and the
 // error analysis).
 PatchVertices patchVerticesOf(const SubTriangleRecords& subs, const SmoothOutput& out);
+
+struct CpuKernelArgs;
+namespace cpu {
+// CPU entries of the deform kernels (smooth_deform_cpu.cpp).
+void deformSmooth(const CpuKernelArgs& args, uint64_t first, uint64_t last);
+void deformStepSample(const CpuKernelArgs& args, uint64_t first, uint64_t last);
+void deformStepFit(const CpuKernelArgs& args, uint64_t first, uint64_t last);
+void deformStepAdjust(const CpuKernelArgs& args, uint64_t first, uint64_t last);
+void deformStepTessellate(const CpuKernelArgs& args, uint64_t first, uint64_t last);
+}  // namespace cpu
 
 }  // namespace sffd

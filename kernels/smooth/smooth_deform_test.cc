@@ -4,6 +4,7 @@
 
 #include <map>
 
+#include "backends/backend_test_support.h"
 #include "model/lattice.h"
 #include "io/lattice_io.h"
 #include "kernels/common/shader_layout.h"
@@ -28,9 +29,9 @@ SmoothRun smooth(const Mesh& m, const Lattice& L, double l, KernelVariant v, int
   SmoothRun r;
   r.mesh = m;
   r.prepared = prepareMesh(m);
-  r.pn = pnTrianglesCpu(r.prepared, v);
-  r.subs = regularClipCpu(r.prepared, r.pn, buildClipTriangles(m, l, splitPatternTable().nmax()), l, v);
-  r.out = smoothDeformCpu(packLattice(L), r.subs, makeFitTable(s), level, v);
+  r.pn = pnTriangles(sffd::testing::cpuBackend(), r.prepared, v);
+  r.subs = regularClip(sffd::testing::cpuBackend(), r.prepared, r.pn, buildClipTriangles(m, l, splitPatternTable().nmax()), l, v);
+  r.out = smoothDeform(sffd::testing::cpuBackend(), packLattice(L), r.subs, makeFitTable(s), level, v);
   return r;
 }
 

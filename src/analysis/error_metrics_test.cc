@@ -9,6 +9,7 @@
 #include <map>
 #include <random>
 
+#include "backends/backend_test_support.h"
 #include "kernels/accurate/accurate_patches.h"
 #include "kernels/classic/classic_ffd.h"
 #include "analysis/error_metrics.h"
@@ -42,12 +43,12 @@ struct Accurate {
 Accurate accurate(const Mesh& mesh, const Lattice& L, int level = 10) {
   AccurateJob job = makeAccurateJob(mesh, L, clipAgainstKnotBoxes(mesh, L), level);
   Accurate a;
-  a.pv = accuratePatchVertices(job, accurateFfdCpu(job, packLattice(L), {false, true}));
+  a.pv = accuratePatchVertices(job, accurateFfd(sffd::testing::cpuBackend(), job, packLattice(L), {false, true}));
   a.out = weldPatchVertices(a.pv);
   return a;
 }
 
-Mesh classic(const Mesh& mesh, const Lattice& L) { return applyClassicOutput(mesh, classicFfdCpu(mesh, packLattice(L), {false, true})); }
+Mesh classic(const Mesh& mesh, const Lattice& L) { return applyClassicOutput(mesh, classicFfd(sffd::testing::cpuBackend(), mesh, packLattice(L), {false, true})); }
 
 // Every triangle split into k^2 (vertices welded by their barycentric grid position along shared edges
 // through exact position equality: the grid points of a shared edge are computed from the same ends).

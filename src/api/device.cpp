@@ -30,7 +30,7 @@ Device Device::open(const DeviceRequest& request, std::vector<std::string>* note
   r.device = request.deviceSubstring;
   r.validation = request.validation;
   OpenedBackend b = openBackend(r, notes);
-  Device d(b.label, std::move(b.gpu));
+  Device d(b.label, std::move(b.backend));
   d.impl_->info = b.info;
   return d;
 }

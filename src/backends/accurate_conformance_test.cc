@@ -1,5 +1,5 @@
-// Conformance of the accurate FFD kernel (kernels/accurate/accurate_patches.comp) on every GPU backend against
-// its C++ twin (kernels/accurate/accurate_patches.cpp): strict variants bit-identical, fast variants within the
+// Conformance of the accurate FFD kernel (kernels/accurate/accurate_patches.comp) on every backend against
+// the CPU backend, which runs its C++ twin (accurate_patches_cpu.cpp): strict variants bit-identical, fast variants within the
 // tolerances of docs/CONFORMANCE.md; chunked jobs equal one dispatch; the identity lattice reproduces
 // the flat mesh; the largest patch degree (5,5,5 -> n = 15) runs.
 #include <gtest/gtest.h>
@@ -58,7 +58,7 @@ class AccurateConformance : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(AccurateConformance, AgreesWithCpuTwinInEveryVariant) {
   OpenedBackend b = open(GetParam());
-  ASSERT_TRUE(b.gpu);
+  ASSERT_TRUE(b.backend);
   Mesh mesh = readMesh(kData + "/sphere.obj");
   // Extrapolate: a margin-less box; Keep: a box smaller than the sphere, so the outside rule is exercised.
   for (auto [outside, margin] : {std::pair{OutsideMode::Extrapolate, 0.0}, std::pair{OutsideMode::Keep, -0.05}}) {
@@ -67,16 +67,16 @@ TEST_P(AccurateConformance, AgreesWithCpuTwinInEveryVariant) {
     AccurateJob job = makeAccurateJob(mesh, L, clipAgainstKnotBoxes(mesh, L), 10);
     ASSERT_GT(job.count(), 1000u);
     std::string o = outside == OutsideMode::Keep ? " keep" : "";
-    AccurateOutput cpuDouble = accurateFfdCpu(job, P, {false, true}), cpuFloat = accurateFfdCpu(job, P, {true, false});
+    AccurateOutput cpuDouble = accurateFfd(sffd::testing::cpuBackend(), job, P, {false, true}), cpuFloat = accurateFfd(sffd::testing::cpuBackend(), job, P, {true, false});
     // Strict float: bit-identical to the C++ float path.
-    expectBuffers(accurateFfdGpu(*b.gpu, job, P, {true, false}), cpuFloat, true, {true, 0, 0}, "strict float" + o);
+    expectBuffers(accurateFfd(*b.backend, job, P, {true, false}), cpuFloat, true, {true, 0, 0}, "strict float" + o);
     // Fast float against the double reference: positions and normals within 1e-5 of the largest value,
     // control points within 2 |A_7^{-1}|_inf 2^-24 = 5e-5, rounded up to 1e-4 (patch degree 2+3+2 = 7).
-    expectBuffers(accurateFfdGpu(*b.gpu, job, P, {false, false}), cpuDouble, true, {false, 64, 1e-5}, "fast float" + o,
+    expectBuffers(accurateFfd(*b.backend, job, P, {false, false}), cpuDouble, true, {false, 64, 1e-5}, "fast float" + o,
                   CompareTolerance{false, 64, 1e-4});
     if (b.info.limits.float64) {
-      expectBuffers(accurateFfdGpu(*b.gpu, job, P, {true, true}), cpuDouble, false, {true, 0, 0}, "strict double" + o);
-      expectBuffers(accurateFfdGpu(*b.gpu, job, P, {false, true}), cpuDouble, false, {false, 0, 1e-12}, "fast double" + o);
+      expectBuffers(accurateFfd(*b.backend, job, P, {true, true}), cpuDouble, false, {true, 0, 0}, "strict double" + o);
+      expectBuffers(accurateFfd(*b.backend, job, P, {false, true}), cpuDouble, false, {false, 0, 1e-12}, "fast double" + o);
     }
   }
   EXPECT_EQ(vk::validationMessageCount(), 0u);
@@ -89,9 +89,9 @@ TEST_P(AccurateConformance, LargestPatchDegree) {
   PackedLattice P = packLattice(L);
   AccurateJob job = makeAccurateJob(mesh, L, clipAgainstKnotBoxes(mesh, L), 10);
   ASSERT_EQ(job.degree, 15);
-  expectBuffers(accurateFfdGpu(*b.gpu, job, P, {true, false}), accurateFfdCpu(job, P, {true, false}), true, {true, 0, 0}, "n=15 strict float");
+  expectBuffers(accurateFfd(*b.backend, job, P, {true, false}), accurateFfd(sffd::testing::cpuBackend(), job, P, {true, false}), true, {true, 0, 0}, "n=15 strict float");
   if (b.info.limits.float64)
-    expectBuffers(accurateFfdGpu(*b.gpu, job, P, {true, true}), accurateFfdCpu(job, P, {false, true}), false, {true, 0, 0}, "n=15 strict double");
+    expectBuffers(accurateFfd(*b.backend, job, P, {true, true}), accurateFfd(sffd::testing::cpuBackend(), job, P, {false, true}), false, {true, 0, 0}, "n=15 strict double");
   EXPECT_EQ(vk::validationMessageCount(), 0u);
 }
 
@@ -103,7 +103,7 @@ TEST_P(AccurateConformance, HighestTessellationLevel) {
   Lattice L = latticeFor(mesh, {5, 5, 5}, {2, 2, 2}, 0.1, OutsideMode::Extrapolate, 0.01);
   PackedLattice P = packLattice(L);
   AccurateJob job = makeAccurateJob(mesh, L, clipAgainstKnotBoxes(mesh, L), 64);
-  expectBuffers(accurateFfdGpu(*b.gpu, job, P, {true, false}), accurateFfdCpu(job, P, {true, false}), true, {true, 0, 0}, "tess 64 strict float");
+  expectBuffers(accurateFfd(*b.backend, job, P, {true, false}), accurateFfd(sffd::testing::cpuBackend(), job, P, {true, false}), true, {true, 0, 0}, "tess 64 strict float");
   EXPECT_EQ(vk::validationMessageCount(), 0u);
 }
 
@@ -113,9 +113,9 @@ TEST_P(AccurateConformance, ChunkedJobEqualsOneDispatch) {
   Lattice L = latticeFor(mesh, {5, 5, 5}, {2, 2, 2}, 0.1, OutsideMode::Extrapolate, 0.01);
   PackedLattice P = packLattice(L);
   AccurateJob job = makeAccurateJob(mesh, L, clipAgainstKnotBoxes(mesh, L), 10);
-  AccurateOutput whole = accurateFfdGpu(*b.gpu, job, P, {true, false});
+  AccurateOutput whole = accurateFfd(*b.backend, job, P, {true, false});
   setenv("SFFD_MAX_CHUNK_PATCHES", "97", 1);   // many chunks, the last one partial
-  AccurateOutput chunked = accurateFfdGpu(*b.gpu, job, P, {true, false});
+  AccurateOutput chunked = accurateFfd(*b.backend, job, P, {true, false});
   unsetenv("SFFD_MAX_CHUNK_PATCHES");
   EXPECT_EQ(whole.controlPoints, chunked.controlPoints);
   EXPECT_EQ(whole.positions, chunked.positions);
@@ -127,7 +127,7 @@ TEST_P(AccurateConformance, IdentityLatticeReproducesTheFlatMesh) {
   Mesh mesh = readMesh(kData + "/sphere.obj");
   Lattice L = latticeFor(mesh, {5, 5, 5}, {2, 2, 2}, 0.0, OutsideMode::Extrapolate, 0.0);
   AccurateJob job = makeAccurateJob(mesh, L, clipAgainstKnotBoxes(mesh, L), 10);
-  PatchVertices pv = accuratePatchVertices(job, accurateFfdGpu(*b.gpu, job, packLattice(L), {false, false}));
+  PatchVertices pv = accuratePatchVertices(job, accurateFfd(*b.backend, job, packLattice(L), {false, false}));
   double worstPos = 0, worstNrm = 0;
   const int nv = tessVertexCount(10);
   for (size_t p = 0; p < pv.patchCount(); ++p) {

@@ -1,24 +1,11 @@
 #include "backend_select.h"
 
-#include <thread>
-
 #include <sffd/error.h>
+#include "backends/cpu/cpu_backend.h"
 #include "backends/opengl/gl_backend.h"
 #include "backends/vulkan/vk_backend.h"
 
 namespace sffd {
-
-DeviceInfo cpuDeviceInfo() {
-  DeviceInfo info;
-  info.api = "cpu";
-  info.provider = "cpu";
-  info.name = "CPU reference (double precision)";
-  info.driver = "sffd " + std::to_string(std::thread::hardware_concurrency()) + " hardware threads";
-  info.type = "cpu";
-  info.limits.maxStorageBufferRange = ~uint64_t(0) >> 1;
-  info.limits.float64 = true;
-  return info;
-}
 
 namespace {
 
@@ -27,8 +14,8 @@ OpenedBackend openGl(gl::Provider provider, const std::string& label, const Back
   o.provider = provider;
   o.deviceSubstring = r.device;
   OpenedBackend b;
-  b.gpu = gl::createBackend(o);
-  b.info = b.gpu->info();
+  b.backend = gl::createBackend(o);
+  b.info = b.backend->info();
   b.label = label == "gl" ? "gl-" + b.info.provider : label;
   return b;
 }
@@ -39,8 +26,8 @@ OpenedBackend openNamed(const std::string& name, const BackendRequest& r) {
     o.deviceSubstring = r.device;
     o.validation = r.validation;
     OpenedBackend b;
-    b.gpu = vk::createBackend(o);
-    b.info = b.gpu->info();
+    b.backend = vk::createBackend(o);
+    b.info = b.backend->info();
     b.label = "vulkan";
     return b;
   }
@@ -50,7 +37,8 @@ OpenedBackend openNamed(const std::string& name, const BackendRequest& r) {
   if (name == "gl-glfw") return openGl(gl::Provider::GLFW, name, r);
   if (name == "cpu") {
     OpenedBackend b;
-    b.info = cpuDeviceInfo();
+    b.backend = cpu::createBackend();
+    b.info = b.backend->info();
     b.label = "cpu";
     return b;
   }
@@ -85,7 +73,7 @@ std::vector<std::pair<std::string, DeviceInfo>> listBackends(std::vector<std::st
   } catch (const Error& e) {
     problems.push_back(std::string("gl: ") + e.what());
   }
-  out.emplace_back("cpu", cpuDeviceInfo());
+  out.emplace_back("cpu", cpu::deviceInfo());
   return out;
 }
 

@@ -1,5 +1,5 @@
 // Opening a compute backend by name (--backend auto|vulkan|gl|cpu, --device SUBSTRING) with the
-// documented fallback order for auto: Vulkan, then GL (EGL, then OSMesa), then the CPU reference.
+// documented fallback order for auto: Vulkan, then GL (EGL, then OSMesa), then the CPU backend.
 #pragma once
 #include <memory>
 #include <string>
@@ -9,11 +9,11 @@
 
 namespace sffd {
 
-// A named way to run a job. `gpu` is null for the CPU reference.
+// A named way to run a job.
 struct OpenedBackend {
   std::string label;            // "vulkan", "gl-egl", "gl-osmesa", "gl-glfw", "cpu"
   DeviceInfo info;
-  std::unique_ptr<Backend> gpu;
+  std::unique_ptr<Backend> backend;
 };
 
 struct BackendRequest {
@@ -21,8 +21,6 @@ struct BackendRequest {
   std::string device;           // device-name substring
   bool validation = false;      // Vulkan validation layer
 };
-
-DeviceInfo cpuDeviceInfo();
 
 // Opens the backend; throws a device Error (exit 3) when the one asked for is unusable. For "auto",
 // failures are skipped and `notes` receives one line per skipped backend.

@@ -1,5 +1,6 @@
-// Conformance: the classic_ffd kernel on every GPU backend (Vulkan, GL through EGL and OSMesa)
-// against the CPU reference, in every variant (docs/CONFORMANCE.md states the tolerances).
+// Conformance: the classic, PN, clip and deform kernels on every backend (Vulkan, GL through EGL and
+// OSMesa, the CPU backend itself) against the CPU backend, in every variant (docs/CONFORMANCE.md states
+// the tolerances).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -64,21 +65,21 @@ class ClassicConformance : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(ClassicConformance, AgreesWithCpuReferenceInEveryVariant) {
   OpenedBackend b = open(GetParam());
-  ASSERT_TRUE(b.gpu);
+  ASSERT_TRUE(b.backend);
   Mesh mesh = sphereMesh(40, 64, 1.05);   // the caps stick out of the box: outside rules are exercised
   for (OutsideMode outside : {OutsideMode::Extrapolate, OutsideMode::Keep}) {
     PackedLattice P = packLattice(deformedLattice(outside));
-    ClassicOutput cpuDouble = classicFfdCpu(mesh, P, {false, true});
-    ClassicOutput cpuStrictFloat = classicFfdCpu(mesh, P, {true, false});
+    ClassicOutput cpuDouble = classicFfd(sffd::testing::cpuBackend(), mesh, P, {false, true});
+    ClassicOutput cpuStrictFloat = classicFfd(sffd::testing::cpuBackend(), mesh, P, {true, false});
 
     // Fast float kernels against the double reference: 64 ulp or 2e-6 of the largest value.
-    expectClose(classicFfdGpu(*b.gpu, mesh, P, {false, false}), cpuDouble, true, {false, 64, 2e-6}, "fast float");
+    expectClose(classicFfd(*b.backend, mesh, P, {false, false}), cpuDouble, true, {false, 64, 2e-6}, "fast float");
     // Strict float kernels: bit-identical to the C++ reference's float path.
-    expectClose(classicFfdGpu(*b.gpu, mesh, P, {true, false}), cpuStrictFloat, true, {true, 0, 0}, "strict float");
+    expectClose(classicFfd(*b.backend, mesh, P, {true, false}), cpuStrictFloat, true, {true, 0, 0}, "strict float");
     if (b.info.limits.float64) {
       // Double kernels: within 1e-12 of the largest value; strict: bit-identical to the double reference.
-      expectClose(classicFfdGpu(*b.gpu, mesh, P, {false, true}), cpuDouble, false, {false, 0, 1e-12}, "fast double");
-      expectClose(classicFfdGpu(*b.gpu, mesh, P, {true, true}), cpuDouble, false, {true, 0, 0}, "strict double");
+      expectClose(classicFfd(*b.backend, mesh, P, {false, true}), cpuDouble, false, {false, 0, 1e-12}, "fast double");
+      expectClose(classicFfd(*b.backend, mesh, P, {true, true}), cpuDouble, false, {true, 0, 0}, "strict double");
     }
   }
   EXPECT_EQ(vk::validationMessageCount(), 0u);
@@ -88,9 +89,9 @@ TEST_P(ClassicConformance, ChunkedJobEqualsOneDispatch) {
   OpenedBackend b = open(GetParam());
   Mesh mesh = sphereMesh(30, 50, 0.9);
   PackedLattice P = packLattice(deformedLattice(OutsideMode::Extrapolate));
-  ClassicOutput whole = classicFfdGpu(*b.gpu, mesh, P, {true, false});
+  ClassicOutput whole = classicFfd(*b.backend, mesh, P, {true, false});
   setenv("SFFD_MAX_CHUNK_VERTICES", "97", 1);   // many small chunks, last one partial
-  ClassicOutput chunked = classicFfdGpu(*b.gpu, mesh, P, {true, false});
+  ClassicOutput chunked = classicFfd(*b.backend, mesh, P, {true, false});
   unsetenv("SFFD_MAX_CHUNK_VERTICES");
   EXPECT_EQ(whole.positions, chunked.positions);
   EXPECT_EQ(whole.normals, chunked.normals);
@@ -100,7 +101,7 @@ TEST_P(ClassicConformance, IdentityLatticeLeavesVerticesAndNormals) {
   OpenedBackend b = open(GetParam());
   Mesh mesh = sphereMesh(20, 32, 0.95);
   PackedLattice P = packLattice(makeIdentityLattice({-1, -1, -1}, {1, 1, 1}, {5, 5, 5}, {2, 2, 2}));
-  ClassicOutput out = classicFfdGpu(*b.gpu, mesh, P, {false, false});
+  ClassicOutput out = classicFfd(*b.backend, mesh, P, {false, false});
   for (size_t v = 0; v < mesh.positions.size(); ++v) {
     EXPECT_NEAR(glm::length(glm::dvec3(out.positions[4 * v], out.positions[4 * v + 1], out.positions[4 * v + 2]) - mesh.positions[v]), 0, 1e-6);
     EXPECT_NEAR(glm::length(glm::dvec3(out.normals[4 * v], out.normals[4 * v + 1], out.normals[4 * v + 2]) - mesh.normals[v]), 0, 1e-6);
@@ -112,19 +113,19 @@ TEST_P(ClassicConformance, PnKernelAgreesWithCpuReference) {
   for (const char* file : {"/cube2.obj", "/torus.obj"}) {
     SCOPED_TRACE(file);
     PreparedMesh P = prepareMesh(readMesh(std::string(SFFD_TEST_DATA) + file));
-    PnOutput cpuDouble = pnTrianglesCpu(P, {false, true}), cpuFloat = pnTrianglesCpu(P, {true, false});
+    PnOutput cpuDouble = pnTriangles(sffd::testing::cpuBackend(), P, {false, true}), cpuFloat = pnTriangles(sffd::testing::cpuBackend(), P, {true, false});
     // Fast kernels against the C++ float path: the same float inputs, so the ill-conditioned spots
     // (normals of very short edges) agree too; the double reference would differ there by 1e-4.
-    CompareResult fast = compareBuffers(pnTrianglesGpu(*b.gpu, P, {false, false}).records, cpuFloat.records, true, {false, 64, 2e-6});
+    CompareResult fast = compareBuffers(pnTriangles(*b.backend, P, {false, false}).records, cpuFloat.records, true, {false, 64, 2e-6});
     EXPECT_EQ(fast.mismatched, 0u) << "fast float: max_abs " << fast.maxAbs << " max_ulp " << fast.maxUlp;
-    CompareResult strict = compareBuffers(pnTrianglesGpu(*b.gpu, P, {true, false}).records, cpuFloat.records, true, {true, 0, 0});
+    CompareResult strict = compareBuffers(pnTriangles(*b.backend, P, {true, false}).records, cpuFloat.records, true, {true, 0, 0});
     EXPECT_EQ(strict.mismatched, 0u) << "strict float: max_abs " << strict.maxAbs << " max_ulp " << strict.maxUlp;
     setenv("SFFD_MAX_CHUNK_TRIANGLES", "1000", 1);   // several chunks, the last one partial
-    CompareResult chunked = compareBuffers(pnTrianglesGpu(*b.gpu, P, {true, false}).records, cpuFloat.records, true, {true, 0, 0});
+    CompareResult chunked = compareBuffers(pnTriangles(*b.backend, P, {true, false}).records, cpuFloat.records, true, {true, 0, 0});
     unsetenv("SFFD_MAX_CHUNK_TRIANGLES");
     EXPECT_EQ(chunked.mismatched, 0u);
     if (b.info.limits.float64) {
-      CompareResult d = compareBuffers(pnTrianglesGpu(*b.gpu, P, {true, true}).records, cpuDouble.records, false, {true, 0, 0});
+      CompareResult d = compareBuffers(pnTriangles(*b.backend, P, {true, true}).records, cpuDouble.records, false, {true, 0, 0});
       EXPECT_EQ(d.mismatched, 0u) << "strict double";
     }
   }
@@ -139,20 +140,20 @@ TEST_P(ClassicConformance, ClipKernelsAgreeWithCpuReference) {
     PreparedMesh P = prepareMesh(m);
     ClipTriangles C = buildClipTriangles(m, l, splitPatternTable().nmax());
     for (KernelVariant v : {KernelVariant{true, false}, KernelVariant{false, false}}) {
-      PnOutput pn = pnTrianglesCpu(P, {true, false});   // the same PN input for both sides
-      SubTriangleRecords cpu = regularClipCpu(P, pn, C, l, {true, false});
-      SubTriangleRecords gpu = regularClipGpu(*b.gpu, P, pn, C, l, v);
+      PnOutput pn = pnTriangles(sffd::testing::cpuBackend(), P, {true, false});   // the same PN input for both sides
+      SubTriangleRecords cpu = regularClip(sffd::testing::cpuBackend(), P, pn, C, l, {true, false});
+      SubTriangleRecords gpu = regularClip(*b.backend, P, pn, C, l, v);
       ASSERT_EQ(gpu.headers, cpu.headers) << "sub-triangle topology differs (strict " << v.strict << ")";
       CompareTolerance tol = v.strict ? CompareTolerance{true, 0, 0} : CompareTolerance{false, 64, 2e-6};
       CompareResult r = compareBuffers(gpu.records, cpu.records, true, tol);
       EXPECT_EQ(r.mismatched, 0u) << "strict " << v.strict << ": max_abs " << r.maxAbs << " max_ulp " << r.maxUlp;
     }
     // Written in several chunks, the output is the same.
-    PnOutput pn = pnTrianglesCpu(P, {true, false});
+    PnOutput pn = pnTriangles(sffd::testing::cpuBackend(), P, {true, false});
     setenv("SFFD_MAX_CHUNK_SUBTRIANGLES", "777", 1);
-    SubTriangleRecords chunked = regularClipGpu(*b.gpu, P, pn, C, l, {true, false});
+    SubTriangleRecords chunked = regularClip(*b.backend, P, pn, C, l, {true, false});
     unsetenv("SFFD_MAX_CHUNK_SUBTRIANGLES");
-    EXPECT_EQ(chunked.records, regularClipCpu(P, pn, C, l, {true, false}).records);
+    EXPECT_EQ(chunked.records, regularClip(sffd::testing::cpuBackend(), P, pn, C, l, {true, false}).records);
   }
   EXPECT_EQ(vk::validationMessageCount(), 0u);
 }
@@ -161,26 +162,26 @@ TEST_P(ClassicConformance, SmoothDeformKernelAgreesWithCpuReference) {
   OpenedBackend b = open(GetParam());
   Mesh m = readMesh(std::string(SFFD_TEST_DATA) + "/cube2.obj");
   PreparedMesh P = prepareMesh(m);
-  PnOutput pn = pnTrianglesCpu(P, {true, false});
+  PnOutput pn = pnTriangles(sffd::testing::cpuBackend(), P, {true, false});
   double l = 0.5;
-  SubTriangleRecords subs = regularClipCpu(P, pn, buildClipTriangles(m, l, splitPatternTable().nmax()), l, {true, false});
+  SubTriangleRecords subs = regularClip(sffd::testing::cpuBackend(), P, pn, buildClipTriangles(m, l, splitPatternTable().nmax()), l, {true, false});
   PackedLattice L = packLattice(deformedLattice(OutsideMode::Extrapolate));
   FitTable fit = makeFitTable(6);
-  SmoothOutput cpu = smoothDeformCpu(L, subs, fit, 10, {true, false});
+  SmoothOutput cpu = smoothDeform(sffd::testing::cpuBackend(), L, subs, fit, 10, {true, false});
   for (KernelVariant v : {KernelVariant{true, false}, KernelVariant{false, false}}) {
-    SmoothOutput gpu = smoothDeformGpu(*b.gpu, L, subs, fit, 10, v);
+    SmoothOutput gpu = smoothDeform(*b.backend, L, subs, fit, 10, v);
     CompareTolerance tol = v.strict ? CompareTolerance{true, 0, 0} : CompareTolerance{false, 64, 2e-6};
     CompareResult p = compareBuffers(gpu.patches, cpu.patches, true, tol), t = compareBuffers(gpu.tess, cpu.tess, true, tol);
     EXPECT_EQ(p.mismatched, 0u) << "patches, strict " << v.strict << ": max_abs " << p.maxAbs << " max_ulp " << p.maxUlp;
     EXPECT_EQ(t.mismatched, 0u) << "tessellation, strict " << v.strict << ": max_abs " << t.maxAbs << " max_ulp " << t.maxUlp;
   }
   // The split form (one dispatch per step) gives the fused kernel's output, bit for bit in strict mode.
-  SmoothOutput split = smoothDeformGpu(*b.gpu, L, subs, fit, 10, {true, false}, /*split=*/true);
+  SmoothOutput split = smoothDeform(*b.backend, L, subs, fit, 10, {true, false}, /*split=*/true);
   EXPECT_EQ(split.patches, cpu.patches);
   EXPECT_EQ(split.tess, cpu.tess);
   EXPECT_EQ(split.timings.size(), 4u);
   setenv("SFFD_MAX_CHUNK_SUBTRIANGLES", "50", 1);
-  SmoothOutput chunked = smoothDeformGpu(*b.gpu, L, subs, fit, 10, {true, false});
+  SmoothOutput chunked = smoothDeform(*b.backend, L, subs, fit, 10, {true, false});
   unsetenv("SFFD_MAX_CHUNK_SUBTRIANGLES");
   EXPECT_EQ(chunked.tess, cpu.tess);
   EXPECT_EQ(vk::validationMessageCount(), 0u);
@@ -193,7 +194,7 @@ TEST(CrossApi, GlAndVulkanFastKernelsAgreeWithinUlpBound) {
   OpenedBackend vkb = open("vulkan"), glb = open("gl");
   Mesh mesh = sphereMesh(40, 64, 1.0);
   PackedLattice P = packLattice(deformedLattice(OutsideMode::Extrapolate));
-  expectClose(classicFfdGpu(*vkb.gpu, mesh, P, {false, false}), classicFfdGpu(*glb.gpu, mesh, P, {false, false}), true,
+  expectClose(classicFfd(*vkb.backend, mesh, P, {false, false}), classicFfd(*glb.backend, mesh, P, {false, false}), true,
               {false, 64, 1e-6}, "GL vs Vulkan fast float");
 }
 

@@ -1,6 +1,7 @@
-// The GPU backend interface: the small surface every compute API implements (src/vk, src/gl).
-// Plain buffers, named kernels from the embedded registry, explicit barriers and per-dispatch
-// timestamps. Pipelines (src/core/*_pipeline.cpp) are written once against this interface.
+// The backend interface: the small surface every compute backend implements (src/backends/vulkan,
+// opengl, and cpu, which runs the kernels' C++ entries on the host). Plain buffers, named kernels from the
+// embedded registry, explicit barriers and per-dispatch timestamps. Pipelines (kernels/<stage>/*.cpp,
+// src/pipelines) are written once against this interface; backend_contract_test.cc checks it.
 #pragma once
 #include <cstddef>
 #include <cstdint>
@@ -42,7 +43,7 @@ struct Dispatch {
 
 struct DispatchTiming {
   std::string label;
-  double gpuMs = -1;   // from timestamp queries; -1 when the device has none
+  double gpuMs = -1;   // from timestamp queries (the CPU backend: the dispatch's wall time); -1 when the device has none
 };
 
 class Backend {

@@ -1,6 +1,6 @@
-// DeformSession (the device-resident path of view and bench) on every GPU backend against the CPU
-// reference in the strict variant: bit-identical records and output, across re-deforms, chunking,
-// the split kernels and knot-box clipping.
+// DeformSession (the device-resident path of deform, view and bench) on every backend, the CPU one
+// included, against the stages run one by one on the CPU backend in the strict variant: bit-identical
+// records and output, across re-deforms, chunking, the split kernels and knot-box clipping.
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -33,19 +33,20 @@ Lattice latticeFor(const Mesh& m, unsigned seed, double amount) {
   return L;
 }
 
-// The CPU reference of the whole smooth job in the strict float order.
+// The whole smooth job stage by stage on the CPU backend, in the strict float order.
 struct Reference {
   SubTriangleRecords subs;
   SmoothOutput out;
 };
 Reference reference(const Mesh& m, const Lattice& L, const DeformSessionOptions& o) {
   const KernelVariant strict{true, false};
+  Backend& cpu = sffd::testing::cpuBackend();
   PreparedMesh P = prepareMesh(m);
-  PnOutput pn = pnTrianglesCpu(P, strict);
+  PnOutput pn = pnTriangles(cpu, P, strict);
   Reference r;
   r.subs = o.knotBoxClip ? recordsFromSubTriangles(P, pn, clipAgainstKnotBoxes(m, L), strict)
-                         : regularClipCpu(P, pn, buildClipTriangles(m, o.edgeLength, splitPatternTable().nmax()), o.edgeLength, strict);
-  r.out = smoothDeformCpu(packLattice(L), r.subs, makeFitTable(6), o.level, strict);
+                         : regularClip(cpu, P, pn, buildClipTriangles(m, o.edgeLength, splitPatternTable().nmax()), o.edgeLength, strict);
+  r.out = smoothDeform(cpu, packLattice(L), r.subs, makeFitTable(6), o.level, strict);
   return r;
 }
 
@@ -64,7 +65,7 @@ TEST_P(DeformSessionTest, StrictSessionEqualsCpuReferenceAcrossRedeforms) {
     o.variant = {true, false};
     o.edgeLength = l;
     o.level = 4;
-    DeformSession s(*b.gpu, m, A, o);
+    DeformSession s(*b.backend, m, A, o);
     Reference ra = reference(m, A, o), rb = reference(m, B, o);
     ASSERT_EQ(s.subTriangles(), ra.subs.size());
     SubTriangleRecords recs = s.records();
@@ -96,7 +97,7 @@ TEST_P(DeformSessionTest, ChunkedSplitAndKnotBoxSessionsEqualCpuReference) {
   Reference ra = reference(m, A, o);
   setenv("SFFD_MAX_CHUNK_SUBTRIANGLES", "97", 1);
   {
-    DeformSession s(*b.gpu, m, A, o);
+    DeformSession s(*b.backend, m, A, o);
     EXPECT_GT(s.chunks().size(), 2u);
     s.deform(A);
     EXPECT_EQ(s.output().tess, ra.out.tess);
@@ -104,7 +105,7 @@ TEST_P(DeformSessionTest, ChunkedSplitAndKnotBoxSessionsEqualCpuReference) {
   unsetenv("SFFD_MAX_CHUNK_SUBTRIANGLES");
   o.split = true;
   {
-    DeformSession s(*b.gpu, m, A, o);
+    DeformSession s(*b.backend, m, A, o);
     const SessionTimings& t = s.deform(A);
     EXPECT_EQ(t.dispatches.size(), 4u);
     EXPECT_EQ(s.output().patches, ra.out.patches);
@@ -112,7 +113,7 @@ TEST_P(DeformSessionTest, ChunkedSplitAndKnotBoxSessionsEqualCpuReference) {
   o.split = false;
   o.knotBoxClip = true;
   Reference rk = reference(m, A, o);
-  DeformSession k(*b.gpu, m, A, o);
+  DeformSession k(*b.backend, m, A, o);
   k.deform(A);
   EXPECT_EQ(k.subTriangles(), rk.subs.size());
   EXPECT_EQ(k.output().tess, rk.out.tess);
@@ -135,7 +136,7 @@ TEST_P(DeformSessionTest, LatticeTooLargeToInlineGivesTheSameOutput) {
   o.variant = {true, false};
   o.edgeLength = 0.3;
   o.level = 3;
-  DeformSession s(*b.gpu, m, big, o);
+  DeformSession s(*b.backend, m, big, o);
   s.deform(big);
   EXPECT_EQ(s.output().tess, reference(m, big, o).out.tess);
   EXPECT_EQ(vk::validationMessageCount(), 0u);
@@ -145,7 +146,7 @@ TEST_P(DeformSessionTest, RefusesALatticeOfAnotherStructureAndBadOptions) {
   OpenedBackend b = open();
   Mesh m = readMesh(std::string(SFFD_TEST_DATA) + "/cube2.obj");
   Lattice A = latticeFor(m, 1, 0.1);
-  DeformSession s(*b.gpu, m, A, {});
+  DeformSession s(*b.backend, m, A, {});
   Lattice other = makeIdentityLattice({-1, -1, -1}, {1, 1, 1}, {4, 5, 5}, {2, 2, 2});
   try {
     s.deform(other);
@@ -155,10 +156,10 @@ TEST_P(DeformSessionTest, RefusesALatticeOfAnotherStructureAndBadOptions) {
   }
   DeformSessionOptions bad;
   bad.edgeLength = 0;
-  EXPECT_THROW(DeformSession(*b.gpu, m, A, bad), Error);
+  EXPECT_THROW(DeformSession(*b.backend, m, A, bad), Error);
   bad.edgeLength = 0.2;
   bad.level = 65;
-  EXPECT_THROW(DeformSession(*b.gpu, m, A, bad), Error);
+  EXPECT_THROW(DeformSession(*b.backend, m, A, bad), Error);
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, DeformSessionTest, ::testing::ValuesIn(sffd::testing::requiredBackends()),

@@ -1,5 +1,6 @@
 // Tests of the OpenGL compute driver and its context providers (EGL surfaceless, OSMesa, GLFW) on
 // Mesa's llvmpipe. No X display is needed except for the GLFW test, which is skipped without one.
+// What every backend must do is checked in ../backend_contract_test.cc.
 #include <dlfcn.h>
 #include <gtest/gtest.h>
 
@@ -12,7 +13,6 @@
 #include <string>
 #include <vector>
 
-#include "kernels/classic/classic_ffd.h"
 #include <sffd/error.h>
 #include "backends/opengl/gl_backend.h"
 #include "backends/opengl/gl_context.h"
@@ -198,186 +198,6 @@ TEST_P(GlProviderTest, ContextIsCore43AndInfoIsFilled) {
               info.name.c_str(), info.driver.c_str(), (unsigned long long)info.limits.maxStorageBufferRange,
               (unsigned long long)info.limits.storageOffsetAlignment, info.limits.maxWorkGroupCount[0],
               int(info.limits.timestamps));
-}
-
-TEST_P(GlProviderTest, BufferRoundTripWithOffsets) {
-  auto b = open(GetParam());
-  const uint64_t n = 1000;
-  BufferId id = b->createBuffer(n);
-  std::vector<uint8_t> data(n), back(n, 0xEE);
-  for (uint64_t i = 0; i < n; ++i) data[i] = uint8_t(i * 7 + 3);
-  b->upload(id, 0, data.data(), n);
-  b->download(id, 0, back.data(), n);
-  EXPECT_EQ(back, data);
-  // Partial writes at unaligned offsets, partial reads.
-  std::vector<uint8_t> patch(37, 0x5A);
-  b->upload(id, 101, patch.data(), patch.size());
-  for (size_t i = 0; i < patch.size(); ++i) data[101 + i] = 0x5A;
-  std::vector<uint8_t> mid(300);
-  b->download(id, 77, mid.data(), mid.size());
-  EXPECT_TRUE(std::equal(mid.begin(), mid.end(), data.begin() + 77));
-  b->download(id, n - 1, mid.data(), 1);
-  EXPECT_EQ(mid[0], data[n - 1]);
-  // Out of range and unknown buffers are internal errors.
-  EXPECT_THROW(b->upload(id, n - 10, patch.data(), 11), Error);
-  EXPECT_THROW(b->download(id, n + 1, mid.data(), 0), Error);
-  EXPECT_THROW(b->download(9999, 0, mid.data(), 1), Error);
-  b->destroyBuffer(id);
-  // A zero-sized buffer exists and can be destroyed.
-  BufferId empty = b->createBuffer(0);
-  b->download(empty, 0, mid.data(), 0);
-  b->destroyBuffer(empty);
-}
-
-TEST_P(GlProviderTest, ClassicIdentityAllVariants) {
-  auto b = open(GetParam());
-  expectIdentity<float>(*b, {false, false}, 1e-6);
-  expectIdentity<float>(*b, {true, false}, 1e-6);
-  expectIdentity<double>(*b, {false, true}, 1e-14);
-  expectIdentity<double>(*b, {true, true}, 1e-14);
-}
-
-TEST_P(GlProviderTest, StorageBindingsAtOffsets) {
-  // The vertices live in the middle of larger buffers, bound with an aligned offset and a size.
-  auto b = open(GetParam());
-  const uint64_t align = b->info().limits.storageOffsetAlignment;
-  HandLattice<float> L;
-  std::vector<float> pos, nrm;
-  makeVertices<float>(100, 100, pos, nrm);
-  const uint64_t bytes = pos.size() * sizeof(float), off = 3 * align;
-  BufferId frame = b->createBuffer(L.frame.size() * 4), coeffs = b->createBuffer(L.coeffs.size() * 4);
-  b->upload(frame, 0, L.frame.data(), L.frame.size() * 4);
-  b->upload(coeffs, 0, L.coeffs.data(), L.coeffs.size() * 4);
-  BufferId big = b->createBuffer(off + 4 * bytes + 4 * align);
-  uint64_t at[4];
-  for (int k = 0; k < 4; ++k) at[k] = off + k * (bytes + align - 1) / align * align;
-  b->upload(big, at[0], pos.data(), bytes);
-  b->upload(big, at[1], nrm.data(), bytes);
-  gpu::ClassicParams params;
-  params.lattice = L.params;
-  params.range = {0, 100, 0, 0};
-  Dispatch d;
-  d.kernel = "classic_ffd";
-  d.variant = {true, false};
-  d.params = &params;
-  d.paramsSize = sizeof params;
-  d.buffers = {{SFFD_BINDING_LATTICE_COEFFS, coeffs}, {SFFD_BINDING_LATTICE_FRAME, frame},
-               {SFFD_BINDING_CLASSIC_POS_IN, big, at[0], bytes},  {SFFD_BINDING_CLASSIC_NRM_IN, big, at[1], bytes},
-               {SFFD_BINDING_CLASSIC_POS_OUT, big, at[2], bytes}, {SFFD_BINDING_CLASSIC_NRM_OUT, big, at[3], bytes}};
-  gridFor(100, b->info().limits, d.groups);
-  b->dispatch(d);
-  b->barrier();
-  std::vector<float> out(pos.size());
-  b->download(big, at[2], out.data(), bytes);
-  for (size_t i = 0; i < 100; ++i)
-    for (int k = 0; k < 3; ++k) ASSERT_NEAR(out[4 * i + k], pos[4 * i + k], 1e-6);
-  // A misaligned offset, a range past the end, a slot out of range, too many groups, a short
-  // parameter block and an unknown kernel are internal errors.
-  auto expectInternal = [&](Dispatch bad) {
-    try {
-      b->dispatch(bad);
-      ADD_FAILURE() << "dispatch accepted";
-    } catch (const Error& e) {
-      EXPECT_EQ(e.kind(), ErrorKind::Internal) << e.what();
-    }
-  };
-  if (align > 1) {
-    Dispatch bad = d;
-    bad.buffers[2].offset = at[0] + 4;
-    expectInternal(bad);
-  }
-  {
-    Dispatch bad = d;
-    bad.buffers[2].size = 100 * bytes;
-    expectInternal(bad);
-  }
-  {
-    Dispatch bad = d;
-    bad.buffers[0].slot = SFFD_MAX_STORAGE_BINDINGS + 1;
-    expectInternal(bad);
-  }
-  {
-    Dispatch bad = d;
-    bad.groups[0] = b->info().limits.maxWorkGroupCount[0] + 1;
-    expectInternal(bad);
-  }
-  {
-    Dispatch bad = d;
-    bad.paramsSize = 16;
-    expectInternal(bad);
-  }
-  {
-    Dispatch bad = d;
-    bad.kernel = "no_such_kernel";
-    expectInternal(bad);
-  }
-  b->takeTimings();
-}
-
-TEST_P(GlProviderTest, DispatchBeyond65535GroupsViaGridFor) {
-  auto b = open(GetParam());
-  // 65535 groups of 64 and then three more groups: a 2-D grid of 65535 x 2.
-  const size_t n = size_t(SFFD_MAX_GROUPS_X) * SFFD_LOCAL_SIZE + 3 * SFFD_LOCAL_SIZE - 5;
-  HandLattice<float> L;
-  std::vector<float> pos(4 * n), nrm(4 * n);
-  for (size_t i = 0; i < n; ++i) {
-    // Distinct points on a 256 x 256 x 64 grid inside the box, exactly representable.
-    pos[4 * i + 0] = float(i % 256) / 256.0f;
-    pos[4 * i + 1] = float((i / 256) % 256) / 256.0f;
-    pos[4 * i + 2] = float((i / 65536) % 64) / 64.0f;
-    pos[4 * i + 3] = 1;
-    nrm[4 * i + 2] = 1;
-  }
-  ClassicRun<float> r = runClassic(*b, {false, false}, L, pos, nrm);
-  EXPECT_LE(r.groups[0], 65535u);
-  EXPECT_EQ(r.groups[1], 2u);   // more than 65535 groups of work: a second row of groups is needed
-  EXPECT_GE(uint64_t(r.groups[0]) * r.groups[1] * SFFD_LOCAL_SIZE, n);
-  ASSERT_EQ(r.timings.size(), 1u);
-  std::printf("%s: %zu vertices, 2 rows of groups: %.1f ms by timestamps, %.1f ms wall with downloads\n",
-              b->info().provider.c_str(), n, r.timings[0].gpuMs, r.wallMs);
-  if (b->info().limits.timestamps) {
-    EXPECT_GT(r.timings[0].gpuMs, 0.0);
-    EXPECT_LE(r.timings[0].gpuMs, r.wallMs);
-  }
-  size_t bad = 0;
-  for (size_t i = 0; i < n; ++i) {
-    bool ok = std::abs(r.pos[4 * i] - pos[4 * i]) <= 1e-6f && std::abs(r.pos[4 * i + 1] - pos[4 * i + 1]) <= 1e-6f &&
-              std::abs(r.pos[4 * i + 2] - pos[4 * i + 2]) <= 1e-6f && r.pos[4 * i + 3] == 1.0f &&
-              r.nrm[4 * i + 2] == 1.0f;
-    if (!ok && bad++ < 5) ADD_FAILURE() << "vertex " << i << " of " << n << " not written or wrong";
-  }
-  EXPECT_EQ(bad, 0u);
-}
-
-TEST_P(GlProviderTest, StrictMatchesCpuReferenceBitForBit) {
-  // The strict kernels and the C++ reference (built with -ffp-contract=off) round alike.
-  auto b = open(GetParam());
-  HandLattice<double> L(true);
-  PackedLattice P;
-  P.params = L.params;
-  P.frame = L.frame;
-  P.coeffs = L.coeffs;
-  std::vector<double> pos, nrm;
-  makeVertices<double>(500, 400, pos, nrm, 11);
-  Mesh mesh;
-  for (size_t i = 0; i < 500; ++i) {
-    mesh.positions.push_back({pos[4 * i], pos[4 * i + 1], pos[4 * i + 2]});
-    mesh.normals.push_back({nrm[4 * i], nrm[4 * i + 1], nrm[4 * i + 2]});
-  }
-  for (bool f64 : {false, true}) {
-    KernelVariant v{true, f64};
-    ClassicOutput gpu = classicFfdGpu(*b, mesh, P, v), cpu = classicFfdCpu(mesh, P, v);
-    size_t diff = 0;
-    for (size_t i = 0; i < gpu.positions.size(); ++i) {
-      if (std::memcmp(&gpu.positions[i], &cpu.positions[i], sizeof(double)) != 0 ||
-          std::memcmp(&gpu.normals[i], &cpu.normals[i], sizeof(double)) != 0) {
-        if (diff++ < 5)
-          ADD_FAILURE() << (f64 ? "f64" : "f32") << " value " << i << ": gpu " << gpu.positions[i] << "/"
-                        << gpu.normals[i] << " cpu " << cpu.positions[i] << "/" << cpu.normals[i];
-      }
-    }
-    EXPECT_EQ(diff, 0u) << (f64 ? "f64" : "f32");
-  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Headless, GlProviderTest, ::testing::Values(Provider::EGL, Provider::OSMesa),

@@ -1,5 +1,6 @@
 // Tests of the Vulkan driver on whatever device the machine has (lavapipe in CI), with the
-// validation layer on: every test ends with no validation message.
+// validation layer on: every test ends with no validation message. What every backend must do is
+// checked in ../backend_contract_test.cc, the staging path of discrete GPUs included.
 #include "backends/vulkan/vk_backend.h"
 
 #include <gtest/gtest.h>
@@ -198,71 +199,11 @@ TEST_F(VkBackendTest, PicksDeviceBySubstring) {
   EXPECT_EQ(errorKindOf([] { vk::createBackend({"no such device 42"}); }), ErrorKind::Device);
 }
 
-// Upload and download with offsets, on mapped memory and through staging buffers (the path of
-// discrete GPUs, forced by SFFD_VK_STAGING=1).
-TEST_F(VkBackendTest, BufferRoundTrip) {
-  for (const char* staging : {"0", "1"}) {
-    SCOPED_TRACE(std::string("SFFD_VK_STAGING=") + staging);
-    ScopedEnv env("SFFD_VK_STAGING", staging);
-    auto gpu = vk::createBackend({});
-    const size_t n = 1 << 18;
-    std::vector<uint32_t> data(n);
-    for (size_t i = 0; i < n; ++i) data[i] = uint32_t(i * 2654435761u);
-    BufferId a = gpu->createBuffer(n * 4);
-    BufferId b = gpu->createBuffer(100);
-    EXPECT_NE(a, 0u);
-    EXPECT_NE(a, b);
-    gpu->upload(a, 0, data.data(), n * 4);
-    std::vector<uint32_t> patch = {1, 2, 3, 4, 5};
-    gpu->upload(a, 4000, patch.data(), patch.size() * 4);
-    std::copy(patch.begin(), patch.end(), data.begin() + 1000);
-
-    std::vector<uint32_t> all(n), part(7);
-    gpu->download(a, 0, all.data(), n * 4);
-    EXPECT_EQ(all, data);
-    gpu->download(a, 3996, part.data(), part.size() * 4);
-    EXPECT_EQ(part, std::vector<uint32_t>(data.begin() + 999, data.begin() + 1006));
-
-    gpu->destroyBuffer(a);
-    BufferId c = gpu->createBuffer(16);   // ids are reused
-    EXPECT_EQ(c, a);
-    EXPECT_EQ(errorKindOf([&] { gpu->download(b, 96, part.data(), 8); }), ErrorKind::Internal);   // overrun
-    EXPECT_EQ(errorKindOf([&] { gpu->upload(12345, 0, part.data(), 4); }), ErrorKind::Internal);   // bad id
-    gpu->destroyBuffer(b);
-    gpu->destroyBuffer(c);
-  }
-}
-
 template <typename T>
 void runIdentity(Backend& gpu, KernelVariant variant, double tol) {
   ClassicJob<T> job(gpu, 1000);
   job.dispatch(variant, 0, 1000, job.posIn, job.posOut);
   job.expectIdentity(0, 1000, tol);
-}
-
-// classic_ffd in its four variants on the identity lattice.
-TEST_F(VkBackendTest, ClassicFfdIdentityAllVariants) {
-  for (const char* staging : {"0", "1"}) {
-    ScopedEnv env("SFFD_VK_STAGING", staging);
-    auto gpu = vk::createBackend({});
-    for (bool f64 : {false, true})
-      for (bool strict : {false, true}) {
-        SCOPED_TRACE(std::string("staging ") + staging + ", strict " + std::to_string(strict) + ", f64 " +
-                     std::to_string(f64));
-        KernelVariant v{strict, f64};
-        if (f64 && !gpu->info().limits.float64) {
-          EXPECT_EQ(errorKindOf([&] { runIdentity<double>(*gpu, v, 0); }), ErrorKind::Device);
-          continue;
-        }
-        if (f64)
-          runIdentity<double>(*gpu, v, 1e-12);
-        else
-          runIdentity<float>(*gpu, v, 1e-6);
-      }
-    std::vector<DispatchTiming> t = gpu->takeTimings();
-    EXPECT_EQ(t.size(), gpu->info().limits.float64 ? 4u : 2u);
-    EXPECT_TRUE(gpu->takeTimings().empty());
-  }
 }
 
 // A device without shaderFloat64 (simulated with SFFD_VK_DISABLE_F64=1) refuses f64 kernels with a
@@ -274,97 +215,6 @@ TEST_F(VkBackendTest, RefusesF64WithoutShaderFloat64) {
   EXPECT_EQ(errorKindOf([&] { runIdentity<double>(*gpu, {false, true}, 0); }), ErrorKind::Device);
   EXPECT_EQ(errorKindOf([&] { runIdentity<double>(*gpu, {true, true}, 0); }), ErrorKind::Device);
   runIdentity<float>(*gpu, {true, false}, 1e-6);
-}
-
-TEST_F(VkBackendTest, UnknownKernelIsInternalError) {
-  auto gpu = vk::createBackend({});
-  Dispatch d;
-  d.kernel = "no_such_kernel";
-  EXPECT_EQ(errorKindOf([&] { gpu->dispatch(d); }), ErrorKind::Internal);
-  gpu->finish();
-}
-
-// Recorded work runs in order: an upload after a dispatch does not change what the dispatch read,
-// a barrier orders dependent dispatches, and download sees everything without an explicit finish.
-TEST_F(VkBackendTest, OrdersUploadsDispatchesAndDownloads) {
-  for (const char* staging : {"0", "1"}) {
-    SCOPED_TRACE(std::string("SFFD_VK_STAGING=") + staging);
-    ScopedEnv env("SFFD_VK_STAGING", staging);
-    auto gpu = vk::createBackend({});
-    const size_t n = 5000;
-    ClassicJob<float> job(*gpu, n);
-    BufferId second = gpu->createBuffer(job.bytes()), third = gpu->createBuffer(job.bytes());
-    job.dispatch({}, 0, n, job.posIn, job.posOut);   // posOut = pos
-    std::vector<float> shifted = job.pos;
-    for (size_t i = 0; i < 4 * n; i += 4) shifted[i] = 0.5f * shifted[i];
-    gpu->upload(job.posIn, 0, shifted.data(), shifted.size() * sizeof(float));
-    job.dispatch({}, 0, n, job.posIn, second);   // second = shifted
-    gpu->barrier();
-    job.dispatch({}, 0, n, second, third);       // third = second, after the barrier
-    job.expectIdentity(0, n, 1e-6);
-    std::vector<float> s = job.download(second, 0, n), t = job.download(third, 0, n);
-    for (size_t i = 0; i < 4 * n; ++i) {
-      ASSERT_NEAR(s[i], shifted[i], 1e-6) << i;
-      ASSERT_NEAR(t[i], shifted[i], 1e-6) << i;
-    }
-    gpu->destroyBuffer(second);
-    gpu->destroyBuffer(third);
-  }
-}
-
-// Many chunked dispatches in one submission (more than one descriptor pool, query pool and
-// parameter chunk), each with its own parameter block, and one timing record per dispatch.
-TEST_F(VkBackendTest, ManyDispatchesInOneSubmission) {
-  auto gpu = vk::createBackend({});
-  const uint32_t chunks = 700, chunk = 64;
-  ClassicJob<float> job(*gpu, chunks * chunk);
-  for (uint32_t c = 0; c < chunks; ++c)
-    job.dispatch({}, c * chunk, chunk, job.posIn, job.posOut, c == 0 ? "first chunk" : "");
-  gpu->finish();
-  job.expectIdentity(0, chunks * chunk, 1e-6);
-  std::vector<DispatchTiming> t = gpu->takeTimings();
-  ASSERT_EQ(t.size(), chunks);
-  EXPECT_EQ(t.front().label, "first chunk");
-  EXPECT_EQ(t.back().label, "classic_ffd");
-  for (const DispatchTiming& d : t) EXPECT_EQ(d.gpuMs >= 0, gpu->info().limits.timestamps);
-}
-
-// A 1-D job too large for one grid row: 4.2M vertices need 65625 groups of 64 threads.
-TEST_F(VkBackendTest, LargeJobUsesTwoDimensionalGrid) {
-  auto gpu = vk::createBackend({});
-  const uint32_t n = 4200000;
-  uint32_t groups[3];
-  gridFor(n, gpu->info().limits, groups);
-  EXPECT_GT(groups[1], 1u);
-  EXPECT_GE(uint64_t(groups[0]) * groups[1] * SFFD_LOCAL_SIZE, n);
-  ClassicJob<float> job(*gpu, n);
-  job.dispatch({}, 0, 64, job.posIn, job.posOut, "warm-up");   // compiles the kernel (llvmpipe JITs at first use)
-  gpu->finish();
-  gpu->takeTimings();
-  job.dispatch({}, 0, n, job.posIn, job.posOut, "large");
-  job.expectIdentity(0, 1000, 1e-6);
-  job.expectIdentity(n - 70000, 70000, 1e-6);   // the vertices in the second grid row
-  std::vector<DispatchTiming> t = gpu->takeTimings();
-  ASSERT_EQ(t.size(), 1u);
-  EXPECT_EQ(t[0].label, "large");
-  if (gpu->info().limits.timestamps) {
-    EXPECT_GT(t[0].gpuMs, 0);
-  }
-  std::printf("classic_ffd, %u vertices, float: %.2f ms on %s\n", n, t[0].gpuMs, gpu->info().name.c_str());
-}
-
-// A buffer destroyed while recorded work still uses it lives until that work has run.
-TEST_F(VkBackendTest, DestroyBufferWithPendingWork) {
-  for (const char* staging : {"0", "1"}) {
-    ScopedEnv env("SFFD_VK_STAGING", staging);
-    auto gpu = vk::createBackend({});
-    ClassicJob<float> job(*gpu, 256);
-    BufferId scratch = gpu->createBuffer(job.bytes());
-    gpu->upload(scratch, 0, job.pos.data(), job.bytes());
-    job.dispatch({}, 0, 256, scratch, job.posOut);
-    gpu->destroyBuffer(scratch);
-    job.expectIdentity(0, 256, 1e-6);
-  }
 }
 
 // Validation requested but the layer is not installed: one warning, and the backend works.

@@ -1,0 +1,102 @@
+// The CPU entry of kernel accurate_patches: its C++ twin, one stage a dispatch as the kernel runs
+// (range.z: samples, control points, tessellation), the same operations in the same order.
+#include <algorithm>
+#include <span>
+
+#include "kernels/accurate/accurate_patches.h"
+#include "kernels/common/cpu_kernel.h"
+
+namespace sffd {
+namespace {
+
+// The point (i, j, k) / d of the flat triangle (c0, c1, c2) (accFlatPoint).
+template <class Real>
+RVec3<Real> flatPoint(RVec3<Real> c0, RVec3<Real> c1, RVec3<Real> c2, uint32_t i, uint32_t j, uint32_t k, uint32_t d) {
+  Real l0 = Real(i) / Real(d);
+  Real l1 = Real(j) / Real(d);
+  Real l2 = Real(k) / Real(d);
+  return (c0 * l0 + c1 * l1) + c2 * l2;
+}
+
+// Row r of linear index idx in the triangular layout (accRow).
+uint32_t row(uint32_t idx) {
+  uint32_t r = 0;
+  while ((r + 1) * (r + 2) / 2 <= idx) ++r;
+  return r;
+}
+
+template <class Real>
+RVec3<Real> get(const Real* r) { return {r[0], r[1], r[2]}; }
+template <class Real>
+void put(Real* o, RVec3<Real> v) { o[0] = v.x, o[1] = v.y, o[2] = v.z, o[3] = 0; }
+
+template <class Real>
+void accurateThreads(const CpuKernelArgs& a, uint64_t first, uint64_t last) {
+  const auto& p = a.paramsAs<gpu::AccurateParams>();
+  const uint32_t n = p.shape.x, m = p.shape.y, L = p.shape.z, nv = p.shape.w, stage = p.range.z;
+  a.check(m <= SFFD_ACC_MAX_CP && m == uint32_t(triangleControlPoints(int(n))) && nv == uint32_t(tessVertexCount(int(L))),
+          "accurate: patch shape out of range");
+  const uint64_t subs = uint64_t(p.range.x) + p.range.y, per = stage == SFFD_ACC_STAGE_TESSELLATE ? nv : m;
+  const Real* corners = a.array<const Real>(SFFD_BINDING_ACC_CORNERS, 4 * SFFD_ACC_CORNER_STRIDE * subs).data();
+  const uint64_t end = std::min<uint64_t>(last, per * p.range.y);
+  if (stage == SFFD_ACC_STAGE_SAMPLES) {
+    LatticeEvaluator<Real> eval = boundLattice<Real>(a, p.lattice);
+    Real* samples = a.array<Real>(SFFD_BINDING_ACC_SAMPLES, 4 * m * subs).data();
+    for (uint64_t t = first; t < end; ++t) {
+      const uint32_t local = uint32_t(t / per), e = uint32_t(t - uint64_t(local) * per), s = p.range.x + local;
+      const Real* c = &corners[4 * SFFD_ACC_CORNER_STRIDE * size_t(s)];
+      const uint32_t r = row(e), q = e - r * (r + 1) / 2;
+      RVec3<Real> x = flatPoint(get(c), get(c + 4), get(c + 8), n - r, r - q, q, n);
+      LatticeSampleT<Real> S = eval.evaluate(x);
+      bool keep = !S.inside && p.lattice.degree.w == SFFD_OUTSIDE_KEEP;
+      put(&samples[4 * (size_t(s) * m + e)], keep ? x : S.value);
+    }
+  } else if (stage == SFFD_ACC_STAGE_PATCHES) {
+    const Real* matrix = a.array<const Real>(SFFD_BINDING_ACC_MATRIX, uint64_t(m) * m).data();
+    const Real* samples = a.array<const Real>(SFFD_BINDING_ACC_SAMPLES, 4 * m * subs).data();
+    Real* patches = a.array<Real>(SFFD_BINDING_ACC_PATCHES, 4 * m * subs).data();
+    for (uint64_t t = first; t < end; ++t) {
+      const uint32_t local = uint32_t(t / per), e = uint32_t(t - uint64_t(local) * per), s = p.range.x + local;
+      RVec3<Real> cp{};
+      for (uint32_t l = 0; l < m; ++l) cp = cp + get(&samples[4 * (size_t(s) * m + l)]) * matrix[size_t(l) * m + e];
+      put(&patches[4 * (size_t(s) * m + e)], cp);
+    }
+  } else if (stage == SFFD_ACC_STAGE_TESSELLATE) {
+    LatticeEvaluator<Real> eval = boundLattice<Real>(a, p.lattice);
+    const Real* basis = a.array<const Real>(SFFD_BINDING_ACC_TESS_BASIS, uint64_t(nv) * m).data();
+    const Real* patches = a.array<const Real>(SFFD_BINDING_ACC_PATCHES, 4 * m * subs).data();
+    Real* positions = a.array<Real>(SFFD_BINDING_ACC_POSITIONS, 4 * nv * subs).data();
+    Real* normals = a.array<Real>(SFFD_BINDING_ACC_NORMALS, 4 * nv * subs).data();
+    for (uint64_t t = first; t < end; ++t) {
+      const uint32_t local = uint32_t(t / per), e = uint32_t(t - uint64_t(local) * per), s = p.range.x + local;
+      const Real* c = &corners[4 * SFFD_ACC_CORNER_STRIDE * size_t(s)];
+      const RVec3<Real> nf = get(c + 12);
+      const uint32_t r = row(e), q = e - r * (r + 1) / 2;
+      const uint32_t i = L - r, j = r - q, k = q;
+      RVec3<Real> x = flatPoint(get(c), get(c + 4), get(c + 8), i, j, k, L);
+      LatticeSampleT<Real> S = eval.evaluate(x);
+      bool keep = !S.inside && p.lattice.degree.w == SFFD_OUTSIDE_KEEP;
+      RVec3<Real> pos{};
+      if (i == 0 || j == 0 || k == 0) {
+        pos = keep ? x : S.value;
+      } else {
+        const Real* b = &basis[size_t(e) * m];
+        for (uint32_t kk = 0; kk < m; ++kk) pos = pos + get(&patches[4 * (size_t(s) * m + kk)]) * b[kk];
+      }
+      RVec3<Real> nrm = keep ? nf : eval.cofactorNormal(S, nf);
+      if (!(sdot(nrm, nrm) > Real(0))) nrm = nf;   // a singular point of the map
+      put(&positions[4 * (size_t(s) * nv + e)], pos);
+      put(&normals[4 * (size_t(s) * nv + e)], snormalize(nrm));
+    }
+  } else {
+    a.fail("accurate: unknown stage " + std::to_string(stage));
+  }
+}
+
+}  // namespace
+
+void cpu::accuratePatches(const CpuKernelArgs& a, uint64_t first, uint64_t last) {
+  a.variant.f64 ? accurateThreads<double>(a, first, last) : accurateThreads<float>(a, first, last);
+}
+
+}  // namespace sffd

@@ -1,0 +1,77 @@
+// kernels/common/cpu_kernel.h: what a kernel's CPU entry sees, the C++ side of a GLSL main(): the
+// variant, the parameter block (binding SFFD_BINDING_PARAMS) and the storage ranges bound to slots
+// 1..SFFD_MAX_STORAGE_BINDINGS. The CPU backend (src/backends/cpu) calls an entry with slices of the
+// thread indices that sffdThreadIndex() gives on a GPU; each entry sits beside its kernel's GLSL in
+// kernels/<stage>/ and calls that kernel's C++ twin.
+#pragma once
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string>
+
+#include <sffd/error.h>
+#include "core/backend.h"
+#include "kernels/common/lattice_eval.h"
+#include "kernels/common/shader_layout.h"
+
+namespace sffd {
+
+struct CpuKernelArgs {
+  struct Range {
+    std::byte* data = nullptr;
+    uint64_t bytes = 0;
+  };
+  std::string_view kernel;
+  KernelVariant variant;
+  const void* params = nullptr;   // 16-byte aligned, at least the kernel's parameter struct
+  Range slots[SFFD_MAX_STORAGE_BINDINGS + 1];
+
+  template <class P>
+  const P& paramsAs() const { return *static_cast<const P*>(params); }
+
+  // The range bound at `slot` as elements of T (real4 data: 4 reals an element), at least `count` of
+  // them: a GPU reads past a range's end harmlessly, the host would not.
+  template <class T>
+  std::span<T> array(uint32_t slot, uint64_t count = 0) const {
+    const Range& r = slots[slot];
+    if (!r.data) fail("slot " + std::to_string(slot) + " is not bound");
+    if (r.bytes / sizeof(T) < count)
+      fail("slot " + std::to_string(slot) + " holds " + std::to_string(r.bytes / sizeof(T)) + " elements, the dispatch needs " +
+           std::to_string(count));
+    return {reinterpret_cast<T*>(r.data), size_t(r.bytes / sizeof(T))};
+  }
+
+  // An index read from the data (a vertex or parent id) that falls outside its array.
+  void check(bool ok, const char* what) const {
+    if (!ok) fail(what);
+  }
+  [[noreturn]] void fail(const std::string& what) const {
+    throw Error(ErrorKind::Internal, "cpu: " + std::string(kernel) + ": " + what);
+  }
+};
+
+// A kernel's CPU entry: runs threads [first, last) of the dispatch, as its GLSL main() would.
+using CpuKernelFn = void (*)(const CpuKernelArgs& args, uint64_t first, uint64_t last);
+
+// The lattice of bindings 1 and 2, checked against the sizes its parameters imply.
+template <class Real>
+LatticeEvaluator<Real> boundLattice(const CpuKernelArgs& a, const gpu::LatticeParams& L, const Real* frame = nullptr,
+                                    const Real* coeffs = nullptr) {
+  const uint32_t deg[3] = {L.degree.x, L.degree.y, L.degree.z}, boxes[3] = {L.boxes.x, L.boxes.y, L.boxes.z},
+                 offs[3] = {L.break_offset.x, L.break_offset.y, L.break_offset.z};
+  uint64_t frameReals = SFFD_FRAME_BREAKS, perBox = 1;
+  for (int k = 0; k < 3; ++k) {
+    a.check(deg[k] <= SFFD_MAX_DEGREE && boxes[k] > 0, "lattice degree or box count out of range");
+    frameReals = std::max<uint64_t>(frameReals, uint64_t(offs[k]) + boxes[k] + 1);
+    perBox *= deg[k] + 1;
+  }
+  a.check(L.boxes.w >= perBox, "lattice box holds fewer coefficients than its degrees need");
+  // Given pointers (the deform kernels' inline lattice) were sized by the host; the bindings are checked.
+  if (!frame) frame = a.array<const Real>(SFFD_BINDING_LATTICE_FRAME, frameReals).data();
+  if (!coeffs)
+    coeffs = a.array<const Real>(SFFD_BINDING_LATTICE_COEFFS, 4ull * boxes[0] * boxes[1] * boxes[2] * L.boxes.w).data();
+  return LatticeEvaluator<Real>(L, frame, coeffs);
+}
+
+}  // namespace sffd

@@ -1,0 +1,289 @@
+// The CPU entries of the deform kernels (deform_smooth and the split deform_step_*): the C++ twin of
+// smooth_deform.glsl, one function per step as there, reading the bound ranges (or the lattice and fit
+// table inline in the parameter block) as the kernels do.
+#include <algorithm>
+#include <span>
+
+#include "kernels/common/cpu_kernel.h"
+#include "kernels/pn/pn_eval.h"
+#include "kernels/smooth/smooth_deform.h"
+
+namespace sffd {
+namespace {
+
+constexpr int kCornerCp[3] = {0, 6, 9};
+
+template <class Real>
+bool lexLess(RVec3<Real> a, RVec3<Real> b) {
+  if (a.x != b.x) return a.x < b.x;
+  if (a.y != b.y) return a.y < b.y;
+  return a.z < b.z;
+}
+
+template <class Real>
+RVec3<Real> nearControlPoint(RVec3<Real> q0, RVec3<Real> q1, RVec3<Real> q2, RVec3<Real> q3) {
+  return (((q0 * Real(-5) + q1 * Real(18)) + q2 * Real(-9)) + q3 * Real(2)) / Real(6);
+}
+
+// What every deform kernel reads: its parameters, the lattice, the fit table, the sub-triangle inputs.
+template <class Real>
+struct DeformTwin {
+  const gpu::DeformParams& p;
+  LatticeEvaluator<Real> L;
+  const Real* fit;   // SFFD_FIT_STRIDE per interior fitting point
+  const uint32_t* headers;
+  const Real* records;
+  int fitPoints, level;
+
+  // float variants: the lattice and the fit table from the parameter block where the host put them
+  // there (layout.h, DeformParams), as lattice_eval.glsl and fitAt() read them.
+  static const Real* inlineReals(const gpu::DeformParams& p, bool present, uint32_t vec4) {
+    if constexpr (std::is_same_v<Real, float>) return present ? &p.inline_lattice[vec4].x : nullptr;
+    return nullptr;
+  }
+  DeformTwin(const CpuKernelArgs& a, uint64_t n)
+      : p(a.paramsAs<gpu::DeformParams>()),
+        L(boundLattice<Real>(a, p.lattice, inlineReals(p, p.lattice.break_offset.w != 0, 0),
+                             inlineReals(p, p.lattice.break_offset.w != 0, p.lattice.break_offset.w))),
+        fit(inlineReals(p, p.inline_fit.x != 0, p.inline_fit.x)),
+        headers(a.array<const uint32_t>(SFFD_BINDING_DEFORM_SUB_HEADERS, 4 * n).data()),
+        records(a.array<const Real>(SFFD_BINDING_DEFORM_SUB_RECORDS, 4 * SFFD_SUB_STRIDE * n).data()),
+        fitPoints(int(p.range.z)),
+        level(int(p.range.w)) {
+    if (!fit) fit = a.array<const Real>(SFFD_BINDING_DEFORM_FIT, uint64_t(SFFD_FIT_STRIDE) * p.range.z).data();
+    a.check(p.range.z <= SFFD_MAX_FIT_POINTS && p.range.w >= 1, "deform: fitting points or tessellation level out of range");
+  }
+
+  RVec3<Real> at(size_t st, int slot) const {
+    const Real* r = &records[4 * (SFFD_SUB_STRIDE * st + slot)];
+    return {r[0], r[1], r[2]};
+  }
+  // The lifted corners and their linear normals, read once per sub-triangle (smoothSubCorners).
+  struct Corners {
+    RVec3<Real> x[3], n[3];
+  };
+  Corners corners(size_t st) const {
+    Corners C;
+    for (int c = 0; c < 3; ++c) C.x[c] = at(st, SFFD_SUB_XPN + c), C.n[c] = at(st, SFFD_SUB_NLIN + c);
+    return C;
+  }
+  RVec3<Real> cofN(const LatticeSampleT<Real>& S, RVec3<Real> n) const { return snormalize(L.cofactorNormal(S, n)); }
+
+  // Steps 1, 2 and 4 at the corners (smoothCornerSamples).
+  void cornerSamples(size_t st, const Corners& C, RVec3<Real> Q[3], RVec3<Real> QN[3], RVec3<Real> adj[3],
+                     RVec3<Real> adjNbr[6]) const {
+    const uint32_t creaseBits = headers[4 * st + 1];
+    for (int c = 0; c < 3; ++c) {
+      auto S = L.evaluate(C.x[c]);
+      Q[c] = S.value;
+      QN[c] = cofN(S, C.n[c]);
+      adj[c] = cofN(S, at(st, SFFD_SUB_NPN + c));
+      for (int h = 0; h < 2; ++h) {
+        int s = 2 * c + h;
+        adjNbr[s] = ((creaseBits >> s) & 1u) ? cofN(S, at(st, SFFD_SUB_NNBR + s)) : adj[c];
+      }
+    }
+  }
+
+  // Step 2 on the edges (smoothEdgeSamples): E[2e] a third from corner e, E[2e+1] a third from e+1.
+  void edgeSamples(const Corners& C, RVec3<Real> E[6], RVec3<Real> EN[6]) const {
+    const Real third = Real(1) / Real(3), twoThirds = Real(2) / Real(3);
+    for (int e = 0; e < 3; ++e) {
+      int a = e, b = (e + 1) % 3;
+      for (int h = 0; h < 2; ++h) {
+        Real wa = h == 0 ? twoThirds : third, wb = h == 0 ? third : twoThirds;
+        RVec3<Real> x = C.x[a] * wa + C.x[b] * wb;
+        RVec3<Real> n = C.n[a] * wa + C.n[b] * wb;
+        auto S = L.evaluate(x);
+        E[2 * e + h] = S.value;
+        EN[2 * e + h] = cofN(S, snormalize(n));
+      }
+    }
+  }
+
+  // Step 1 inside: the deformed normal at interior fitting point i (smoothInteriorNormal).
+  RVec3<Real> interiorNormal(const Corners& C, int i) const {
+    const Real* f = &fit[SFFD_FIT_STRIDE * i];
+    RVec3<Real> x = (C.x[0] * f[0] + C.x[1] * f[1]) + C.x[2] * f[2];
+    RVec3<Real> n = (C.n[0] * f[0] + C.n[1] * f[1]) + C.n[2] * f[2];
+    return cofN(L.evaluate(x), snormalize(n));
+  }
+
+  // Step 3 inside: one interior sample's share of the normal patch's centre (smoothCentreTerm).
+  RVec3<Real> centreTerm(const RVec3<Real> ncp[10], RVec3<Real> qn, int i) const {
+    const Real* f = &fit[SFFD_FIT_STRIDE * i];
+    RVec3<Real> r = qn;
+    for (int k = 0; k < 10; ++k)
+      if (k != 4) r = r - ncp[k] * f[4 + k];
+    return r * f[3];
+  }
+};
+
+// Step 3: boundary control points by the closed form of the constrained fit (smoothBoundaryControlPoints).
+template <class Real>
+void boundaryControlPoints(const RVec3<Real> Q[3], const RVec3<Real> QN[3], const RVec3<Real> E[6], const RVec3<Real> EN[6],
+                           RVec3<Real> cp[10], RVec3<Real> ncp[10]) {
+  for (int c = 0; c < 3; ++c) cp[kCornerCp[c]] = Q[c], ncp[kCornerCp[c]] = QN[c];
+  for (int s = 0; s < 6; ++s) {
+    int c = s / 2;
+    int o = (s % 2 == 1) ? (c + 1) % 3 : (c + 2) % 3;
+    int e = (s % 2 == 1) ? c : o;
+    int nearC = c == e ? 2 * e : 2 * e + 1, nearO = c == e ? 2 * e + 1 : 2 * e;
+    cp[kSlotControlPoint[s]] = nearControlPoint(Q[c], E[nearC], E[nearO], Q[o]);
+    ncp[kSlotControlPoint[s]] = nearControlPoint(QN[c], EN[nearC], EN[nearO], QN[o]);
+  }
+  cp[4] = ncp[4] = RVec3<Real>{};
+}
+
+// Step 5: edge control points onto the tangent plane or the crease line; centre by the PN rule (smoothAdjust).
+template <class Real>
+void adjust(uint32_t creaseBits, const RVec3<Real> adj[3], const RVec3<Real> adjNbr[6], RVec3<Real> cp[10]) {
+  for (int s = 0; s < 6; ++s) {
+    int c = s / 2;
+    RVec3<Real> X = cp[kCornerCp[c]], b = cp[kSlotControlPoint[s]];
+    RVec3<Real> d = b - X;
+    bool adjusted = false;
+    if ((creaseBits >> s) & 1u) {
+      RVec3<Real> n1 = adj[c], n2 = adjNbr[s];
+      if (lexLess(n2, n1)) std::swap(n1, n2);
+      RVec3<Real> cr = scross(n1, n2);
+      Real len2 = sdot(cr, cr);
+      if (len2 > Real(1e-12)) {
+        RVec3<Real> t = cr / Real(std::sqrt(len2));
+        b = X + t * sdot(d, t);
+        adjusted = true;
+      }
+    }
+    if (!adjusted) b = b - adj[c] * sdot(d, adj[c]);
+    cp[kSlotControlPoint[s]] = b;
+  }
+  RVec3<Real> edgeSum = ((((cp[1] + cp[2]) + cp[3]) + cp[5]) + cp[7]) + cp[8];
+  RVec3<Real> cornerSum = (cp[0] + cp[6]) + cp[9];
+  cp[4] = edgeSum / Real(4) - cornerSum / Real(6);
+}
+
+// Step 6: the tessellation at level Lv, positions then normals (smoothTessVertex for every vertex).
+template <class Real>
+void tessellate(const RVec3<Real> cp[10], const RVec3<Real> ncp[10], int Lv, Real* tessOut) {
+  const int nv = (Lv + 1) * (Lv + 2) / 2;
+  auto put = [](Real* o, RVec3<Real> v) { o[0] = v.x, o[1] = v.y, o[2] = v.z, o[3] = 0; };
+  for (int r = 0; r <= Lv; ++r)
+    for (int t = 0; t <= r; ++t) {
+      int i = Lv - r, j = r - t, k = t;
+      int v = r * (r + 1) / 2 + t;
+      RVec3<Real> x, n;
+      if (i == Lv || j == Lv || k == Lv) {
+        int c = i == Lv ? 0 : (j == Lv ? 1 : 2);
+        x = cp[kCornerCp[c]];
+        n = snormalize(ncp[kCornerCp[c]]);
+      } else if (i == 0 || j == 0 || k == 0) {
+        // Evaluated from the lexicographically smaller corner, so both patches of the edge agree bit for bit.
+        int a = k == 0 ? 0 : (i == 0 ? 1 : 2), b = (a + 1) % 3;
+        int stepsFromA = a == 0 ? j : (a == 1 ? k : i);
+        int sa = 2 * a + 1, sb = 2 * b;
+        int lo = a, hi = b, steps = stepsFromA, slo = sa, shi = sb;
+        if (lexLess(cp[kCornerCp[b]], cp[kCornerCp[a]])) lo = b, hi = a, steps = Lv - stepsFromA, slo = sb, shi = sa;
+        Real u = Real(steps) / Real(Lv);
+        x = pnEdgeCurve(cp[kCornerCp[lo]], cp[kSlotControlPoint[slo]], cp[kSlotControlPoint[shi]], cp[kCornerCp[hi]], u);
+        n = snormalize(pnEdgeCurve(ncp[kCornerCp[lo]], ncp[kSlotControlPoint[slo]], ncp[kSlotControlPoint[shi]], ncp[kCornerCp[hi]], u));
+      } else {
+        RVec3<Real> lam = RVec3<Real>{Real(i), Real(j), Real(k)} / Real(Lv);
+        Real w[10];
+        pnCubicWeights(lam, w);
+        RVec3<Real> xs{}, ns{};
+        for (int q = 0; q < 10; ++q) xs = xs + cp[q] * w[q], ns = ns + ncp[q] * w[q];
+        x = xs;
+        n = snormalize(ns);
+      }
+      put(tessOut + 4 * v, x);
+      put(tessOut + 4 * (nv + v), n);
+    }
+}
+
+template <class Real>
+void putPatch(Real* o, const RVec3<Real> cp[10], const RVec3<Real> ncp[10]) {
+  for (int k = 0; k < 10; ++k) {
+    Real* a = o + 4 * k;
+    Real* b = o + 4 * (10 + k);
+    a[0] = cp[k].x, a[1] = cp[k].y, a[2] = cp[k].z, a[3] = 0;
+    b[0] = ncp[k].x, b[1] = ncp[k].y, b[2] = ncp[k].z, b[3] = 0;
+  }
+}
+
+template <class Real>
+RVec3<Real> get(const Real* r) { return {r[0], r[1], r[2]}; }
+
+// The kernels. Each loops over its threads' sub-triangles st = range.x + t, t < range.y.
+enum class Step { Fused, Sample, Fit, Adjust, Tessellate };
+
+template <class Real, Step K>
+void deformThreads(const CpuKernelArgs& a, uint64_t first, uint64_t last) {
+  const auto& p = a.paramsAs<gpu::DeformParams>();
+  const uint64_t n = uint64_t(p.range.x) + p.range.y;
+  const DeformTwin<Real> D(a, n);
+  const uint64_t nv = (uint64_t(p.range.w) + 1) * (p.range.w + 2) / 2, sampleStride = SFFD_SAMPLE_FIXED + p.range.z;
+  std::span<Real> patches, tess, samples;
+  if constexpr (K != Step::Sample) patches = a.array<Real>(SFFD_BINDING_DEFORM_PATCHES, 4 * SFFD_PATCH_STRIDE * n);
+  if constexpr (K == Step::Fused || K == Step::Tessellate) tess = a.array<Real>(SFFD_BINDING_DEFORM_TESS, 8 * nv * n);
+  if constexpr (K != Step::Fused && K != Step::Tessellate) samples = a.array<Real>(SFFD_BINDING_DEFORM_SAMPLES, 4 * sampleStride * n);
+  RVec3<Real> Q[3], QN[3], adj[3], adjNbr[6], E[6], EN[6], cp[10], ncp[10];
+  for (uint64_t t = first; t < std::min<uint64_t>(last, p.range.y); ++t) {
+    const size_t st = p.range.x + uint32_t(t);
+    Real* patch = K == Step::Sample ? nullptr : &patches[4 * SFFD_PATCH_STRIDE * st];
+    Real* smp = samples.empty() ? nullptr : &samples[4 * sampleStride * st];
+    auto sample = [&](int i) { return get(smp + 4 * i); };
+    if constexpr (K == Step::Fused) {
+      const auto C = D.corners(st);
+      D.cornerSamples(st, C, Q, QN, adj, adjNbr);
+      D.edgeSamples(C, E, EN);
+      boundaryControlPoints(Q, QN, E, EN, cp, ncp);
+      RVec3<Real> centreN{};
+      for (int i = 0; i < D.fitPoints; ++i) centreN = centreN + D.centreTerm(ncp, D.interiorNormal(C, i), i);
+      ncp[4] = centreN;
+      adjust(D.headers[4 * st + 1], adj, adjNbr, cp);
+      putPatch(patch, cp, ncp);
+    } else if constexpr (K == Step::Sample) {
+      const auto C = D.corners(st);
+      D.cornerSamples(st, C, Q, QN, adj, adjNbr);
+      D.edgeSamples(C, E, EN);
+      auto put = [&](int i, RVec3<Real> v) { Real* o = smp + 4 * i; o[0] = v.x, o[1] = v.y, o[2] = v.z, o[3] = 0; };
+      for (int c = 0; c < 3; ++c) put(c, Q[c]), put(3 + c, QN[c]), put(18 + c, adj[c]);
+      for (int e = 0; e < 6; ++e) put(6 + e, E[e]), put(12 + e, EN[e]), put(21 + e, adjNbr[e]);
+      for (int i = 0; i < D.fitPoints; ++i) put(SFFD_SAMPLE_FIXED + i, D.interiorNormal(C, i));
+    } else if constexpr (K == Step::Fit) {
+      for (int c = 0; c < 3; ++c) Q[c] = sample(c), QN[c] = sample(3 + c);
+      for (int e = 0; e < 6; ++e) E[e] = sample(6 + e), EN[e] = sample(12 + e);
+      boundaryControlPoints(Q, QN, E, EN, cp, ncp);
+      RVec3<Real> centreN{};
+      for (int i = 0; i < D.fitPoints; ++i) centreN = centreN + D.centreTerm(ncp, sample(SFFD_SAMPLE_FIXED + i), i);
+      ncp[4] = centreN;
+      putPatch(patch, cp, ncp);
+    } else if constexpr (K == Step::Adjust) {
+      for (int c = 0; c < 3; ++c) adj[c] = sample(18 + c);
+      for (int e = 0; e < 6; ++e) adjNbr[e] = sample(21 + e);
+      for (int k = 0; k < 10; ++k) cp[k] = get(patch + 4 * k), ncp[k] = get(patch + 4 * (10 + k));
+      adjust(D.headers[4 * st + 1], adj, adjNbr, cp);
+      putPatch(patch, cp, ncp);
+    } else {
+      for (int k = 0; k < 10; ++k) cp[k] = get(patch + 4 * k), ncp[k] = get(patch + 4 * (10 + k));
+    }
+    if constexpr (K == Step::Fused || K == Step::Tessellate) tessellate(cp, ncp, D.level, &tess[8 * nv * st]);
+  }
+}
+
+template <Step K>
+void deformEntry(const CpuKernelArgs& a, uint64_t first, uint64_t last) {
+  a.variant.f64 ? deformThreads<double, K>(a, first, last) : deformThreads<float, K>(a, first, last);
+}
+
+}  // namespace
+
+void cpu::deformSmooth(const CpuKernelArgs& a, uint64_t first, uint64_t last) { deformEntry<Step::Fused>(a, first, last); }
+void cpu::deformStepSample(const CpuKernelArgs& a, uint64_t first, uint64_t last) { deformEntry<Step::Sample>(a, first, last); }
+void cpu::deformStepFit(const CpuKernelArgs& a, uint64_t first, uint64_t last) { deformEntry<Step::Fit>(a, first, last); }
+void cpu::deformStepAdjust(const CpuKernelArgs& a, uint64_t first, uint64_t last) { deformEntry<Step::Adjust>(a, first, last); }
+void cpu::deformStepTessellate(const CpuKernelArgs& a, uint64_t first, uint64_t last) {
+  deformEntry<Step::Tessellate>(a, first, last);
+}
+
+}  // namespace sffd

@@ -1,0 +1,35 @@
+// The CPU backend: the Backend interface on host memory. Buffers are byte arrays; a dispatch runs the
+// kernel's CPU entry (its C++ twin, kernels/<stage>/, found in cpu_kernels.cpp) over the dispatch's
+// thread grid, split across the host's cores, before dispatch() returns. Strict and fast variants are
+// the same arithmetic here: the strict kernels' operations in their order, in float or double, so in
+// strict mode every GPU backend gives these bits. It is the reference the GPU backends are tested against.
+//
+// Timings: gpuMs is the dispatch's host wall time (a dispatch runs to completion inside dispatch(), so
+// that is its device time), and limits.timestamps is true.
+#pragma once
+#include <memory>
+#include <string_view>
+
+#include "core/backend.h"
+#include "kernels/common/cpu_kernel.h"
+
+namespace sffd {
+
+// Threads a dispatch runs on: every core, or SFFD_CPU_THREADS (1..256).
+unsigned cpuThreadCount();
+
+namespace cpu {
+
+struct Kernel {
+  const char* name;     // the kernel's stem, as in cmake/Kernels.cmake
+  size_t paramsSize;    // its parameter struct (kernels/common/layout.h)
+  CpuKernelFn run;
+};
+// The CPU entry of a kernel; null when there is none.
+const Kernel* findKernel(std::string_view name);
+
+DeviceInfo deviceInfo();
+std::unique_ptr<Backend> createBackend();
+
+}  // namespace cpu
+}  // namespace sffd

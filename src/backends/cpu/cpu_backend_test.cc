@@ -1,0 +1,96 @@
+// What is particular to the CPU backend: every kernel has a CPU entry, the thread count does not
+// change the bits, and a kernel's error on a worker thread comes back as an sffd::Error.
+#include "backends/cpu/cpu_backend.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <random>
+#include <string>
+
+#include <sffd/error.h>
+#include "core/kernel_registry.h"
+#include "kernels/pn/pn_triangles.h"
+#include "pipelines/deform_session.h"
+
+namespace sffd {
+namespace {
+
+TEST(CpuBackend, EveryKernelHasACpuEntry) {
+  size_t n = 0;
+  for (const EmbeddedKernel& k : embeddedKernels()) {
+    const cpu::Kernel* entry = cpu::findKernel(k.name);
+    ASSERT_NE(entry, nullptr) << k.name << " has no CPU entry (src/backends/cpu/cpu_kernels.cpp)";
+    EXPECT_GT(entry->paramsSize, 0u) << k.name;
+    ++n;
+  }
+  EXPECT_EQ(n, 10u);
+  EXPECT_EQ(cpu::findKernel("no_such_kernel"), nullptr);
+}
+
+TEST(CpuBackend, ThreadCountDoesNotChangeTheBits) {
+  Mesh m = readMesh(std::string(SFFD_TEST_DATA) + "/sphere.obj");
+  Lattice L = makeIdentityLattice({-1.1, -1.1, -1.1}, {1.1, 1.1, 1.1}, {5, 5, 5}, {2, 2, 2});
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-0.1, 0.1);
+  for (auto& p : L.controlPoints) p += glm::dvec3(u(rng), u(rng), u(rng));
+  auto run = [&](const char* threads, bool split) {
+    setenv("SFFD_CPU_THREADS", threads, 1);
+    auto b = cpu::createBackend();
+    EXPECT_NE(b->info().name.find(std::string("(") + threads + " threads)"), std::string::npos) << b->info().name;
+    DeformSessionOptions o;
+    o.edgeLength = 0.1;
+    o.level = 4;
+    o.split = split;
+    DeformSession s(*b, m, L, o);
+    s.deform(L);
+    unsetenv("SFFD_CPU_THREADS");
+    return s.output().tess;
+  };
+  std::vector<double> one = run("1", false);
+  EXPECT_EQ(run("3", false), one);
+  EXPECT_EQ(run("2", true), one);
+}
+
+TEST(CpuBackend, KernelErrorsOnWorkerThreadsAreInternalErrors) {
+  setenv("SFFD_CPU_THREADS", "4", 1);
+  auto b = cpu::createBackend();
+  unsetenv("SFFD_CPU_THREADS");
+  // 20000 triangles whose vertex ids run past the 3 vertices there are.
+  const uint32_t nt = 20000;
+  std::vector<float> verts(12, 0.0f), slots(48 * size_t(nt), 0.0f);
+  std::vector<uint32_t> tris(8 * size_t(nt));
+  for (uint32_t t = 0; t < nt; ++t) tris[8 * t] = t, tris[8 * t + 1] = 1, tris[8 * t + 2] = 2;
+  auto make = [&](const void* data, size_t bytes) {
+    BufferId id = b->createBuffer(bytes);
+    b->upload(id, 0, data, bytes);
+    return id;
+  };
+  BufferId pos = make(verts.data(), verts.size() * 4), nrm = make(verts.data(), verts.size() * 4);
+  BufferId tri = make(tris.data(), tris.size() * 4), slot = make(slots.data(), slots.size() * 4);
+  BufferId out = b->createBuffer(size_t(nt) * SFFD_PN_STRIDE * 16);
+  gpu::PnParams params;
+  params.range = {0, nt, 0, 0};
+  Dispatch d;
+  d.kernel = "pn_triangles";
+  d.params = &params;
+  d.paramsSize = sizeof params;
+  d.buffers = {{SFFD_BINDING_MESH_POSITIONS, pos}, {SFFD_BINDING_MESH_NORMALS, nrm}, {SFFD_BINDING_MESH_TRIANGLES, tri},
+               {SFFD_BINDING_MESH_SLOT_NORMALS, slot}, {SFFD_BINDING_PN_OUT, out}};
+  gridFor(nt, b->info().limits, d.groups);
+  try {
+    b->dispatch(d);
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Internal);
+    EXPECT_NE(std::string(e.what()).find("vertex id"), std::string::npos) << e.what();
+  }
+  // The backend still works: the first three triangles are valid.
+  params.range = {0, 3, 0, 0};
+  gridFor(3, b->info().limits, d.groups);
+  b->dispatch(d);
+  EXPECT_EQ(b->takeTimings().size(), 1u);
+}
+
+}  // namespace
+}  // namespace sffd
