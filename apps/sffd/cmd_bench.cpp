@@ -1,5 +1,5 @@
 // sffd bench MESH -l LATTICE: per-stage times of smooth FFD (the paper's Tables 1 and 2) on each
-// backend asked. GPU backends run the device-resident DeformSession, the path `view` uses: the
+// backend asked, through sffd::Deformer (on a GPU the device-resident DeformSession, the path `view` uses): the
 // pre-compute (PN + clip) and the deform stage are timed apart, from GPU timestamps (Vulkan
 // timestamp queries, GL timestamp pairs) with the host wall time beside them; the first,
 // cold run (kernel compilation) is reported apart; then --warmup runs, then --repeat timed runs.
@@ -13,19 +13,14 @@
 
 #include <nlohmann/json.hpp>
 
+#include <sffd/deformer.h>
+#include <sffd/error.h>
+
 #include "apps/sffd/cli.h"
 #include "apps/sffd/deform_job.h"
-#include "pipelines/deform_session.h"
-#include <sffd/error.h>
-#include "kernels/clip/knot_box_clip.h"
-#include "model/lattice_pack.h"
-#include "model/mesh_topology.h"
-#include "pipelines/patch_output.h"
-#include "kernels/pn/pn_triangles.h"
-#include "kernels/clip/regular_clip.h"
-#include "kernels/smooth/smooth_deform.h"
-#include "kernels/clip/split_pattern_table.h"
 #include "core/wall_clock.h"
+#include "kernels/smooth/smooth_deform.h"
+#include "pipelines/deformer_internal.h"
 
 namespace sffd::cli {
 namespace {
@@ -53,7 +48,7 @@ nlohmann::ordered_json summary(std::vector<double> v) {
 }
 
 struct BenchSettings {
-  DeformSessionOptions session;
+  DeformOptions options;
   int warmup = 2, repeat = 20;
 };
 
@@ -65,71 +60,39 @@ struct BackendResult {
   double peakRss = 0;
 };
 
-void addStages(Series& s, const SessionTimings& pre, const SessionTimings& def) {
+void addStages(Series& s, const Timings& pre, const Timings& def) {
   s.add("pn", pre.pnMs);
   s.add("clip", pre.clipMs);
   s.add("deform", def.deformMs);
   s.add("total", pre.pnMs + pre.clipMs + def.deformMs);
-  std::map<std::string, double> steps;
-  for (const DispatchTiming& d : def.dispatches)
-    if (d.label.find('.') != std::string::npos) steps[d.label] += std::max(d.gpuMs, 0.0);
+  std::map<std::string, double> steps;   // --split: deform.sample, ... in name order
+  for (const auto& [label, ms] : def.steps)
+    if (label.find('.') != std::string::npos) steps[label] += ms;
   for (const auto& [k, v] : steps) s.add(k, v);
 }
 
-BackendResult benchGpu(OpenedBackend& b, const Job& job, const BenchSettings& S) {
+// One device: a Deformer made and deformed once (the cold run), then per run the pre-compute again
+// (PN triangles, clipping) and a deform; nothing is downloaded.
+BackendResult benchDevice(Device& device, const Job& job, const BenchSettings& S) {
   BackendResult r;
-  r.label = b.label;
-  r.device = b.info.name;
+  r.label = device.label();
+  r.device = device.info().api != "cpu" ? device.info().name
+                                        : std::string("CPU reference, ") + (S.options.precision == Precision::Double ? "double" : "float") +
+                                              ", " + std::to_string(cpuThreadCount()) + " threads";
   auto t0 = std::chrono::steady_clock::now();
-  DeformSession session(*b.gpu, job.mesh, job.lattice, S.session);
-  session.deform(job.lattice);
+  Deformer deformer(device, job.mesh, job.lattice, S.options);
+  deformer.deform(job.lattice);
   r.coldMs = msSince(t0);
-  r.subTriangles = session.subTriangles();
+  r.subTriangles = deformer.subTriangles();
   for (int i = 0; i < S.warmup + S.repeat; ++i) {
-    SessionTimings p = session.precompute();
-    SessionTimings d = session.deform(job.lattice);
+    Timings pre;
+    deformer.internal().run->precompute(pre);
+    Timings def = deformer.deform(job.lattice);
     if (i < S.warmup) continue;
-    addStages(r.stages, p, d);
-    r.host.add("precompute", p.wallMs);
-    r.host.add("deform", d.wallMs);
+    addStages(r.stages, pre, def);
+    r.host.add("precompute", pre.wallMs);
+    r.host.add("deform", def.wallMs);
   }
-  r.peakRss = peakRssMb();
-  return r;
-}
-
-// The CPU reference (one thread, double or the strict float order), timed by wall clock.
-BackendResult benchCpu(const Job& job, const BenchSettings& S) {
-  BackendResult r;
-  r.label = "cpu";
-  r.device = std::string("CPU reference, ") + (S.session.variant.f64 ? "double" : "float") + ", " +
-             std::to_string(cpuThreadCount()) + " threads";
-  const DeformSessionOptions& o = S.session;
-  Mesh mesh = job.mesh;
-  if (!mesh.normalsFromFile) applyCreaseAngle(mesh, o.creaseAngleDeg);
-  PreparedMesh prepared = prepareMesh(mesh);
-  ClipTriangles clip = o.knotBoxClip ? ClipTriangles{} : buildClipTriangles(mesh, o.edgeLength, splitPatternTable().nmax());
-  std::vector<SubTriangle> knotBox = o.knotBoxClip ? clipAgainstKnotBoxes(mesh, job.lattice) : std::vector<SubTriangle>{};
-  FitTable fit = makeFitTable(o.samples);
-  auto once = [&](bool record) {
-    auto t0 = std::chrono::steady_clock::now();
-    PnOutput pn = pnTrianglesCpu(prepared, o.variant);
-    SubTriangleRecords subs = o.knotBoxClip ? recordsFromSubTriangles(prepared, pn, knotBox, o.variant)
-                                            : regularClipCpu(prepared, pn, clip, o.edgeLength, o.variant);
-    double preMs = msSince(t0);
-    SmoothOutput out = smoothDeformCpu(packLattice(job.lattice), subs, fit, o.level, o.variant);
-    r.subTriangles = subs.size();
-    if (!record) return;
-    r.stages.add("pn", pn.wallMs);
-    r.stages.add("clip", subs.wallMs);
-    r.stages.add("deform", out.wallMs);
-    r.stages.add("total", pn.wallMs + subs.wallMs + out.wallMs);
-    r.host.add("precompute", preMs);
-    r.host.add("deform", out.wallMs);
-  };
-  auto t0 = std::chrono::steady_clock::now();
-  once(false);
-  r.coldMs = msSince(t0);
-  for (int i = 0; i < S.warmup + S.repeat; ++i) once(i >= S.warmup);
   r.peakRss = peakRssMb();
   return r;
 }
@@ -146,18 +109,20 @@ int run(const ParsedArgs& args) {
   if (S.repeat < 1 || S.repeat > 100000) throw Error(ErrorKind::Input, "--repeat must be 1..100000");
   if (S.warmup < 0 || S.warmup > 100000) throw Error(ErrorKind::Input, "--warmup must be 0..100000");
   Job job = loadJob(args);
-  DeformSessionOptions& o = S.session;
-  o.variant.strict = args.has("--strict");
-  o.level = tessLevel(args);
-  if (o.level < 1 || o.level > 64) throw Error(ErrorKind::Input, "--tess must be 1..64");
+  DeformOptions& o = S.options;
+  o.strict = args.has("--strict");
+  o.tess = args.getInt("--tess", 10);
+  if (o.tess < 1 || o.tess > 64) throw Error(ErrorKind::Input, "--tess must be 1..64");
   o.edgeLength = edgeLengthOf(args, job.mesh);
   checkEdgeLength(job.mesh, o.edgeLength);
   o.samples = std::max(3, args.getInt("--samples", job.lattice.degree[0] + job.lattice.degree[1] + job.lattice.degree[2]));
-  o.knotBoxClip = clipName == "knot-box";
+  o.clip = clipName == "knot-box" ? Clip::KnotBox : Clip::Regular;
   o.split = args.has("--split");
   o.creaseAngleDeg = args.getDouble("--crease-angle", 40.0);
-  if (args.get("--precision", "float") == "double") o.variant.f64 = true;
+  o.maxChunkElements = chunkFromEnvironment("SFFD_MAX_CHUNK_SUBTRIANGLES");
+  if (args.get("--precision", "float") == "double") o.precision = Precision::Double;
   else if (args.get("--precision", "float") != "float") throw Error(ErrorKind::Input, "--precision must be float or double");
+  else o.precision = Precision::Float;
 
   std::vector<std::string> names;
   std::stringstream ss(args.get("--backends", "vulkan,gl"));
@@ -167,17 +132,13 @@ int run(const ParsedArgs& args) {
 
   std::vector<BackendResult> results;
   for (const std::string& name : names) {
-    if (name == "cpu") {
-      results.push_back(benchCpu(job, S));
-      continue;
-    }
-    BackendRequest req;
+    DeviceRequest req;
     req.name = name;
-    req.device = args.get("--device");
+    if (name != "cpu") req.deviceSubstring = args.get("--device");
     std::vector<std::string> notes;
-    OpenedBackend b = openBackend(req, &notes);
-    if (!b.gpu) throw Error(ErrorKind::Device, "backend '" + name + "' gave no GPU device");
-    results.push_back(benchGpu(b, job, S));
+    Device device = Device::open(req, &notes);
+    if (name != "cpu" && device.info().api == "cpu") throw Error(ErrorKind::Device, "backend '" + name + "' gave no GPU device");
+    results.push_back(benchDevice(device, job, S));
   }
 
   const size_t subs = results.empty() ? 0 : results.front().subTriangles;
@@ -187,10 +148,10 @@ int run(const ParsedArgs& args) {
                                 {"method", "smooth"},
                                 {"clip", clipName},
                                 {"edge_length", o.edgeLength},
-                                {"tess", o.level},
+                                {"tess", o.tess},
                                 {"input_triangles", job.mesh.triangles.size()},
                                 {"sub_triangles", subs},
-                                {"output_triangles", subs * size_t(tessTriangleCount(o.level))},
+                                {"output_triangles", subs * size_t(tessTriangleCount(o.tess))},
                                 {"runs", nlohmann::ordered_json::array()}};
     for (const BackendResult& r : results) {
       nlohmann::ordered_json run = {{"backend", r.label}, {"device", r.device}, {"repeat", S.repeat},
@@ -208,7 +169,7 @@ int run(const ParsedArgs& args) {
   }
   std::printf("%s: smooth FFD, %zu triangles -> %zu sub-triangles (l = %g, %s clipping) -> %zu output triangles (level %d)\n",
               meshName.c_str(), job.mesh.triangles.size(), subs, o.edgeLength, clipName.c_str(),
-              subs * size_t(tessTriangleCount(o.level)), o.level);
+              subs * size_t(tessTriangleCount(o.tess)), o.tess);
   std::printf("median of %d runs after %d warm-up, min..max in brackets; GPU timestamps (cpu: wall clock)\n", S.repeat, S.warmup);
   for (const BackendResult& r : results) {
     std::printf("%-10s %s\n", r.label.c_str(), r.device.c_str());

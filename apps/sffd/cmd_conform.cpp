@@ -62,24 +62,28 @@ int run(const ParsedArgs& args) {
 
   std::vector<BackendRun> runs;
   for (const std::string& name : names) {
-    BackendRequest req;
+    DeviceRequest req;
     req.name = name;
-    req.device = args.get("--device");
-    OpenedBackend b = openBackend(req);
+    req.deviceSubstring = args.get("--device");
+    Device device = Device::open(req);
+    // Until the CPU reference is a Backend, its functions.
+    Backend* gpu = device.info().api == "cpu" ? nullptr : &device.backend();
     BackendRun r;
-    r.label = b.label;
-    r.isCpu = !b.gpu;
+    r.label = device.label();
+    r.isCpu = !gpu;
     // The CPU reference runs in the kernels' precision (in float, in the strict kernels' operation
     // order): conformance compares the same arithmetic on the same inputs. Accuracy against the
     // double reference is a separate matter (docs/CONFORMANCE.md).
     KernelVariant cpuVariant{true, variant.f64};
-    ClassicOutput classic = b.gpu ? classicFfdGpu(*b.gpu, job.mesh, packed, variant) : classicFfdCpu(job.mesh, packed, cpuVariant);
+    ClassicOutput classic = gpu ? classicFfdGpu(*gpu, job.mesh, packed, variant, chunkFromEnvironment("SFFD_MAX_CHUNK_VERTICES"))
+                                : classicFfdCpu(job.mesh, packed, cpuVariant);
     r.buffers.push_back({"classic.positions", std::move(classic.positions)});
     r.buffers.push_back({"classic.normals", std::move(classic.normals)});
-    PnOutput pn = b.gpu ? pnTrianglesGpu(*b.gpu, prepared, variant) : pnTrianglesCpu(prepared, cpuVariant);
+    PnOutput pn = gpu ? pnTrianglesGpu(*gpu, prepared, variant, chunkFromEnvironment("SFFD_MAX_CHUNK_TRIANGLES"))
+                      : pnTrianglesCpu(prepared, cpuVariant);
     // Each backend clips from its own PN records: the whole pre-compute stage is compared.
-    SubTriangleRecords subs = b.gpu ? regularClipGpu(*b.gpu, prepared, pn, clip, l, variant)
-                                    : regularClipCpu(prepared, pn, clip, l, cpuVariant);
+    SubTriangleRecords subs = gpu ? regularClipGpu(*gpu, prepared, pn, clip, l, variant, chunkFromEnvironment("SFFD_MAX_CHUNK_SUBTRIANGLES"))
+                                  : regularClipCpu(prepared, pn, clip, l, cpuVariant);
     r.buffers.push_back({"pn.records", std::move(pn.records)});
     r.buffers.push_back({"clip.headers", std::vector<double>(subs.headers.begin(), subs.headers.end())});
     r.buffers.push_back({"clip.records", std::move(subs.records)});

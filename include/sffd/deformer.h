@@ -67,11 +67,11 @@ struct Timings {
   std::vector<std::pair<std::string, double>> steps;   // every dispatch by label (split: deform.sample, ...)
 };
 
-// A range of a device buffer holding results, as the interop headers hand it out
-// (sffd::vulkan::bufferOf, sffd::opengl::bufferOf).
+// One chunk of a Deformer's results on the device, as the interop headers hand it out
+// (sffd::vulkan::bufferOf, sffd::opengl::bufferOf). Layout: see Deformer::deviceOutput().
 struct OutputChunk {
-  size_t firstPatch = 0, patchCount = 0;   // Smooth/Accurate: the sub-triangles whose tessellation it holds
-  uint32_t buffer = 0;                     // internal id; see the interop headers
+  size_t first = 0, count = 0;   // Smooth, Accurate: the patches [first, first + count); Classic: the vertices
+  uint32_t buffer = 0;           // internal id; see the interop headers
   uint64_t offset = 0, bytes = 0;
 };
 
@@ -101,10 +101,14 @@ class Deformer {
   std::vector<double> patchControlPoints() const;
   size_t subTriangles() const;   // Smooth, Accurate: the patches made; Classic: 0
 
-  // The last deform()'s output where it lives on the device, for drawing from it without a copy.
-  // Smooth and Accurate: per patch, tessVertexCount(tess) positions then as many unit normals, each 4
-  // reals (w = 0; float, or double in double precision). Classic: per vertex a position (w: 1 inside
-  // the lattice box, 0 outside), then per vertex a normal, 4 reals each.
+  // The last deform()'s output where it lives on the device, for drawing from it without a copy; 4
+  // reals (float, or double when doublePrecision()) a position or unit normal, w = 0 unless said.
+  //   Smooth    per patch of the chunk, tessVertexCount(tess) positions then as many normals.
+  //   Accurate  the positions of the chunk's patches' vertices (tessVertexCount(tess) a patch), then
+  //             from offset + bytes / 2 their normals.
+  //   Classic   per vertex a position (w: 1 inside the lattice box, 0 outside), then from
+  //             offset + bytes / 2 the normals.
+  // Empty on a device that keeps nothing (the CPU reference).
   std::vector<OutputChunk> deviceOutput() const;
   bool doublePrecision() const;   // whether the reals above are doubles
   const DeformOptions& options() const;

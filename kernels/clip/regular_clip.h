@@ -45,8 +45,9 @@ struct SubTriangleRecords {
 // Regular clipping on the CPU reference (double, or float in the strict kernels' order) and on a GPU.
 SubTriangleRecords regularClipCpu(const PreparedMesh& mesh, const PnOutput& pn, const ClipTriangles& clip, double l,
                                   KernelVariant variant);
+// `maxChunk` (not 0) caps the sub-triangles of one chunk, to test chunking.
 SubTriangleRecords regularClipGpu(Backend& backend, const PreparedMesh& mesh, const PnOutput& pn,
-                                  const ClipTriangles& clip, double l, KernelVariant variant);
+                                  const ClipTriangles& clip, double l, KernelVariant variant, size_t maxChunk = 0);
 
 // Records of sub-triangles given by their parent sites (knot-box clipping), on the CPU reference.
 SubTriangleRecords recordsFromSubTriangles(const PreparedMesh& mesh, const PnOutput& pn,

@@ -16,6 +16,7 @@ struct PnOutput {
 };
 
 PnOutput pnTrianglesCpu(const PreparedMesh& mesh, KernelVariant variant);
-PnOutput pnTrianglesGpu(Backend& backend, const PreparedMesh& mesh, KernelVariant variant);
+// `maxChunk` (not 0) caps the triangles of one dispatch, to test chunking.
+PnOutput pnTrianglesGpu(Backend& backend, const PreparedMesh& mesh, KernelVariant variant, size_t maxChunk = 0);
 
 }  // namespace sffd
