@@ -1,4 +1,4 @@
-// Shared inputs of the benchmarks: the acaffd models from the shared data directory, normalised the
+// Shared inputs of the benchmarks: the models of the test data (tests/data), normalised the
 // way `sffd --normalize` does (centred, largest half-extent 1/1.1), and a deformed lattice around
 // them. Loaded once per process and cached, so file parsing never shows up in a timed loop.
 #pragma once
@@ -13,7 +13,7 @@
 
 namespace sffd::bench {
 
-inline const std::string kDataDir = std::string(SFFD_SHARED_DATA) + "/acaffd/";
+inline const std::string kDataDir = std::string(SFFD_TEST_DATA) + "/";
 
 inline void meshBox(const Mesh& m, glm::dvec3& lo, glm::dvec3& hi) {
   lo = glm::dvec3(1e300), hi = glm::dvec3(-1e300);
@@ -32,7 +32,7 @@ inline void normalize(Mesh& m, double scale) {
     for (auto& p : patch.points) p = (p - c) * f;
 }
 
-// "t.bpt" (teapot, 36 Bezier patches at the default 10x10 grid = 7200 triangles) or an .obj name.
+// "teapot.bpt" (teapot, 36 Bezier patches at the default 10x10 grid = 7200 triangles) or an .obj name.
 inline const Mesh& model(const std::string& file) {
   static std::map<std::string, Mesh> cache;
   auto it = cache.find(file);

@@ -2,7 +2,7 @@
 // form (packLattice: Boehm knot insertion per knot box, extractBoxForm), to evaluate the trivariate
 // volume and its Jacobian at a point (LatticeEvaluator, the C++ twin of kernels/common/lattice_eval.glsl,
 // in double as the oracle and in float in the strict kernels' order), classic FFD of a whole model
-// (classicFfdCpu, rabbit_cym.obj) and the exact reference of the error analysis (ExactReference).
+// (classicFfdCpu, torus.obj) and the exact reference of the error analysis (ExactReference).
 // These are the innermost loops of every CPU path and of `sffd conform`/`sffd error`, so their
 // per-point rate is the number to watch when the evaluator or the packing changes.
 #include <benchmark/benchmark.h>
@@ -92,10 +92,10 @@ void BM_LatticeEvaluateWithNormal(benchmark::State& state) {
 BENCHMARK_TEMPLATE(BM_LatticeEvaluateWithNormal, double)->Unit(benchmark::kMillisecond);
 BENCHMARK_TEMPLATE(BM_LatticeEvaluateWithNormal, float)->Unit(benchmark::kMillisecond);
 
-// Classic FFD of rabbit_cym.obj (every vertex and normal) on the CPU reference. Arg: 1 = double
+// Classic FFD of torus.obj (every vertex and normal) on the CPU reference. Arg: 1 = double
 // (the oracle), 0 = float in the strict kernels' order. Items = vertices.
-void BM_ClassicFfdCpuRabbit(benchmark::State& state) {
-  const Mesh& m = bench::model("rabbit_cym.obj");
+void BM_ClassicFfdCpuTorus(benchmark::State& state) {
+  const Mesh& m = bench::model("torus.obj");
   PackedLattice P = packLattice(bench::deformedLattice(m, 5, 2));
   KernelVariant v{true, state.range(0) != 0};
   for (auto _ : state) {
@@ -105,12 +105,12 @@ void BM_ClassicFfdCpuRabbit(benchmark::State& state) {
   state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(m.positions.size()));
   state.counters["vertices"] = double(m.positions.size());
 }
-BENCHMARK(BM_ClassicFfdCpuRabbit)->ArgName("f64")->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ClassicFfdCpuTorus)->ArgName("f64")->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond);
 
 // The error analysis' exact reference: pre-image of a point of a teapot triangle on the exact
 // Bezier surface (.bpt), then its exact FFD (position and cofactor normal). Items = points.
 void BM_ExactReferenceTeapot(benchmark::State& state) {
-  const Mesh& m = bench::model("t.bpt");
+  const Mesh& m = bench::model("teapot.bpt");
   PackedLattice P = packLattice(bench::deformedLattice(m, 5, 2));
   ExactReference ref(m, P);
   const uint32_t triangles = uint32_t(m.triangles.size());

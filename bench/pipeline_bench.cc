@@ -1,5 +1,5 @@
-// The smooth-FFD pipeline on the CPU reference, stage by stage, on the teapot (t.bpt, 36 patches,
-// 7200 triangles) and the rabbit (rabbit_cym.obj, 8400 triangles), both normalised to a largest
+// The smooth-FFD pipeline on the CPU reference, stage by stage, on the teapot (teapot.bpt, 36 patches,
+// 7200 triangles) and the bumpy torus (torus.obj, 8400 triangles), both normalised to a largest
 // half-extent of 1/1.1 and clipped with target edge length l = 0.2 (the call sequence of
 // apps/sffd/smooth_job.cpp). At l = 0.2 every edge of both models is shorter than l, so regular
 // clipping yields one sub-triangle per triangle; the `fine` cases use l = 0.02, where the split
@@ -28,7 +28,7 @@ using namespace sffd;
 namespace {
 
 constexpr double kEdgeLengths[] = {0.2, 0.02};   // index = the `fine` argument
-const char* const kModels[] = {"t.bpt", "rabbit_cym.obj"};
+const char* const kModels[] = {"teapot.bpt", "torus.obj"};
 
 // Every stage's output for one model and arithmetic, computed once.
 struct Stages {
@@ -61,7 +61,7 @@ const Stages& stages(int model, bool f64, int fine = 0) {
 
 void setModelLabel(benchmark::State& state, int model) { state.SetLabel(kModels[model]); }
 
-// Arg: model (0 teapot, 1 rabbit). Items = triangles.
+// Arg: model (0 teapot, 1 torus). Items = triangles.
 void BM_PrepareMesh(benchmark::State& state) {
   const int model = int(state.range(0));
   const Mesh& m = bench::model(kModels[model]);

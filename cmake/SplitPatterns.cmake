@@ -1,4 +1,4 @@
-# Generates the crack-free split-pattern table (ALGORITHM.md 4.2) at build time with
+# Generates the crack-free split-pattern table (METHOD.md 4.2) at build time with
 # tools/split_pattern_gen.cpp; the generated source is compiled into sffd_core
 # (kernels/clip/split_pattern_table.h). See docs/SPLIT_PATTERNS.md.
 set(SFFD_SPLIT_NMAX 24 CACHE STRING "Largest per-edge segment count of the split-pattern table (24 or more)")

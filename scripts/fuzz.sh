@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets of fuzz/ (clang, ASan + UBSan) in build-fuzz/ and runs each for SECONDS
-# (default 60) from a seed corpus: the shared data files, tests/data/bad/ (the bad-input corpus, the odd
+# (default 60) from a seed corpus: the test data of tests/data/ (models and lattices, PyGeM's fixtures), the
+# demo's data/, tests/data/bad/ (the bad-input corpus, the odd
 # inputs and the fuzzers' own regression files under tests/data/bad/fuzz/TARGET/).
 #   scripts/fuzz.sh [SECONDS]
 # Every seed is run first, so the regression files are re-checked by each run. New inputs that reach
@@ -18,7 +19,6 @@ CC=clang CXX=clang++ cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithD
   -DSFFD_BUILD_TESTS=OFF >/dev/null
 cmake --build "$build" -j2 --target sffd_fuzz
 
-shared=../shared/data
 # Seeds per target, by extension.
 declare -A exts=(
   [fuzz_mesh_text]="obj off bpt ply stl"
@@ -37,7 +37,7 @@ for t in fuzz_mesh_text fuzz_mesh_binary fuzz_lattice; do
   rm -rf "$seeds"
   mkdir -p "$seeds" "$corpus" "$crashes"
   for e in ${exts[$t]}; do
-    find "$shared" tests/data/bad -type f -name "*.$e" -size -1024k -exec cp -t "$seeds" --backup=numbered {} + 2>/dev/null || true
+    find tests/data data -type f -name "*.$e" -size -1024k -exec cp -t "$seeds" --backup=numbered {} + 2>/dev/null || true
   done
   [ -d "tests/data/bad/fuzz/$t" ] && cp -t "$seeds" --backup=numbered tests/data/bad/fuzz/"$t"/* 2>/dev/null || true
   log="$build/$t.log"

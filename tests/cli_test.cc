@@ -13,45 +13,18 @@
 #include <nlohmann/json.hpp>
 
 #include "model/mesh.h"
+#include "tests/support/cli_runner.h"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-const std::string kData = SFFD_SHARED_DATA;
-const std::string kSffd = SFFD_BINARY;
+const std::string kData = SFFD_TEST_DATA;
 
-struct RunResult {
-  int status = -1;
-  std::string out, err;
-};
-
-// Runs sffd with the given arguments (shell-quoted by the caller) and an optional environment prefix.
-RunResult runSffd(const std::string& args, const std::string& env = "") {
-  fs::path dir = fs::temp_directory_path() / ("sffd_cli_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  std::string outFile = (dir / "stdout").string(), errFile = (dir / "stderr").string();
-  std::string cmd = env + " " + kSffd + " " + args + " >" + outFile + " 2>" + errFile;
-  int raw = std::system(cmd.c_str());
-  RunResult r;
-  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : 128;
-  auto slurp = [](const std::string& p) {
-    std::ifstream f(p);
-    std::stringstream ss;
-    ss << f.rdbuf();
-    return ss.str();
-  };
-  r.out = slurp(outFile);
-  r.err = slurp(errFile);
-  return r;
-}
-
-fs::path tempDir(const std::string& name) {
-  fs::path d = fs::temp_directory_path() / ("sffd_test_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+using sffd::test::RunResult;
+using sffd::test::runSffd;
+using sffd::test::slurp;
+using sffd::test::tempDir;
 
 std::vector<glm::dvec3> readPoints(const std::string& path) {
   std::ifstream f(path);
@@ -130,9 +103,9 @@ TEST(Cli, IdentityPrmLeavesTheSphere) {
 TEST(Cli, LatticeThenDeformWritesStats) {
   fs::path dir = tempDir("lattice");
   std::string lat = (dir / "twist.json").string(), out = (dir / "t.ply").string(), stats = (dir / "s.json").string();
-  RunResult r = runSffd("lattice " + kData + "/acaffd/sphere.obj -o " + lat + " --preset twist:0.5 --quiet");
+  RunResult r = runSffd("lattice " + kData + "/sphere.obj -o " + lat + " --preset twist:0.5 --quiet");
   ASSERT_EQ(r.status, 0) << r.err;
-  r = runSffd("deform " + kData + "/acaffd/sphere.obj -l " + lat + " --method classic -o " + out + " --stats " + stats + " --quiet");
+  r = runSffd("deform " + kData + "/sphere.obj -l " + lat + " --method classic -o " + out + " --stats " + stats + " --quiet");
   ASSERT_EQ(r.status, 0) << r.err;
   std::ifstream sf(stats);
   nlohmann::json j = nlohmann::json::parse(sf);
@@ -151,7 +124,7 @@ TEST(Cli, DevicesListsLavapipeAndLlvmpipe) {
 }
 
 TEST(Cli, MissingVulkanLoaderIsADeviceError) {
-  RunResult r = runSffd("deform " + kData + "/acaffd/cube.obj -l " + kData + "/acaffd/lattices/cube_control_points0.npy --method classic --backend vulkan -o /tmp/never.obj",
+  RunResult r = runSffd("deform " + kData + "/cube.obj -l " + kData + "/lattices/cube_bend.npy --method classic --backend vulkan -o /tmp/never.obj",
                         "SFFD_VULKAN_LIBRARY=libvulkan-missing.so.9");
   EXPECT_EQ(r.status, 3);
   expectOneErrorLine(r);
@@ -159,7 +132,7 @@ TEST(Cli, MissingVulkanLoaderIsADeviceError) {
 }
 
 TEST(Cli, MissingIcdIsADeviceErrorAndAutoFallsBack) {
-  std::string args = "deform " + kData + "/acaffd/cube.obj -l " + kData + "/acaffd/lattices/cube_control_points0.npy --method classic ";
+  std::string args = "deform " + kData + "/cube.obj -l " + kData + "/lattices/cube_bend.npy --method classic ";
   fs::path dir = tempDir("fallback");
   RunResult r = runSffd(args + "--backend vulkan -o " + (dir / "a.obj").string(), "VK_DRIVER_FILES=/nonexistent.json VK_ICD_FILENAMES=/nonexistent.json");
   EXPECT_EQ(r.status, 3);
@@ -172,7 +145,7 @@ TEST(Cli, MissingIcdIsADeviceErrorAndAutoFallsBack) {
 TEST(Cli, ErrorsHaveOneLineAndTheContractStatus) {
   fs::path dir = tempDir("errors");
   std::string out = (dir / "o.obj").string();
-  std::string cube = kData + "/acaffd/cube.obj", lat = kData + "/acaffd/lattices/cube_control_points0.npy";
+  std::string cube = kData + "/cube.obj", lat = kData + "/lattices/cube_bend.npy";
   struct Case { std::string args; int status; };
   std::vector<Case> cases = {
       {"", 2},
@@ -209,7 +182,7 @@ TEST(Cli, HelpForEveryCommand) {
 }
 
 TEST(Cli, ConformPassesAndStrictIsBitIdentical) {
-  std::string base = "conform " + kData + "/acaffd/sphere.obj -l " + kData + "/acaffd/lattices/sphere_control_points0.npy --method classic";
+  std::string base = "conform " + kData + "/sphere.obj -l " + kData + "/lattices/sphere_twist.npy --method classic";
   RunResult r = runSffd(base);
   EXPECT_EQ(r.status, 0) << r.out << r.err;
   EXPECT_NE(r.out.find("conform: PASS"), std::string::npos) << r.out;
@@ -228,7 +201,7 @@ TEST(Cli, ClipWritesACrackFreeSubTriangleMeshAndStats) {
   fs::path dir = tempDir("clip");
   for (const char* clip : {"regular", "knot-box"}) {
     std::string out = (dir / (std::string(clip) + ".obj")).string(), stats = (dir / (std::string(clip) + ".json")).string();
-    RunResult r = runSffd("clip " + kData + "/acaffd/cube2.obj -l " + kData + "/acaffd/lattices/cube2_control_points5.npy --edge-length 0.3 --clip " +
+    RunResult r = runSffd("clip " + kData + "/cube2.obj -l " + kData + "/lattices/cube2_twist.npy --edge-length 0.3 --clip " +
                           clip + " -o " + out + " --stats " + stats + " --quiet");
     ASSERT_EQ(r.status, 0) << r.err;
     sffd::Mesh m = sffd::readMesh(out);
@@ -249,11 +222,11 @@ TEST(Cli, ClipWritesACrackFreeSubTriangleMeshAndStats) {
 }
 
 TEST(Cli, ClipRefusesAnAbsurdEdgeLength) {
-  RunResult r = runSffd("clip " + kData + "/acaffd/rabbit_cym.obj -l " + kData + "/acaffd/lattices/rabbit_cym_control_points0.npy --edge-length 1e-6 -o /tmp/never_clip.obj");
+  RunResult r = runSffd("clip " + kData + "/torus.obj -l " + kData + "/lattices/torus_twist.npy --edge-length 1e-6 -o /tmp/never_clip.obj");
   EXPECT_EQ(r.status, 2);
   expectOneErrorLine(r);
   EXPECT_NE(r.err.find("sub-triangles"), std::string::npos) << r.err;
-  r = runSffd("clip " + kData + "/acaffd/cube2.obj -l " + kData + "/acaffd/lattices/cube2_control_points5.npy --edge-length -1 -o /tmp/never_clip.obj");
+  r = runSffd("clip " + kData + "/cube2.obj -l " + kData + "/lattices/cube2_twist.npy --edge-length -1 -o /tmp/never_clip.obj");
   EXPECT_EQ(r.status, 2);
   EXPECT_FALSE(fs::exists("/tmp/never_clip.obj"));
 }
@@ -265,14 +238,14 @@ namespace {
 TEST(Cli, RenderColoursByError) {
   fs::path dir = tempDir("render_error");
   std::string out = (dir / "e.png").string();
-  RunResult r = runSffd("render " + kData + "/acaffd/cube2.obj -l " + kData +
-                        "/acaffd/lattices/cube2_control_points5.npy --edge-length 0.5 --color-by normal --width 160 --height 120 -o " + out + " --quiet");
+  RunResult r = runSffd("render " + kData + "/cube2.obj -l " + kData +
+                        "/lattices/cube2_twist.npy --edge-length 0.5 --color-by normal --width 160 --height 120 -o " + out + " --quiet");
   ASSERT_EQ(r.status, 0) << r.err;
   std::ifstream f(out, std::ios::binary);
   char sig[8] = {};
   f.read(sig, 8);
   EXPECT_EQ(std::string(sig + 1, 3), "PNG");
-  r = runSffd("render " + kData + "/acaffd/cube2.obj --color-by normal -o " + (dir / "f.png").string());
+  r = runSffd("render " + kData + "/cube2.obj --color-by normal -o " + (dir / "f.png").string());
   EXPECT_EQ(r.status, 2);   // colouring by error needs a lattice
   EXPECT_FALSE(fs::exists(dir / "f.png"));
 }
@@ -281,8 +254,8 @@ TEST(Cli, RenderColoursByError) {
 
 // bench --json: the contract's keys, one run per backend asked, stage times from each, the split steps.
 TEST(Cli, BenchJsonHasTheContractKeysOnEveryBackend) {
-  RunResult r = runSffd("bench " + kData + "/acaffd/sphere.obj -l " + kData +
-                        "/acaffd/lattices/sphere_control_points0.npy --normalize 0.99 --edge-length 0.12 --tess 4 "
+  RunResult r = runSffd("bench " + kData + "/sphere.obj -l " + kData +
+                        "/lattices/sphere_twist.npy --normalize 0.99 --edge-length 0.12 --tess 4 "
                         "--backends vulkan,gl,cpu --repeat 3 --warmup 1 --split --json --quiet");
   ASSERT_EQ(r.status, 0) << r.err;
   nlohmann::json j = nlohmann::json::parse(r.out);
@@ -309,7 +282,7 @@ TEST(Cli, BenchJsonHasTheContractKeysOnEveryBackend) {
 }
 
 TEST(Cli, BenchRefusesBadOptions) {
-  const std::string base = "bench " + kData + "/acaffd/sphere.obj -l " + kData + "/acaffd/lattices/sphere_control_points0.npy ";
+  const std::string base = "bench " + kData + "/sphere.obj -l " + kData + "/lattices/sphere_twist.npy ";
   for (const std::string& bad : {std::string("--repeat 0"), std::string("--method classic"), std::string("--backends nope"),
                                  std::string("--tess 0"), std::string("--edge-length -1")}) {
     RunResult r = runSffd(base + bad);

@@ -1,4 +1,4 @@
-// End-to-end tests of `sffd error` (CONTRACT.md, docs/ACCURACY.md "Error metrics"): the JSON contract,
+// End-to-end tests of `sffd error` (docs/CLI.md, docs/ACCURACY.md "Error metrics"): the JSON contract,
 // accurate FFD measured against the exact FFD (about 0), classic FFD (positive), closed and open meshes.
 #include <gtest/gtest.h>
 
@@ -11,35 +11,16 @@
 
 #include <nlohmann/json.hpp>
 
+#include "tests/support/cli_runner.h"
+
 namespace fs = std::filesystem;
 
 namespace {
 
-const std::string kAcaffd = std::string(SFFD_SHARED_DATA) + "/acaffd/";
-const std::string kSffd = SFFD_BINARY;
+const std::string kData = std::string(SFFD_TEST_DATA) + "/";
 
-struct Result {
-  int status = -1;
-  std::string out, err;
-};
-
-Result sffd(const std::string& args) {
-  fs::path dir = fs::temp_directory_path() / ("sffd_error_test_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  std::string o = (dir / "stdout").string(), e = (dir / "stderr").string();
-  int raw = std::system((kSffd + " " + args + " >" + o + " 2>" + e).c_str());
-  Result r;
-  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : 128;
-  auto slurp = [](const std::string& p) {
-    std::ifstream f(p);
-    std::stringstream ss;
-    ss << f.rdbuf();
-    return ss.str();
-  };
-  r.out = slurp(o);
-  r.err = slurp(e);
-  return r;
-}
+using Result = sffd::test::RunResult;
+using sffd::test::runSffd;
 
 void expectStats(const nlohmann::json& s) {
   for (const char* k : {"avg", "max", "std"}) {
@@ -49,13 +30,13 @@ void expectStats(const nlohmann::json& s) {
   EXPECT_LE(s["avg"].get<double>(), s["max"].get<double>());
 }
 
-const std::string kCube = kAcaffd + "cube2.obj -l " + kAcaffd + "lattices/cube2_control_points5.npy";
-const std::string kTeapot = kAcaffd + "t.bpt -l " + kAcaffd + "lattices/t_control_points1.npy --normalize 0.9090909";
+const std::string kCube = kData + "cube2.obj -l " + kData + "lattices/cube2_twist.npy";
+const std::string kTeapot = kData + "teapot.bpt -l " + kData + "lattices/teapot_bend.npy --normalize 0.9090909";
 
 }  // namespace
 
 TEST(ErrorCommand, AccurateOnTheCubeIsExactAndHasAVolume) {
-  Result r = sffd("error " + kCube + " --method accurate --json --quiet");
+  Result r = runSffd("error " + kCube + " --method accurate --json --quiet");
   ASSERT_EQ(r.status, 0) << r.err;
   nlohmann::json j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["method"], "accurate");
@@ -74,8 +55,8 @@ TEST(ErrorCommand, AccurateOnTheCubeIsExactAndHasAVolume) {
 }
 
 TEST(ErrorCommand, ClassicHasAPositiveErrorOnTheSameJob) {
-  Result a = sffd("error " + kCube + " --method accurate --json --quiet --backend cpu");
-  Result c = sffd("error " + kCube + " --method classic --json --quiet --backend cpu");
+  Result a = runSffd("error " + kCube + " --method accurate --json --quiet --backend cpu");
+  Result c = runSffd("error " + kCube + " --method classic --json --quiet --backend cpu");
   ASSERT_EQ(a.status, 0) << a.err;
   ASSERT_EQ(c.status, 0) << c.err;
   nlohmann::json ja = nlohmann::json::parse(a.out), jc = nlohmann::json::parse(c.out);
@@ -89,7 +70,7 @@ TEST(ErrorCommand, ClassicHasAPositiveErrorOnTheSameJob) {
 }
 
 TEST(ErrorCommand, TheOpenTeapotHasNoVolume) {
-  Result r = sffd("error " + kTeapot + " --method classic --json --quiet");
+  Result r = runSffd("error " + kTeapot + " --method classic --json --quiet");
   ASSERT_EQ(r.status, 0) << r.err;
   nlohmann::json j = nlohmann::json::parse(r.out);
   EXPECT_TRUE(j["volume"].is_null()) << r.out;
@@ -99,7 +80,7 @@ TEST(ErrorCommand, TheOpenTeapotHasNoVolume) {
 }
 
 TEST(ErrorCommand, AccurateTeapotRunsOnTheExactSurfaceReference) {
-  Result r = sffd("error " + kTeapot + " --method accurate --json --quiet --tess 2");
+  Result r = runSffd("error " + kTeapot + " --method accurate --json --quiet --tess 2");
   ASSERT_EQ(r.status, 0) << r.err;
   nlohmann::json j = nlohmann::json::parse(r.out);
   EXPECT_TRUE(j["volume"].is_null());
@@ -108,16 +89,16 @@ TEST(ErrorCommand, AccurateTeapotRunsOnTheExactSurfaceReference) {
 }
 
 TEST(ErrorCommand, HumanReadableSummaryAndBadOptions) {
-  Result r = sffd("error " + kCube + " --method accurate --quiet --tess 3");
+  Result r = runSffd("error " + kCube + " --method accurate --quiet --tess 3");
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.out.find("geometry"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("volume"), std::string::npos) << r.out;
-  Result bad = sffd("error " + kCube + " --method exact");
+  Result bad = runSffd("error " + kCube + " --method exact");
   EXPECT_EQ(bad.status, 2);
   EXPECT_EQ(bad.err.rfind("sffd: error: ", 0), 0u) << bad.err;
-  Result tess = sffd("error " + kCube + " --method accurate --tess 0");
+  Result tess = runSffd("error " + kCube + " --method accurate --tess 0");
   EXPECT_EQ(tess.status, 2) << tess.err;
-  Result help = sffd("error --help");
+  Result help = runSffd("error --help");
   EXPECT_EQ(help.status, 0);
   EXPECT_NE(help.out.find("--json"), std::string::npos);
 }

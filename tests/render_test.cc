@@ -17,10 +17,10 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const std::string kData = SFFD_SHARED_DATA;
+const std::string kData = SFFD_TEST_DATA;
 const std::string kSffd = SFFD_BINARY;
-const std::string kTeapot = kData + "/acaffd/t.bpt";
-const std::string kLattice = kData + "/acaffd/lattices/t_control_points1.npy";
+const std::string kTeapot = kData + "/teapot.bpt";
+const std::string kLattice = kData + "/lattices/teapot_bend.npy";
 
 struct Result {
   int status = -1;

@@ -26,6 +26,7 @@
 #include "io/lattice_io.h"
 #include "model/lattice_pack.h"
 #include "model/mesh.h"
+#include "tests/support/cli_runner.h"
 
 namespace fs = std::filesystem;
 
@@ -42,12 +43,7 @@ struct Result {
   long maxRssKiB = 0;
 };
 
-std::string slurp(const fs::path& p) {
-  std::ifstream f(p, std::ios::binary);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
+using sffd::test::slurp;
 
 // A fresh folder per test (tests run in parallel under ctest), removed afterwards.
 class Robust : public ::testing::Test {

@@ -14,26 +14,22 @@
 #include <unistd.h>
 
 #include "apps/render/gl_renderer.h"
+#include "tests/support/cli_runner.h"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-const std::string kData = SFFD_SHARED_DATA;
-const std::string kSffd = SFFD_BINARY;
-const std::string kSphere = kData + "/acaffd/sphere.obj";
+const std::string kData = SFFD_TEST_DATA;
+const std::string kSphere = kData + "/sphere.obj";
 
 struct Result {
   int status = -1;
   std::string err;
 };
 
-fs::path freshDir(const std::string& name) {
-  fs::path d = fs::temp_directory_path() / ("sffd_view_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+using sffd::test::slurp;
+fs::path freshDir(const std::string& name) { return sffd::test::tempDir("view_" + name); }
 
 // The X server prefix: none with a DISPLAY, xvfb-run without one; nullopt when neither is there.
 std::optional<std::string> xPrefix() {
@@ -43,25 +39,11 @@ std::optional<std::string> xPrefix() {
   return std::nullopt;
 }
 
-Result run(const std::string& args, const fs::path& dir, const std::string& prefix = "") {
-  std::string errFile = (dir / "stderr.txt").string();
-  std::string cmd = "LIBGL_ALWAYS_SOFTWARE=1 " + prefix + kSffd + " " + args + " >/dev/null 2>" + errFile;
-  int raw = std::system(cmd.c_str());
-  Result r;
-  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : 128;
-  std::ifstream f(errFile);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  r.err = ss.str();
-  return r;
+Result run(const std::string& args, const fs::path&, const std::string& prefix = "") {
+  sffd::test::RunResult r = sffd::test::runSffd(args, "LIBGL_ALWAYS_SOFTWARE=1 " + prefix);
+  return {r.status, r.err};
 }
 
-std::string slurp(const fs::path& p) {
-  std::ifstream f(p);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
 
 void writeFile(const fs::path& p, const std::string& text) { std::ofstream(p) << text; }
 

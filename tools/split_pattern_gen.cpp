@@ -1,4 +1,4 @@
-// Build-time tool: generates the crack-free split-pattern table (ALGORITHM.md 4.2, offline
+// Build-time tool: generates the crack-free split-pattern table (METHOD.md 4.2, offline
 // generator steps 1-6) as a C++ source compiled into sffd_core (kernels/clip/split_pattern_table.h).
 // usage: split_pattern_gen [--nmax N] [--verbose] OUT.cpp
 //

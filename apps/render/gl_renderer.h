@@ -21,6 +21,7 @@
 
 #include <glm/glm.hpp>
 
+#include "apps/render/png_io.h"
 #include "backends/opengl/gl_context.h"
 #include "model/mesh.h"
 
@@ -83,11 +84,11 @@ struct SlotCamera {
   glm::dmat4 view{1}, projection{1};
 };
 
-struct Image {
-  int width = 0, height = 0;
-  std::vector<uint8_t> rgba;       // 4 bytes a pixel, rows from the top
-  std::vector<SlotCamera> cameras; // one per item
-  const uint8_t* pixel(int x, int y) const { return &rgba[(static_cast<size_t>(y) * width + x) * 4]; }
+// A rendered picture with the camera of each item's slot (for picking and tests).
+struct Image : RgbaImage {
+  std::vector<SlotCamera> cameras;   // one per item
+  Image() = default;
+  Image(RgbaImage pixels) : RgbaImage(std::move(pixels)) {}
 };
 
 class Renderer {
@@ -152,10 +153,5 @@ class Renderer {
 // Viridis, the perceptually uniform colormap (sRGB, t clamped to [0, 1]).
 glm::vec3 viridis(float t);
 
-// Writes the image as an 8-bit RGB PNG, through a temporary file renamed into place (nothing is left
-// on failure; an unwritable path is an input Error).
-void writePng(const std::string& path, const Image& image);
-// Reads an 8-bit (or 16-bit, reduced) gray/RGB/RGBA/palette PNG as RGBA; throws an input Error on a bad file.
-Image readPng(const std::string& path);
 
 }  // namespace sffd::gl

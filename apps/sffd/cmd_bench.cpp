@@ -201,7 +201,7 @@ CommandSpec benchCommand() {
   options.insert(options.begin() + 1, {"--backends", "LIST", "comma-separated backends to time: vulkan, gl, gl-egl, gl-osmesa, cpu (default vulkan,gl)"});
   options.insert(options.begin() + 2, {"--repeat", "N", "timed runs per backend (default 20); the median, min and max are reported"});
   options.insert(options.begin() + 3, {"--warmup", "N", "untimed runs after the cold first run (default 2)"});
-  options.insert(options.begin() + 4, {"--json", nullptr, "print the results as JSON (CONTRACT.md) instead of a table"});
+  options.insert(options.begin() + 4, {"--json", nullptr, "print the results as JSON (docs/CLI.md) instead of a table"});
   options.insert(options.begin() + 5, {"--method", "NAME", "smooth (the only method with the pn, clip and deform stages)"});
   options.insert(options.begin() + 6, {"--precision", "NAME", "float (default) or double kernels"});
   return CommandSpec{"bench", "MESH -l LATTICE [--backends LIST] [--repeat N] [--json]",

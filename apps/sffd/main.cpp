@@ -1,5 +1,5 @@
 // sffd: smooth free-form deformation on any GPU. Dispatches to the commands and turns every failure
-// into one "sffd: error: ..." line and the documented exit status (CONTRACT.md).
+// into one "sffd: error: ..." line and the documented exit status (docs/CLI.md).
 #include <cstdio>
 #include <cstring>
 #include <new>
@@ -10,7 +10,7 @@
 
 using namespace sffd;
 
-// Every message is one printable line, whatever a file name or a token in it holds (CONTRACT.md).
+// Every message is one printable line, whatever a file name or a token in it holds (docs/CLI.md).
 static std::string oneLine(const char* what) {
   std::string s(what);
   for (char& c : s)

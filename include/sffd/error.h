@@ -1,7 +1,7 @@
 // sffd/error.h: sffd::Error, the one exception type the library throws. Its kind says whose the
-// problem is; the command-line tool turns it into its exit status (2 bad input or usage, 3 missing
-// or unusable device, 1 anything else, cancelled included). what() is one line, "file:line: what"
-// when a line of an input file is at fault.
+// problem is; the command-line tool turns it into its exit status (docs/CLI.md: 2 bad input or usage,
+// 3 missing or unusable device, 1 anything else, cancelled included). what() is one line,
+// "file:line: what" when a line of an input file is at fault.
 #pragma once
 #include <stdexcept>
 #include <string>

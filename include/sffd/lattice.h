@@ -1,5 +1,5 @@
 // sffd/lattice.h: the FFD lattice, a trivariate B-spline volume of any degree 1..5 per axis
-// (docs/METHOD.md), and lattice files.
+// (docs/METHOD.md 1), and lattice files.
 //
 // Plain data: control points in world space, knot vectors in lattice-parameter space, and an affine
 // frame mapping world points to parameters (the identity for native lattices, PyGeM's rotated box

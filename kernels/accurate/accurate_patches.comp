@@ -1,5 +1,5 @@
 #version 450
-// Kernel accurate_patches: accurate FFD (Feng, Heng & Wong 1998; Feng & Peng 2000; ALGORITHM.md 2) of
+// Kernel accurate_patches: accurate FFD (Feng, Heng & Wong 1998; Feng & Peng 2000; METHOD.md 2) of
 // knot-box sub-triangles, in three dispatches per chunk (params.range.z, layout.h):
 //  stage 0, a thread per (sub-triangle, sample l): S_l = R(x(l/n)), the lattice volume at the principal
 //     lattice points l/n of the flat sub-triangle (every sample finds its own knot box; the sub-triangle
@@ -15,7 +15,7 @@
 //     (the sub-triangle lies in the parent's plane): differencing the control points of the slivers
 //     that knot-box clipping makes loses all float precision. It keeps the parent's orientation (also
 //     where det J < 0) and jumps across sub-triangle edges, which is why accurate FFD shades
-//     unsmoothly (ALGORITHM.md 2.2, last paragraph).
+//     unsmoothly (METHOD.md 2.2, last paragraph).
 // Why not one thread per sub-triangle: llvmpipe and lavapipe end an invocation after 65535 loop
 // iterations in all (gallivm's LP_MAX_TGSI_LOOP_ITERATIONS, shared by every loop of the shader), which a
 // whole patch at --tess 38 already exceeds; here an invocation runs at most a few hundred.

@@ -1,8 +1,8 @@
-// Accurate FFD (Feng, Heng & Wong 1998; Feng & Peng 2000; ALGORITHM.md 2): the reference method.
+// Accurate FFD (Feng, Heng & Wong 1998; Feng & Peng 2000; METHOD.md 2): the reference method.
 // Every triangle is clipped against the knot boxes (knot_box_clip.h); on each knot-box sub-triangle the
 // lattice volume composed with the flat sub-triangle is a polynomial of total degree n = nu+nv+nw, so it
 // is exactly a triangular Bezier patch of degree n, found by interpolation at the principal lattice:
-// P = A_n^{-1} S, A_n[l][k] = B^n_k(l/n) (linear index order of ALGORITHM.md 0). Each patch is then
+// P = A_n^{-1} S, A_n[l][k] = B^n_k(l/n) (linear index order of METHOD.md 0). Each patch is then
 // tessellated at level L (patch_output.h).
 //
 // Runs on a GPU backend (kernel kernels/accurate/accurate_patches.comp, three dispatches per chunk: a thread per
@@ -18,7 +18,7 @@
 // sub-triangle lies in the parent's plane): differencing the control points of the slivers that
 // knot-box clipping makes would lose all float precision (0.5 degree on sphere.obj in float). The
 // normal keeps the parent's orientation, also where det J < 0. It jumps across sub-triangle edges:
-// accurate FFD shades unsmoothly, which is what smooth FFD is for (ALGORITHM.md 2.2).
+// accurate FFD shades unsmoothly, which is what smooth FFD is for (METHOD.md 2.2).
 //
 // Exactness: the composition is a polynomial only where the map is one. With OutsideMode::Keep (PyGeM
 // lattices), a sub-triangle that straddles the lattice box is not, and there the patch interpolates
@@ -37,7 +37,7 @@ namespace sffd {
 
 // Number of control points of a triangular Bezier patch of degree n: (n+1)(n+2)/2.
 inline int triangleControlPoints(int n) { return (n + 1) * (n + 2) / 2; }
-// Multi-index (i, j, k) of linear index `idx` in degree n (ALGORITHM.md 0: i = n..0, then j = n-i..0).
+// Multi-index (i, j, k) of linear index `idx` in degree n (METHOD.md 0: i = n..0, then j = n-i..0).
 void triangleMultiIndex(int n, int idx, int& i, int& j, int& k);
 // B^n_{ijk}(lambda) = n!/(i!j!k!) l0^i l1^j l2^k.
 double triangleBernstein(int n, int i, int j, int k, const glm::dvec3& lambda);

@@ -1,4 +1,4 @@
-// Accurate FFD (accurate_patches.h, ALGORITHM.md 2): the interpolation matrix and its inverse, the patches
+// Accurate FFD (accurate_patches.h, METHOD.md 2): the interpolation matrix and its inverse, the patches
 // against the blossom product (Method B) and against the lattice itself, identity and affine lattices
 // reproduced exactly, bit-identical shared boundaries (closed output) and the float twin.
 #include <gtest/gtest.h>
@@ -19,11 +19,11 @@ using namespace sffd;
 
 namespace {
 
-const std::string kData = SFFD_SHARED_DATA;
+const std::string kData = SFFD_TEST_DATA;
 
 int linearIndex(int d, int i, int k) { return (d - i) * (d - i + 1) / 2 + k; }
 
-// ---- Method B: the blossom product (DeRose 1988; ALGORITHM.md 2.2), for a single Bezier box ----
+// ---- Method B: the blossom product (DeRose 1988; METHOD.md 2.2), for a single Bezier box ----
 using Tri = std::vector<double>;   // triangular Bernstein coefficients of one degree, linear index order
 
 // Coefficients (degree p) of B^p_r(alpha . lambda): the blossom of B^p_r at {alpha0 x mu0, alpha1 x mu1, alpha2 x mu2}.
@@ -84,7 +84,7 @@ struct BezierBox {
 double angleBetween(const glm::dvec3& a, const glm::dvec3& b) { return std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b)); }
 
 // ---- meshes and lattices ----
-Mesh load(const std::string& name) { return readMesh(kData + "/acaffd/" + name); }
+Mesh load(const std::string& name) { return readMesh(kData + "/" + name); }
 
 Lattice boxLattice(const Mesh& m, std::array<int, 3> counts, std::array<int, 3> degree, double margin = 0.0) {
   glm::dvec3 lo = m.positions[0], hi = lo;
@@ -158,7 +158,7 @@ void expectClosed(const Mesh& out) {
 }  // namespace
 
 TEST(AccurateFfd, MultiIndexOrder) {
-  // ALGORITHM.md 0: 0:300 1:210 2:201 3:120 4:111 5:102 6:030 7:021 8:012 9:003.
+  // METHOD.md 0: 0:300 1:210 2:201 3:120 4:111 5:102 6:030 7:021 8:012 9:003.
   const char* expected[] = {"300", "210", "201", "120", "111", "102", "030", "021", "012", "003"};
   for (int idx = 0; idx < 10; ++idx) {
     int i, j, k;

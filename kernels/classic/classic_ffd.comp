@@ -1,6 +1,6 @@
 #version 450
 // Kernel classic_ffd: classic (vertex-only) FFD, one thread per vertex. Deforms the position by the
-// lattice volume and the normal by the cofactor of its Jacobian (ALGORITHM.md 1.4, 6).
+// lattice volume and the normal by the cofactor of its Jacobian (METHOD.md 1.4, 6).
 #extension GL_GOOGLE_include_directive : require
 #include "../common/prelude.glsl"
 #include "../common/lattice_eval.glsl"

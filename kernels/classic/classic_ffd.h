@@ -1,5 +1,5 @@
 // Classic FFD (Sederberg & Parry 1986; PyGeM, Blender): every vertex and its normal through the lattice
-// volume, nothing else (ALGORITHM.md 6). Runs on a GPU backend (kernel kernels/classic/classic_ffd.comp) or on
+// volume, nothing else (METHOD.md 6). Runs on a GPU backend (kernel kernels/classic/classic_ffd.comp) or on
 // the CPU reference (lattice_eval.h) with the same inputs and output layout.
 #pragma once
 #include <string>

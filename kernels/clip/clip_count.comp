@@ -1,6 +1,6 @@
 #version 450
 // Kernel clip_count: per clip triangle, the number of sub-triangles its split pattern makes (the
-// counting pass before the exclusive scan; ALGORITHM.md 4.2 step 5).
+// counting pass before the exclusive scan; METHOD.md 4.2 step 5).
 #extension GL_GOOGLE_include_directive : require
 #include "../common/prelude.glsl"
 #include "clip_sites.glsl"

@@ -1,4 +1,4 @@
-// kernels/clip/clip_sites.glsl: regular clipping by the split-pattern table (Lu & Feng; ALGORITHM.md 4.2),
+// kernels/clip/clip_sites.glsl: regular clipping by the split-pattern table (Lu & Feng; METHOD.md 4.2),
 // shared by the kernels clip_count and clip_write. The C++ twin is kernels/clip/regular_clip.cpp.
 //
 // Crack-freeness rests on three rules: (1) edge lengths and counts are computed from the endpoint with

@@ -1,6 +1,6 @@
 #version 450
 // Kernel clip_write: per clip triangle, writes its sub-triangle records at its scanned offset, in
-// pattern order, so the output is deterministic (ALGORITHM.md 3.3, 4.2).
+// pattern order, so the output is deterministic (METHOD.md 3.3, 4.2).
 #extension GL_GOOGLE_include_directive : require
 #include "../common/prelude.glsl"
 #include "clip_sites.glsl"

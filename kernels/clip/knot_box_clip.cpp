@@ -1,4 +1,4 @@
-// Knot-box clipping (ALGORITHM.md 2.1): Cui & Feng, "Smooth free-form deformation with sharp feature
+// Knot-box clipping (METHOD.md 2.1): Cui & Feng, "Smooth free-form deformation with sharp feature
 // awareness" (2015), clipping step as in the authors' code (albuscrow/acaffd, `ACTriangle.py` /
 // `model.py`: `ACPoly`, `OBJ.split`), itself the first step of the accurate FFD of Feng, Heng & Wong
 // (1998) and Feng & Peng (2000): a triangle crossing knot planes is mapped by a piecewise polynomial,

@@ -1,4 +1,4 @@
-// Knot-box clipping (Cui & Feng 2015; ALGORITHM.md 2.1): each triangle is cut by the interior knot
+// Knot-box clipping (Cui & Feng 2015; METHOD.md 2.1): each triangle is cut by the interior knot
 // planes of the lattice into convex pieces that each lie in one knot box, and the pieces are fanned
 // into sub-triangles. The baseline that the improved (regular) clipping replaces, and the first step
 // of accurate FFD.

@@ -1,4 +1,4 @@
-// Knot-box clipping (knot_box_clip.h, ALGORITHM.md 2.1): the pieces tile each parent (area, winding),
+// Knot-box clipping (knot_box_clip.h, METHOD.md 2.1): the pieces tile each parent (area, winding),
 // each lies in one knot box, vertex descriptions are consistent, and shared parent edges are cut at
 // bitwise-identical places from both sides (no cracks, no T-junctions). Statistics for rabbit_cym.
 #include <gtest/gtest.h>
@@ -20,9 +20,9 @@ using namespace sffd;
 
 namespace {
 
-const std::string kData = SFFD_SHARED_DATA;
+const std::string kData = SFFD_TEST_DATA;
 
-Mesh load(const std::string& name) { return readMesh(kData + "/acaffd/" + name); }
+Mesh load(const std::string& name) { return readMesh(kData + "/" + name); }
 
 // The paper's lattice shape: 5x5x5 control points, degree 2, over the mesh's bounding box.
 Lattice boxLattice(const Mesh& m) {
@@ -252,7 +252,7 @@ TEST(KnotBoxClip, Cube2) {
 
 TEST(KnotBoxClip, Sphere) { runModel("sphere.obj"); }
 
-TEST(KnotBoxClip, RabbitStatistics) { runModel("rabbit_cym.obj"); }
+TEST(KnotBoxClip, RabbitStatistics) { runModel("torus.obj"); }
 
 TEST(KnotBoxClip, RotatedFrame) {
   // The clipping happens in parameter space: a rotated, scaled, shifted frame moves the planes.
@@ -395,7 +395,7 @@ TEST(KnotBoxClip, RandomFramesAndKnotsStayCrackFree) {
   // on vertex coordinates (planes through vertices, along edges when a mesh is axis-aligned).
   std::mt19937 rng(2024);
   std::uniform_real_distribution<double> uni(0.0, 1.0);
-  for (const char* name : {"cube2.obj", "sphere.obj", "rabbit_cym.obj"}) {
+  for (const char* name : {"cube2.obj", "sphere.obj", "torus.obj"}) {
     const Mesh m = load(name);
     for (int round = 0; round < 4; ++round) {
       SCOPED_TRACE(std::string(name) + " round " + std::to_string(round));

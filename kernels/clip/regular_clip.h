@@ -1,4 +1,4 @@
-// Kernel K2 "clip" with the improved regular clipping of Lu & Feng (ALGORITHM.md 3.3, 4.2): every
+// Kernel K2 "clip" with the improved regular clipping of Lu & Feng (METHOD.md 3.3, 4.2): every
 // triangle split by the pattern of its edges' segment counts ceil(len / l), into near-regular
 // sub-triangles lifted onto the PN surface, crack-free by construction. Also turns knot-box clipping
 // (knot_box_clip.h) into the same sub-triangle records, so both clippings feed one deform stage.

@@ -1,4 +1,4 @@
-// Regular clipping (ALGORITHM.md 4.2): crack-free sub-triangles (the welded result of a closed mesh is
+// Regular clipping (METHOD.md 4.2): crack-free sub-triangles (the welded result of a closed mesh is
 // closed and consistently oriented), exact cover of every parent, pre-split of long edges.
 #include <gtest/gtest.h>
 
@@ -16,7 +16,7 @@ using namespace sffd;
 
 namespace {
 
-const std::string kData = SFFD_SHARED_DATA;
+const std::string kData = SFFD_TEST_DATA;
 
 glm::dvec3 rec(const SubTriangleRecords& R, size_t s, int slot) {
   const double* p = &R.records[(s * SFFD_SUB_STRIDE + slot) * 4];
@@ -74,8 +74,8 @@ void expectCoversParents(const Mesh& m, const SubTriangleRecords& R) {
 }  // namespace
 
 TEST(RegularClip, ClosedMeshesStayClosedAndCovered) {
-  for (auto [file, l] : {std::pair{"/acaffd/cube2.obj", 0.3}, std::pair{"/acaffd/sphere.obj", 0.2},
-                         std::pair{"/acaffd/rabbit_cym.obj", 0.05}}) {
+  for (auto [file, l] : {std::pair{"/cube2.obj", 0.3}, std::pair{"/sphere.obj", 0.2},
+                         std::pair{"/torus.obj", 0.05}}) {
     SCOPED_TRACE(file);
     Mesh m = readMesh(kData + file);
     for (KernelVariant v : {KernelVariant{false, true}, KernelVariant{true, false}}) {
@@ -89,7 +89,7 @@ TEST(RegularClip, ClosedMeshesStayClosedAndCovered) {
 }
 
 TEST(RegularClip, SubTriangleCountFollowsEdgeLength) {
-  Mesh m = readMesh(kData + "/acaffd/cube2.obj");   // edges of length 2 and 2*sqrt(2)
+  Mesh m = readMesh(kData + "/cube2.obj");   // edges of length 2 and 2*sqrt(2)
   SubTriangleRecords coarse = clipMesh(m, 10.0, {false, true});
   EXPECT_EQ(coarse.size(), m.triangles.size());    // every count is 1: the parents themselves
   SubTriangleRecords fine = clipMesh(m, 0.25, {false, true});
@@ -101,7 +101,7 @@ TEST(RegularClip, SubTriangleCountFollowsEdgeLength) {
 }
 
 TEST(RegularClip, LongEdgesArePresplitNotDropped) {
-  Mesh m = readMesh(kData + "/acaffd/cube2.obj");
+  Mesh m = readMesh(kData + "/cube2.obj");
   int nmax = splitPatternTable().nmax();
   double l = 2.0 / (2.5 * nmax);   // cube edges need 2.5 Nmax segments
   ClipTriangles C;
@@ -114,7 +114,7 @@ TEST(RegularClip, LongEdgesArePresplitNotDropped) {
 
 TEST(RegularClip, IdentityCornersLieOnThePnSurface) {
   // Corners of parents come out exactly; normals unit length.
-  Mesh m = readMesh(kData + "/acaffd/sphere.obj");
+  Mesh m = readMesh(kData + "/sphere.obj");
   SubTriangleRecords R = clipMesh(m, 0.3, {false, true});
   for (size_t s = 0; s < R.size(); ++s)
     for (int c = 0; c < 3; ++c) {
@@ -126,7 +126,7 @@ TEST(RegularClip, IdentityCornersLieOnThePnSurface) {
 }
 
 TEST(KnotBoxRecords, ClosedAndCoveredLikeRegular) {
-  for (const char* file : {"/acaffd/cube2.obj", "/acaffd/rabbit_cym.obj"}) {
+  for (const char* file : {"/cube2.obj", "/torus.obj"}) {
     SCOPED_TRACE(file);
     Mesh m = readMesh(kData + file);
     glm::dvec3 lo(1e30), hi(-1e30);
@@ -142,9 +142,9 @@ TEST(KnotBoxRecords, ClosedAndCoveredLikeRegular) {
 }
 
 TEST(RegularClip, FewerSliversThanKnotBoxAtComparableCounts) {
-  // ALGORITHM.md 4: the reason for the improved clipping. Rabbit, 5x5x5 knot boxes vs a regular
+  // METHOD.md 4: the reason for the improved clipping. Rabbit, 5x5x5 knot boxes vs a regular
   // split tuned to a similar sub-triangle count.
-  Mesh m = readMesh(kData + "/acaffd/rabbit_cym.obj");
+  Mesh m = readMesh(kData + "/torus.obj");
   glm::dvec3 lo(1e30), hi(-1e30);
   for (const auto& p : m.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
   PreparedMesh P = prepareMesh(m);

@@ -1,4 +1,4 @@
-// Lu & Feng, improved smooth FFD: the crack-free split-pattern table (ALGORITHM.md 4.2). The data
+// Lu & Feng, improved smooth FFD: the crack-free split-pattern table (METHOD.md 4.2). The data
 // is generated at build time by tools/split_pattern_gen.cpp (build/generated/split_patterns.cpp).
 #include "kernels/clip/split_pattern_table.h"
 

@@ -1,4 +1,4 @@
-// Crack-free split-pattern table for the improved smooth FFD of Lu & Feng (ALGORITHM.md section 4,
+// Crack-free split-pattern table for the improved smooth FFD of Lu & Feng (METHOD.md section 4,
 // "Improved clipping: crack-free split-pattern table"). A triangle whose edges get n_e segments is
 // split by the pattern of its sorted counts a <= b <= c; every boundary vertex lies at exactly t/n
 // on its edge, so two triangles sharing an edge produce the same vertices there (no T-junctions).

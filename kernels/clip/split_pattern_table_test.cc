@@ -1,4 +1,4 @@
-// The split-pattern table (ALGORITHM.md 4.2): every pattern is a valid triangulation of its
+// The split-pattern table (METHOD.md 4.2): every pattern is a valid triangulation of its
 // canonical triangle with boundary vertices exactly at t/n, and its triangle quality is in the
 // range of the spec's table (2*sqrt(3)*inradius / longest edge).
 #include <gtest/gtest.h>

@@ -1,5 +1,5 @@
 // kernels/common/lattice_eval.glsl: evaluation of the B-spline lattice volume from its per-knot-box
-// Bezier form (ALGORITHM.md 1.2-1.4). The C++ twin is kernels/common/lattice_eval.h; both follow the
+// Bezier form (METHOD.md 1.2-1.4). The C++ twin is kernels/common/lattice_eval.h; both follow the
 // same operation order so that the strict variants agree bit for bit.
 #ifndef SFFD_BSPLINE_GLSL
 #define SFFD_BSPLINE_GLSL
@@ -207,7 +207,7 @@ LatticeSample latticeEvaluate(LatticeParams L, real3 x) {
 }
 
 // Deformed normal direction of a world-space normal n at the sample: cof(J_R) cof(A) n, up to a
-// positive factor (ALGORITHM.md 1.4). Not normalised.
+// positive factor (METHOD.md 1.4). Not normalised.
 real latticeCofactorRow(uint r, real3 n) {
   uint o = SFFD_FRAME_COF_AFFINE + 4u * r;
   P real xy = latticeFrameAt(o) * n.x + latticeFrameAt(o + 1u) * n.y;

@@ -109,7 +109,7 @@ class LatticeEvaluator {
     return S;
   }
 
-  // cof(J_R) cof(A) n up to a positive factor; not normalised (ALGORITHM.md 1.4).
+  // cof(J_R) cof(A) n up to a positive factor; not normalised (METHOD.md 1.4).
   RVec3<Real> cofactorNormal(const LatticeSampleT<Real>& S, RVec3<Real> n) const {
     RVec3<Real> q;
     for (int r = 0; r < 3; ++r) {

@@ -56,7 +56,7 @@ SFFD_STRUCT_BEGIN(ClassicParams)
   SFFD_UVEC4 range;          // x: first vertex of this chunk (relative to the bound ranges), y: vertex count
 SFFD_STRUCT_END(ClassicParams)
 
-// ---- kernel pn_triangles: one thread per original triangle (ALGORITHM.md 3.2) ----
+// ---- kernel pn_triangles: one thread per original triangle (METHOD.md 3.2) ----
 // Mesh buffers shared by the pre-compute kernels.
 #define SFFD_BINDING_MESH_POSITIONS 3      // real4 per vertex (w unused)
 #define SFFD_BINDING_MESH_NORMALS 4        // real4 per vertex, unit (w unused)
@@ -72,7 +72,7 @@ SFFD_STRUCT_END(ClassicParams)
 #define SFFD_PN_STRIDE 16
 #define SFFD_PN_NORMALS 10
 
-// ---- kernels clip_count and clip_write: regular clipping by the split-pattern table (ALGORITHM.md 4.2) ----
+// ---- kernels clip_count and clip_write: regular clipping by the split-pattern table (METHOD.md 4.2) ----
 // One thread per clip triangle (an original triangle, or a piece of one after the pre-split of
 // triangles whose edges need more than Nmax segments). Buffers 3..7 are the mesh and PN buffers above.
 #define SFFD_BINDING_SPLIT_TABLE 1     // uint: pattern entries (4 each), then vertices (4 each: lambda bits, edge | step << 16), then packed uint16 triangle indices
@@ -89,7 +89,7 @@ SFFD_STRUCT_END(ClassicParams)
 // Edge params of clip edge e (corner e -> corner e+1): x = parent edge it lies on (-1: none),
 // y = parameter of corner e along that parent edge, z = of corner e+1; parameters are measured from
 // the parent edge's endpoint with the lower weld id.
-// Sub-triangle record (ALGORITHM.md 3.3): lam[3], x_pn[3], x_flat[3], n_lin[3], n_pn[3], n_nbr[6].
+// Sub-triangle record (METHOD.md 3.3): lam[3], x_pn[3], x_flat[3], n_lin[3], n_pn[3], n_nbr[6].
 #define SFFD_SUB_STRIDE 21
 #define SFFD_SUB_LAM 0
 #define SFFD_SUB_XPN 3
@@ -104,7 +104,7 @@ SFFD_STRUCT_BEGIN(ClipParams)
   SFFD_VEC4 target;    // x: target edge length l
 SFFD_STRUCT_END(ClipParams)
 
-// ---- kernel deform_smooth: the deform stage of smooth FFD, one thread per sub-triangle (ALGORITHM.md 3.4) ----
+// ---- kernel deform_smooth: the deform stage of smooth FFD, one thread per sub-triangle (METHOD.md 3.4) ----
 // Bindings 1 and 2 are the lattice (lattice_eval.glsl).
 #define SFFD_BINDING_DEFORM_FIT 3          // reals: per interior fitting point SFFD_FIT_STRIDE values
 #define SFFD_BINDING_DEFORM_SUB_HEADERS 4  // uvec4 per sub-triangle (clip_write's headers)
@@ -142,7 +142,7 @@ SFFD_STRUCT_BEGIN(PnParams)
   SFFD_UVEC4 range;   // x: first triangle, y: triangle count
 SFFD_STRUCT_END(PnParams)
 
-// ---- kernel accurate_patches (accurate FFD, ALGORITHM.md 2; owner: accurate FFD) ----
+// ---- kernel accurate_patches (accurate FFD, METHOD.md 2; owner: accurate FFD) ----
 // Three dispatches a chunk of knot-box sub-triangles (range.z selects the stage), so that no invocation
 // runs more than a few hundred loop iterations (llvmpipe ends every invocation after 65535 in all):
 //   stage 0, a thread per (sub-triangle, sample l): S_l = R(x(l/n)) at the principal lattice points;

@@ -1,5 +1,5 @@
 // kernels/pn/pn_eval.glsl: PN triangles with sharp features (Vlachos et al. 2001, "Curved PN
-// triangles"; crease handling of Cui & Feng 2015 and Lu & Feng; ALGORITHM.md 3.2). The C++ twin is
+// triangles"; crease handling of Cui & Feng 2015 and Lu & Feng; METHOD.md 3.2). The C++ twin is
 // kernels/pn/pn_eval.h; both follow the same operation order (strict variants agree bit for bit).
 //
 // Every quantity on a shared edge is computed from data ordered canonically (by weld id, and the
@@ -7,7 +7,7 @@
 #ifndef SFFD_PN_GLSL
 #define SFFD_PN_GLSL
 
-// Edge control point next to corner Vc on the edge towards Vo (ALGORITHM.md 3.2). nFirst.w = 1 marks
+// Edge control point next to corner Vc on the edge towards Vo (METHOD.md 3.2). nFirst.w = 1 marks
 // a crease: the point is projected onto the crease line t = normalize(nFirst x nSecond).
 real3 pnEdgePoint(real3 Vc, real3 Vo, real4 nFirst, real3 nSecond) {
   P real3 d = Vo - Vc;

@@ -1,4 +1,4 @@
-// C++ twin of kernels/pn/pn_eval.glsl (PN triangles with sharp features, ALGORITHM.md 3.2), templated
+// C++ twin of kernels/pn/pn_eval.glsl (PN triangles with sharp features, METHOD.md 3.2), templated
 // on the arithmetic type like lattice_eval.h. Keep the two in step, operation for operation.
 #pragma once
 #include <array>

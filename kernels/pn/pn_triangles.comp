@@ -1,5 +1,5 @@
 #version 450
-// Kernel pn_triangles (K1 of ALGORITHM.md 3.2): one thread per original triangle; the cubic PN
+// Kernel pn_triangles (K1 of METHOD.md 3.2): one thread per original triangle; the cubic PN
 // geometry patch (10 control points) and the quadratic normal patch (6), creases kept sharp.
 #extension GL_GOOGLE_include_directive : require
 #include "../common/prelude.glsl"
@@ -12,7 +12,7 @@ layout(std430, SFFD_SET binding = SFFD_BINDING_MESH_TRIANGLES) readonly buffer T
 layout(std430, SFFD_SET binding = SFFD_BINDING_MESH_SLOT_NORMALS) readonly buffer SlotNormals { real4 slotNormals[]; };
 layout(std430, SFFD_SET binding = SFFD_BINDING_PN_OUT) writeonly buffer PnOut { real4 pn[]; };
 
-// Control point of each slot in the cubic linear index order (ALGORITHM.md 3.3).
+// Control point of each slot in the cubic linear index order (METHOD.md 3.3).
 const uint kSlotControlPoint[6] = uint[6](2u, 1u, 3u, 7u, 8u, 5u);
 
 void main() {

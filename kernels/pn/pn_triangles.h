@@ -1,5 +1,5 @@
 // Kernel K1 "PN triangles" (Vlachos et al. 2001 with the sharp-feature rule of Cui & Feng 2015;
-// ALGORITHM.md 3.2): per original triangle, the cubic PN geometry patch and quadratic normal patch.
+// METHOD.md 3.2): per original triangle, the cubic PN geometry patch and quadratic normal patch.
 // Runs on a GPU backend (kernels/pn/pn_triangles.comp) or on the CPU reference (pn_eval.h).
 #pragma once
 #include <vector>

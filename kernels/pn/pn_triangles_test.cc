@@ -1,4 +1,4 @@
-// PN triangles (ALGORITHM.md 3.2, 3.5): interpolation of corners and normals, identical boundary
+// PN triangles (METHOD.md 3.2, 3.5): interpolation of corners and normals, identical boundary
 // curves across shared edges (smooth and crease), flat PN patches for the split-normal cube.
 #include <gtest/gtest.h>
 
@@ -10,7 +10,7 @@ using namespace sffd;
 
 namespace {
 
-const std::string kData = SFFD_SHARED_DATA;
+const std::string kData = SFFD_TEST_DATA;
 
 glm::dvec3 at(const PnOutput& o, size_t tri, int i) {
   const double* p = &o.records[(tri * SFFD_PN_STRIDE + i) * 4];
@@ -44,7 +44,7 @@ void expectSharedEdgesIdentical(const Mesh& mesh, KernelVariant variant) {
 }  // namespace
 
 TEST(PnTriangles, InterpolatesCornersAndNormals) {
-  Mesh m = readMesh(kData + "/acaffd/sphere.obj");
+  Mesh m = readMesh(kData + "/sphere.obj");
   PnOutput o = pnTrianglesCpu(prepareMesh(m), {false, true});
   for (size_t t = 0; t < m.triangles.size(); ++t) {
     const int corner[3] = {0, 6, 9}, normal[3] = {0, 3, 5};
@@ -56,7 +56,7 @@ TEST(PnTriangles, InterpolatesCornersAndNormals) {
 }
 
 TEST(PnTriangles, SharedEdgesGiveIdenticalCurves) {
-  for (const char* file : {"/acaffd/sphere.obj", "/acaffd/cube2.obj", "/acaffd/rabbit_cym.obj"}) {
+  for (const char* file : {"/sphere.obj", "/cube2.obj", "/torus.obj"}) {
     SCOPED_TRACE(file);
     Mesh m = readMesh(kData + file);
     expectSharedEdgesIdentical(m, {false, true});
@@ -65,8 +65,8 @@ TEST(PnTriangles, SharedEdgesGiveIdenticalCurves) {
 }
 
 TEST(PnTriangles, SplitNormalCubeIsFlat) {
-  // ALGORITHM.md 5: cube2's PN triangles are flat (crease projections fall on the edges).
-  Mesh m = readMesh(kData + "/acaffd/cube2.obj");
+  // METHOD.md 5: cube2's PN triangles are flat (crease projections fall on the edges).
+  Mesh m = readMesh(kData + "/cube2.obj");
   PnOutput o = pnTrianglesCpu(prepareMesh(m), {false, true});
   for (size_t t = 0; t < m.triangles.size(); ++t) {
     glm::dvec3 a = m.positions[m.triangles[t][0]], b = m.positions[m.triangles[t][1]], c = m.positions[m.triangles[t][2]];

@@ -1,5 +1,5 @@
 #version 450
-// Kernel deform_smooth (K3 of ALGORITHM.md 3.4, fused): per sub-triangle, (1) sampling and (2)
+// Kernel deform_smooth (K3 of METHOD.md 3.4, fused): per sub-triangle, (1) sampling and (2)
 // constraint points by exact FFD, (3) control points by the constrained least-squares fit, the normal
 // patch by the same fit on cofactor-deformed normals, (4) adjusting normals, (5) adjustment of the edge
 // control points (tangent plane, or crease line on crease slots) and the PN centre rule, (6)

@@ -1,5 +1,5 @@
 #version 450
-// Split deform, step 5 (ALGORITHM.md 3.4): edge control points onto the tangent plane or crease line.
+// Split deform, step 5 (METHOD.md 3.4): edge control points onto the tangent plane or crease line.
 #extension GL_GOOGLE_include_directive : require
 #include "../common/prelude.glsl"
 #include "smooth_deform.glsl"

@@ -1,5 +1,5 @@
 #version 450
-// Split deform, step 3 (ALGORITHM.md 3.4): control points and normal patch by the constrained fit.
+// Split deform, step 3 (METHOD.md 3.4): control points and normal patch by the constrained fit.
 #extension GL_GOOGLE_include_directive : require
 #include "../common/prelude.glsl"
 #include "smooth_deform.glsl"

@@ -1,5 +1,5 @@
 #version 450
-// Split deform, steps 1, 2 and 4 (ALGORITHM.md 3.4): every lattice evaluation of a sub-triangle, stored
+// Split deform, steps 1, 2 and 4 (METHOD.md 3.4): every lattice evaluation of a sub-triangle, stored
 // for the later steps. Same functions as the fused kernel deform_smooth.
 #extension GL_GOOGLE_include_directive : require
 #include "../common/prelude.glsl"

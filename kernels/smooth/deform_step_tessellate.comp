@@ -1,5 +1,5 @@
 #version 450
-// Split deform, step 6 (ALGORITHM.md 3.4): tessellation of the patches at level L.
+// Split deform, step 6 (METHOD.md 3.4): tessellation of the patches at level L.
 #extension GL_GOOGLE_include_directive : require
 #include "../common/prelude.glsl"
 #include "smooth_deform.glsl"

@@ -1,4 +1,4 @@
-// kernels/smooth/smooth_deform.glsl: the steps of the smooth-FFD deform stage (ALGORITHM.md 3.4) as
+// kernels/smooth/smooth_deform.glsl: the steps of the smooth-FFD deform stage (METHOD.md 3.4) as
 // functions, shared by the fused kernel deform_smooth and the split kernels deform_step_*; the C++
 // twin is kernels/smooth/smooth_deform.cpp. Both forms call the same functions, so they agree.
 //

@@ -1,4 +1,4 @@
-// Kernel K3 "deform" of smooth FFD (Cui & Feng 2015, improved by Lu & Feng; ALGORITHM.md 3.4): each
+// Kernel K3 "deform" of smooth FFD (Cui & Feng 2015, improved by Lu & Feng; METHOD.md 3.4): each
 // sub-triangle becomes a cubic triangular Bezier patch fitted to the exactly deformed surface, with a
 // cubic normal patch, creases kept sharp, tessellated at level L. GPU kernel kernels/smooth/deform_smooth.comp;
 // the C++ twin here, templated on the arithmetic type.
@@ -14,7 +14,7 @@
 namespace sffd {
 
 // The interior fitting points of the degree-s sampling lattice with their centre-fit weights
-// (closed form of the constrained least squares, ALGORITHM.md 3.4 step 3): SFFD_FIT_STRIDE values each.
+// (closed form of the constrained least squares, METHOD.md 3.4 step 3): SFFD_FIT_STRIDE values each.
 struct FitTable {
   int s = 6;
   int points = 0;

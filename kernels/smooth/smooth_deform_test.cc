@@ -1,4 +1,4 @@
-// Smooth FFD deform stage (ALGORITHM.md 3.4, 3.5): the identity lattice reproduces the PN triangles;
+// Smooth FFD deform stage (METHOD.md 3.4, 3.5): the identity lattice reproduces the PN triangles;
 // closed inputs give closed, consistently oriented outputs (bitwise C0 along every shared edge).
 #include <gtest/gtest.h>
 
@@ -14,7 +14,7 @@ using namespace sffd;
 
 namespace {
 
-const std::string kData = SFFD_SHARED_DATA;
+const std::string kData = SFFD_TEST_DATA;
 
 struct SmoothRun {
   Mesh mesh;
@@ -65,7 +65,7 @@ void expectClosedOutput(const Mesh& out) {
 }  // namespace
 
 TEST(SmoothDeform, FitTableMatchesTheClosedForm) {
-  // ALGORITHM.md 3.4: for s = 6 the centre weights on the raw interior samples are 18/41, 27/41, 36/41.
+  // METHOD.md 3.4: for s = 6 the centre weights on the raw interior samples are 18/41, 27/41, 36/41.
   FitTable F = makeFitTable(6);
   ASSERT_EQ(F.points, 10);
   double sum = 0;
@@ -81,7 +81,7 @@ TEST(SmoothDeform, FitTableMatchesTheClosedForm) {
 }
 
 TEST(SmoothDeform, IdentityLatticeReproducesPnTriangles) {
-  for (const char* file : {"/acaffd/sphere.obj", "/acaffd/cube2.obj", "/acaffd/rabbit_cym.obj"}) {
+  for (const char* file : {"/sphere.obj", "/cube2.obj", "/torus.obj"}) {
     SCOPED_TRACE(file);
     Mesh m = readMesh(kData + file);
     SmoothRun r = smooth(m, boxLattice(m), 1e3, {false, true});   // no splitting: one patch per triangle
@@ -97,9 +97,9 @@ TEST(SmoothDeform, IdentityLatticeReproducesPnTriangles) {
 
 TEST(SmoothDeform, ClosedInputsGiveClosedOutputs) {
   struct Case { const char* mesh; const char* lattice; double l; };
-  for (const Case& c : {Case{"/acaffd/cube2.obj", "/acaffd/lattices/cube2_control_points5.npy", 0.2},
-                        Case{"/acaffd/rabbit_cym.obj", "/acaffd/lattices/rabbit_cym_control_points0.npy", 0.2},
-                        Case{"/acaffd/sphere.obj", "/acaffd/lattices/sphere_control_points0.npy", 0.1}}) {
+  for (const Case& c : {Case{"/cube2.obj", "/lattices/cube2_twist.npy", 0.2},
+                        Case{"/torus.obj", "/lattices/torus_twist.npy", 0.2},
+                        Case{"/sphere.obj", "/lattices/sphere_twist.npy", 0.1}}) {
     SCOPED_TRACE(c.mesh);
     Mesh m = readMesh(kData + c.mesh);
     // The .npy convention: mesh at 0.99 inside the box normalised to half-extent 1.

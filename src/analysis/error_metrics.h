@@ -1,4 +1,4 @@
-// Error analysis (ALGORITHM.md 5; seed paper 6.3): a deformation result against the exact FFD of the
+// Error analysis (METHOD.md 5; seed paper 6.3): a deformation result against the exact FFD of the
 // same surface points, in double precision on the CPU.
 //
 // Correspondence: every tessellation vertex of the result has a pre-image, barycentrics lam in a parent

@@ -1,4 +1,4 @@
-// Error analysis (error_metrics.h, ALGORITHM.md 5): statistics, the quadrature, the exact deformed
+// Error analysis (error_metrics.h, METHOD.md 5): statistics, the quadrature, the exact deformed
 // volume against exact values and against a very fine classic deformation, the errors of accurate and
 // classic FFD, and the .bpt reference on the exact surface.
 #include <gtest/gtest.h>
@@ -19,9 +19,9 @@ using namespace sffd;
 
 namespace {
 
-const std::string kData = SFFD_SHARED_DATA;
+const std::string kData = SFFD_TEST_DATA;
 
-Mesh load(const std::string& name) { return readMesh(kData + "/acaffd/" + name); }
+Mesh load(const std::string& name) { return readMesh(kData + "/" + name); }
 
 Lattice boxLattice(const Mesh& m, std::array<int, 3> counts, std::array<int, 3> degree, double margin = 0.0) {
   glm::dvec3 lo = m.positions[0], hi = lo;
@@ -208,7 +208,7 @@ TEST(ErrorMetrics, SmoothMeshNormalsAreTheReferenceNotFaceNormals) {
 }
 
 TEST(ErrorMetrics, BptReferenceIsTheExactSurface) {
-  Mesh coarse = load("t.bpt");
+  Mesh coarse = load("teapot.bpt");
   ASSERT_FALSE(coarse.patches.empty());
   EXPECT_FALSE(isClosed(coarse));
   Lattice L = boxLattice(coarse, {5, 5, 5}, {2, 2, 2}, 0.01);
@@ -219,7 +219,7 @@ TEST(ErrorMetrics, BptReferenceIsTheExactSurface) {
   // The midpoint of a coarse grid edge, inside patch 5, is a vertex of the twice finer tessellation.
   MeshReadOptions o;
   o.bptResolution = 20;
-  Mesh fine = readMesh(kData + "/acaffd/t.bpt", o);
+  Mesh fine = readMesh(kData + "/teapot.bpt", o);
   const int patch = 5, i = 3, j = 4;
   const uint32_t tri = uint32_t(patch * 200 + 2 * (i * 10 + j));   // cell (i, j): (i,j) (i+1,j) (i,j+1)
   ASSERT_EQ(coarse.vertexUV[coarse.triangles[tri][0]], glm::dvec2(0.3, 0.4));

@@ -20,7 +20,7 @@ using namespace sffd;
 
 namespace {
 
-const std::string kData = SFFD_SHARED_DATA;
+const std::string kData = SFFD_TEST_DATA;
 
 OpenedBackend open(const std::string& name) { return sffd::testing::openForTest(name); }
 
@@ -59,7 +59,7 @@ class AccurateConformance : public ::testing::TestWithParam<std::string> {};
 TEST_P(AccurateConformance, AgreesWithCpuTwinInEveryVariant) {
   OpenedBackend b = open(GetParam());
   ASSERT_TRUE(b.gpu);
-  Mesh mesh = readMesh(kData + "/acaffd/sphere.obj");
+  Mesh mesh = readMesh(kData + "/sphere.obj");
   // Extrapolate: a margin-less box; Keep: a box smaller than the sphere, so the outside rule is exercised.
   for (auto [outside, margin] : {std::pair{OutsideMode::Extrapolate, 0.0}, std::pair{OutsideMode::Keep, -0.05}}) {
     Lattice L = latticeFor(mesh, {5, 6, 4}, {2, 3, 2}, 0.1, outside, margin);
@@ -84,7 +84,7 @@ TEST_P(AccurateConformance, AgreesWithCpuTwinInEveryVariant) {
 
 TEST_P(AccurateConformance, LargestPatchDegree) {
   OpenedBackend b = open(GetParam());
-  Mesh mesh = readMesh(kData + "/acaffd/cube2.obj");
+  Mesh mesh = readMesh(kData + "/cube2.obj");
   Lattice L = latticeFor(mesh, {7, 6, 7}, {5, 5, 5}, 0.05, OutsideMode::Extrapolate, 0.01);
   PackedLattice P = packLattice(L);
   AccurateJob job = makeAccurateJob(mesh, L, clipAgainstKnotBoxes(mesh, L), 10);
@@ -99,7 +99,7 @@ TEST_P(AccurateConformance, HighestTessellationLevel) {
   // --tess 64 (2145 vertices a patch): one invocation per patch would run past llvmpipe's 65535 loop
   // iterations and leave the last vertices unwritten; the staged kernel must not.
   OpenedBackend b = open(GetParam());
-  Mesh mesh = readMesh(kData + "/acaffd/cube2.obj");
+  Mesh mesh = readMesh(kData + "/cube2.obj");
   Lattice L = latticeFor(mesh, {5, 5, 5}, {2, 2, 2}, 0.1, OutsideMode::Extrapolate, 0.01);
   PackedLattice P = packLattice(L);
   AccurateJob job = makeAccurateJob(mesh, L, clipAgainstKnotBoxes(mesh, L), 64);
@@ -109,7 +109,7 @@ TEST_P(AccurateConformance, HighestTessellationLevel) {
 
 TEST_P(AccurateConformance, ChunkedJobEqualsOneDispatch) {
   OpenedBackend b = open(GetParam());
-  Mesh mesh = readMesh(kData + "/acaffd/sphere.obj");
+  Mesh mesh = readMesh(kData + "/sphere.obj");
   Lattice L = latticeFor(mesh, {5, 5, 5}, {2, 2, 2}, 0.1, OutsideMode::Extrapolate, 0.01);
   PackedLattice P = packLattice(L);
   AccurateJob job = makeAccurateJob(mesh, L, clipAgainstKnotBoxes(mesh, L), 10);
@@ -122,7 +122,7 @@ TEST_P(AccurateConformance, ChunkedJobEqualsOneDispatch) {
 
 TEST_P(AccurateConformance, IdentityLatticeReproducesTheFlatMesh) {
   OpenedBackend b = open(GetParam());
-  Mesh mesh = readMesh(kData + "/acaffd/sphere.obj");
+  Mesh mesh = readMesh(kData + "/sphere.obj");
   Lattice L = latticeFor(mesh, {5, 5, 5}, {2, 2, 2}, 0.0, OutsideMode::Extrapolate, 0.0);
   AccurateJob job = makeAccurateJob(mesh, L, clipAgainstKnotBoxes(mesh, L), 10);
   PatchVertices pv = accuratePatchVertices(job, accurateFfdGpu(*b.gpu, job, packLattice(L), {false, false}));

@@ -107,9 +107,9 @@ TEST_P(ClassicConformance, IdentityLatticeLeavesVerticesAndNormals) {
 
 TEST_P(ClassicConformance, PnKernelAgreesWithCpuReference) {
   OpenedBackend b = open(GetParam());
-  for (const char* file : {"/acaffd/cube2.obj", "/acaffd/rabbit_cym.obj"}) {
+  for (const char* file : {"/cube2.obj", "/torus.obj"}) {
     SCOPED_TRACE(file);
-    PreparedMesh P = prepareMesh(readMesh(std::string(SFFD_SHARED_DATA) + file));
+    PreparedMesh P = prepareMesh(readMesh(std::string(SFFD_TEST_DATA) + file));
     PnOutput cpuDouble = pnTrianglesCpu(P, {false, true}), cpuFloat = pnTrianglesCpu(P, {true, false});
     // Fast kernels against the C++ float path: the same float inputs, so the ill-conditioned spots
     // (normals of very short edges) agree too; the double reference would differ there by 1e-4.
@@ -130,9 +130,9 @@ TEST_P(ClassicConformance, PnKernelAgreesWithCpuReference) {
 
 TEST_P(ClassicConformance, ClipKernelsAgreeWithCpuReference) {
   OpenedBackend b = open(GetParam());
-  for (auto [file, l] : {std::pair{"/acaffd/cube2.obj", 0.09}, std::pair{"/acaffd/rabbit_cym.obj", 0.04}}) {
+  for (auto [file, l] : {std::pair{"/cube2.obj", 0.09}, std::pair{"/torus.obj", 0.04}}) {
     SCOPED_TRACE(file);
-    Mesh m = readMesh(std::string(SFFD_SHARED_DATA) + file);
+    Mesh m = readMesh(std::string(SFFD_TEST_DATA) + file);
     PreparedMesh P = prepareMesh(m);
     ClipTriangles C = buildClipTriangles(m, l, splitPatternTable().nmax());
     for (KernelVariant v : {KernelVariant{true, false}, KernelVariant{false, false}}) {
@@ -154,7 +154,7 @@ TEST_P(ClassicConformance, ClipKernelsAgreeWithCpuReference) {
 
 TEST_P(ClassicConformance, SmoothDeformKernelAgreesWithCpuReference) {
   OpenedBackend b = open(GetParam());
-  Mesh m = readMesh(std::string(SFFD_SHARED_DATA) + "/acaffd/cube2.obj");
+  Mesh m = readMesh(std::string(SFFD_TEST_DATA) + "/cube2.obj");
   PreparedMesh P = prepareMesh(m);
   PnOutput pn = pnTrianglesCpu(P, {true, false});
   double l = 0.5;

@@ -1,10 +1,12 @@
 #include "io/atomic_file.h"
 
+#include <csignal>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <mutex>
 #include <random>
 #include <unistd.h>
 
@@ -14,6 +16,68 @@ namespace sffd {
 namespace fs = std::filesystem;
 
 namespace {
+
+// Temporary files being written, removed by the handler of SIGINT, SIGTERM and SIGHUP so that an
+// interrupted run leaves nothing behind. Fixed storage: the handler may only call async-signal-safe
+// functions (unlink, signal, raise) and read plain memory.
+constexpr int kSlots = 16;
+constexpr size_t kPathMax = 4096;
+char gTempPath[kSlots][kPathMax];
+volatile std::sig_atomic_t gTempUsed[kSlots];
+std::mutex gTempMutex;
+
+extern "C" void removeTemporariesAndDie(int sig) {
+  for (int i = 0; i < kSlots; ++i)
+    if (gTempUsed[i]) ::unlink(gTempPath[i]);
+  std::signal(sig, SIG_DFL);
+  std::raise(sig);
+}
+
+// Installs the handler once, for each signal whose disposition is still the default: an application
+// that handles a signal itself keeps its handler (and its own clean-up).
+void installInterruptHandlers() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    for (int sig : {SIGINT, SIGTERM, SIGHUP}) {
+      struct sigaction old {};
+      if (::sigaction(sig, nullptr, &old) == 0 && old.sa_handler == SIG_DFL) {
+        struct sigaction sa {};
+        sa.sa_handler = removeTemporariesAndDie;
+        sigemptyset(&sa.sa_mask);
+        ::sigaction(sig, &sa, nullptr);
+      }
+    }
+  });
+}
+
+// Registers a temporary path for the handler while it exists; a path too long or more than kSlots at
+// once are simply not registered (they are still removed on every failure the program sees).
+class TemporaryGuard {
+ public:
+  explicit TemporaryGuard(const std::string& path) {
+    installInterruptHandlers();
+    if (path.size() >= kPathMax) return;
+    std::lock_guard<std::mutex> lock(gTempMutex);
+    for (int i = 0; i < kSlots; ++i)
+      if (!gTempUsed[i]) {
+        std::memcpy(gTempPath[i], path.c_str(), path.size() + 1);
+        gTempUsed[i] = 1;
+        slot_ = i;
+        return;
+      }
+  }
+  ~TemporaryGuard() {
+    if (slot_ < 0) return;
+    std::lock_guard<std::mutex> lock(gTempMutex);
+    gTempUsed[slot_] = 0;
+  }
+  TemporaryGuard(const TemporaryGuard&) = delete;
+  TemporaryGuard& operator=(const TemporaryGuard&) = delete;
+
+ private:
+  int slot_ = -1;
+};
+
 std::string temporaryBeside(const std::string& path) {
   fs::path p(path);
   std::random_device rd;
@@ -35,6 +99,7 @@ void commit(const std::string& tmp, const std::string& path) {
 void writePathAtomically(const std::string& path, const std::function<void(const std::string&)>& write) {
   if (fs::is_directory(path)) throw inputError(path, 0, "cannot write: is a directory");
   std::string tmp = temporaryBeside(path);
+  TemporaryGuard guard(tmp);   // registered before the file exists, released after rename or removal
   {
     std::ofstream probe(tmp, std::ios::binary);
     if (!probe) throw inputError(path, 0, std::string("cannot write: ") + std::strerror(errno));

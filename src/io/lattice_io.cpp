@@ -1,7 +1,7 @@
 // Lattice files: dispatch, the native JSON format (read and write) and the presets of `sffd lattice`.
 // PyGeM .prm and .npy are in lattice_io_formats.cpp.
 //
-// JSON (CONTRACT.md "Inputs"), every field checked, errors as "file:line: what":
+// JSON (docs/CLI.md "Inputs"), every field checked, errors as "file:line: what":
 //   "format": "sffd-lattice", "version": 1                                   required
 //   "degree": [du, dv, dw] (1..5), "counts": [cu, cv, cw] (> degree)         required
 //   "box": {"min": [x, y, z], "max": [x, y, z]}  (min < max)                 required

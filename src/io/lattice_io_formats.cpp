@@ -18,7 +18,7 @@ namespace sffd::latticeio {
 // box length x/y/z, box origin x/y/z, rotation angle x/y/z (degrees), and parameter x/y/z, whose value
 // (continued on indented lines) holds "i j k mu" lines, mu the displacement normalised by the box length,
 // in the box's local axes; absent entries are 0.
-// Meaning (ALGORITHM.md 6): a Bernstein lattice, i.e. one knot box of degree n-1 on each axis with knots
+// Meaning (METHOD.md 6): a Bernstein lattice, i.e. one knot box of degree n-1 on each axis with knots
 // [0..0, 1..1] in the parameter space [0,1]^3; R = Rx(ax) Ry(ay) Rz(az), A = R diag(L), parameter of a
 // world point x: p = A^-1 (x - origin); control point (i, j, k) = origin + A ((i/(nx-1), j/(ny-1),
 // k/(nz-1)) + mu_ijk); points outside the box are left unmoved (OutsideMode::Keep).
@@ -192,7 +192,7 @@ Lattice readPrm(const std::string& path, const std::string& text) {
 // .npy (numpy format 1.0/2.0/3.0): a little-endian float32 or float64 array of shape (mu, mv, mw, 3) in
 // C order, point [i][j][k] with i along x. The lattice: degree options.npyDegree, clamped uniform knots
 // over the mesh box [options.meshBoxLo, options.meshBoxHi], identity frame (the reference
-// implementation's convention, ALGORITHM.md 1.1).
+// implementation's convention, METHOD.md 1.1).
 
 namespace {
 

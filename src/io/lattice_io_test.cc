@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -20,7 +21,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const std::string kData = SFFD_SHARED_DATA;
+const std::string kData = SFFD_TEST_DATA;
 
 class LatticeIo : public ::testing::Test {
  protected:
@@ -205,19 +206,18 @@ LatticeReadOptions boxOptions(glm::dvec3 lo, glm::dvec3 hi) {
   return o;
 }
 
-TEST_F(LatticeIo, NpyReferenceFiles) {
-  // t_control_points0 is the identity (Greville points) over the box of t.bpt (tessellated 10 x 10 a
-  // patch) normalised so that its largest half-extent is 1 -- not 0.99: the reference implementation's
-  // body box is the model's box in [-1,1]^3, the model itself then being scaled by 0.99 inside it.
-  const std::string t0 = kData + "/acaffd/lattices/t_control_points0.npy";
-  Mesh teapot = readMesh(kData + "/acaffd/t.bpt");
+// The identity .npy of a .bpt model is the Greville lattice of the model's box (tessellated 10 x 10 a
+// patch) normalised so that its largest half-extent is 1 -- not 0.99: the reference implementation's
+// body box is the model's box in [-1,1]^3, the model itself then being scaled by 0.99 inside it.
+void expectGrevilleNpy(const std::string& npy, const std::string& bpt) {
+  Mesh teapot = readMesh(bpt);
   glm::dvec3 lo(1e9), up(-1e9);
   for (const auto& p : teapot.positions) lo = glm::min(lo, p), up = glm::max(up, p);
   glm::dvec3 centre = 0.5 * (lo + up);
   double half = 0.5 * std::max({up.x - lo.x, up.y - lo.y, up.z - lo.z});
   lo = (lo - centre) / half;
   up = (up - centre) / half;
-  Lattice L = readLattice(t0, boxOptions(lo, up));
+  Lattice L = readLattice(npy, boxOptions(lo, up));
   EXPECT_EQ(L.counts, (std::array<int, 3>{5, 5, 5}));
   EXPECT_EQ(L.degree, (std::array<int, 3>{2, 2, 2}));
   EXPECT_EQ(L.knots[0], clampedUniformKnots(5, 2, lo.x, up.x));
@@ -229,23 +229,44 @@ TEST_F(LatticeIo, NpyReferenceFiles) {
   EXPECT_NEAR(L.controlPoints[L.index(1, 0, 0)].x, -2.0 / 3.0, 1e-7);
   EXPECT_NEAR(L.controlPoints[L.index(0, 3, 0)].y, 2.0 / 3.0 * up.y, 1e-7);
   EXPECT_NEAR(L.controlPoints[L.index(0, 0, 2)].z, 0.0, 1e-7);
-  // cube2_control_points0 is a deformed lattice over [-1,1]^3: its unmoved points are Greville points there.
-  Lattice C = readLattice(kData + "/acaffd/lattices/cube2_control_points0.npy", boxOptions(glm::dvec3(-1), glm::dvec3(1)));
+}
+
+// A deformed lattice over [-1,1]^3: its unmoved points are Greville points there.
+int unmovedNpyPoints(const std::string& npy) {
+  Lattice C = readLattice(npy, boxOptions(glm::dvec3(-1), glm::dvec3(1)));
   Lattice CI = C;
   setIdentityControlPoints(CI);
   int unmoved = 0;
   for (size_t i = 0; i < C.controlPoints.size(); ++i) unmoved += glm::length(C.controlPoints[i] - CI.controlPoints[i]) < 1e-6;
-  EXPECT_EQ(unmoved, 44);
   EXPECT_EQ(C.controlPoints[0], glm::dvec3(-1, -1, -1));
-  // Every shared .npy reads (float32 (5,5,5,3)); the degree comes from the options.
+  return unmoved;
+}
+
+TEST_F(LatticeIo, NpyReferenceFiles) {
+  expectGrevilleNpy(kData + "/lattices/teapot_identity.npy", kData + "/teapot.bpt");
+  // cube2_top moves the 9 interior points of the top layer only (tools/make_test_data.py).
+  EXPECT_EQ(unmovedNpyPoints(kData + "/lattices/cube2_top.npy"), 125 - 9);
+  // Every .npy of the test data reads (float32 (5,5,5,3)); the degree comes from the options.
   LatticeReadOptions o = boxOptions(glm::dvec3(-1), glm::dvec3(1));
   o.npyDegree = {3, 2, 1};
-  for (const auto& e : fs::directory_iterator(kData + "/acaffd/lattices")) {
+  int files = 0;
+  for (const auto& e : fs::directory_iterator(kData + "/lattices")) {
     Lattice X = readLattice(e.path().string(), o);
     EXPECT_EQ(X.pointCount(), 125u);
     EXPECT_EQ(X.degree, o.npyDegree);
     EXPECT_EQ(X.knots[0].size(), 9u);
+    ++files;
   }
+  EXPECT_GE(files, 7);
+}
+
+// The reference implementation's own files, where SFFD_REFERENCE_DATA names a copy (tests/data/README.md).
+TEST_F(LatticeIo, NpyFilesOfTheReferenceImplementation) {
+  const char* ref = std::getenv("SFFD_REFERENCE_DATA");
+  if (!ref) GTEST_SKIP() << "SFFD_REFERENCE_DATA not set: the reference implementation's .npy files are not in the repository";
+  const std::string d = std::string(ref) + "/acaffd/";
+  expectGrevilleNpy(d + "lattices/t_control_points0.npy", d + "t.bpt");
+  EXPECT_EQ(unmovedNpyPoints(d + "lattices/cube2_control_points0.npy"), 44);
 }
 
 TEST_F(LatticeIo, NpyFloat64AndVersion2) {

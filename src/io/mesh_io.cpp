@@ -223,6 +223,14 @@ void checkWritable(const std::string& path, const Mesh& mesh, bool& withNormals)
   for (const auto& t : mesh.triangles)
     for (uint32_t i : t)
       if (i >= n) throw Error(ErrorKind::Internal, path + ": mesh triangle index out of range");
+  // A lattice that sends points beyond the floating-point range gives inf or NaN: refuse to write a
+  // file of them, and say where (the lattice is the input at fault, so this is an input error).
+  auto finite = [](const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
+  for (size_t v = 0; v < n; ++v)
+    if (!finite(mesh.positions[v]) || (withNormals && !finite(mesh.normals[v])))
+      throw Error(ErrorKind::Input, path + ": not written: vertex " + std::to_string(v) + " of the result has a " +
+                                        (finite(mesh.positions[v]) ? "non-finite normal" : "non-finite position") +
+                                        " (the lattice moves it beyond the floating-point range of the computation)");
 }
 
 void writeObj(std::ostream& os, const Mesh& mesh, int digits, bool withNormals) {

@@ -1,4 +1,4 @@
-// .bpt Bezier patch files (ALGORITHM.md 5, "Utah teapot"): a patch count, then per patch a line "3 3"
+// .bpt Bezier patch files (METHOD.md 5, "Utah teapot"): a patch count, then per patch a line "3 3"
 // (the degrees) and 16 control points "x y z", P(u,v) = sum_r sum_c B3_r(u) B3_c(v) P[4r+c].
 //
 // Tessellation: each patch is sampled on a uniform (res+1) x (res+1) grid of (u, v) (res =

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -31,7 +32,7 @@ glm::dvec3 roundedToFloat(const glm::dvec3& v) {
 
 namespace {
 
-const std::string kData = SFFD_SHARED_DATA;
+const std::string kData = SFFD_TEST_DATA;
 
 // A fresh folder per test, removed afterwards.
 class MeshIo : public ::testing::Test {
@@ -103,7 +104,7 @@ void expectWellFormed(const Mesh& m) {
 // Shared example files
 
 TEST_F(MeshIo, Cube2ObjKeepsSplitNormals) {
-  Mesh m = readMesh(kData + "/acaffd/cube2.obj");
+  Mesh m = readMesh(kData + "/cube2.obj");
   expectWellFormed(m);
   EXPECT_TRUE(m.normalsFromFile);
   EXPECT_EQ(m.triangles.size(), 12u);
@@ -134,7 +135,7 @@ TEST_F(MeshIo, Cube2ObjKeepsSplitNormals) {
 }
 
 TEST_F(MeshIo, CubeObjSmoothNormals) {
-  Mesh m = readMesh(kData + "/acaffd/cube.obj");
+  Mesh m = readMesh(kData + "/cube.obj");
   expectWellFormed(m);
   EXPECT_TRUE(m.normalsFromFile);
   EXPECT_EQ(m.positions.size(), 8u);
@@ -145,16 +146,17 @@ TEST_F(MeshIo, CubeObjSmoothNormals) {
 }
 
 TEST_F(MeshIo, OtherSharedObjs) {
-  Mesh sphere = readMesh(kData + "/acaffd/sphere.obj");   // v/vt/vn corners
+  Mesh sphere = readMesh(kData + "/sphere.obj");   // v/vt/vn corners
   expectWellFormed(sphere);
   EXPECT_EQ(sphere.triangles.size(), 720u);
   EXPECT_TRUE(sphere.normalsFromFile);
-  Mesh rabbit = readMesh(kData + "/acaffd/rabbit_cym.obj");
-  expectWellFormed(rabbit);
-  EXPECT_EQ(rabbit.triangles.size(), 8400u);
-  EXPECT_EQ(rabbit.positions.size(), 4432u);   // 4336 positions, 96 of them also used with a second normal
-  EXPECT_EQ(distinctWelds(rabbit), 4250u);       // some 'v' lines repeat a position
-  Mesh teapot = readMesh(kData + "/teapot/teapot_bezier_8x8.obj");   // no normals: computed
+  Mesh torus = readMesh(kData + "/torus.obj");
+  expectWellFormed(torus);
+  EXPECT_EQ(torus.triangles.size(), 8400u);        // 70 x 60 quads
+  EXPECT_EQ(torus.positions.size(), 71u * 61u);    // one per 'v' line: the UV seams repeat a position
+  EXPECT_EQ(distinctWelds(torus), 70u * 60u);      // welded across the seams
+  EXPECT_EQ(boundaryEdges(torus), 0u);
+  Mesh teapot = readMesh(kData + "/teapot_8x8.obj");   // no normals: computed
   expectWellFormed(teapot);
   EXPECT_FALSE(teapot.normalsFromFile);
   EXPECT_EQ(teapot.triangles.size(), 4032u);
@@ -204,7 +206,7 @@ glm::dvec3 patchPoint(const BicubicPatch& P, double u, double v) {
 }
 
 TEST_F(MeshIo, TeapotBpt) {
-  Mesh m = readMesh(kData + "/acaffd/t.bpt");
+  Mesh m = readMesh(kData + "/teapot.bpt");
   expectWellFormed(m);
   EXPECT_TRUE(m.normalsFromFile);
   ASSERT_EQ(m.patches.size(), 36u);
@@ -262,9 +264,32 @@ TEST_F(MeshIo, TeapotBpt) {
   // A coarser resolution.
   MeshReadOptions o;
   o.bptResolution = 4;
-  Mesh c = readMesh(kData + "/acaffd/t.bpt", o);
+  Mesh c = readMesh(kData + "/teapot.bpt", o);
   EXPECT_EQ(c.triangles.size(), 36u * 32u);
   EXPECT_EQ(c.positions.size(), 36u * 25u);
+}
+
+// The generated teapot (tools/make_test_data.py) against the reference implementation's t.bpt, where
+// SFFD_REFERENCE_DATA names a copy: the same 36 patches in the same order. 544 of the 576 control points
+// are the same numbers; the 32 of the four ring patches, typed by hand there, agree to 1e-12 except for
+// eight (two a patch) whose x or y is off by 0.03 (a typo there: 1.3366... for 1.3666..., the blend of
+// the radii 1.3 and 1.4).
+TEST_F(MeshIo, TeapotBptMatchesTheReferenceLayout) {
+  const char* ref = std::getenv("SFFD_REFERENCE_DATA");
+  if (!ref) GTEST_SKIP() << "SFFD_REFERENCE_DATA not set: the reference implementation's t.bpt is not in the repository";
+  Mesh a = readMesh(std::string(ref) + "/acaffd/t.bpt"), b = readMesh(kData + "/teapot.bpt");
+  ASSERT_EQ(a.patches.size(), b.patches.size());
+  size_t same = 0, close = 0, typo = 0;
+  for (size_t p = 0; p < a.patches.size(); ++p)
+    for (int k = 0; k < 16; ++k) {
+      double d = glm::length(a.patches[p].points[k] - b.patches[p].points[k]);
+      same += d == 0;
+      close += d > 0 && d < 1e-12;
+      typo += std::abs(d - 0.03) < 1e-9;
+    }
+  EXPECT_EQ(same, 544u);
+  EXPECT_EQ(same + close + typo, 576u);
+  EXPECT_EQ(typo, 8u);
 }
 
 // ---------------------------------------------------------------------------------------------------
@@ -331,14 +356,14 @@ TEST_F(MeshIo, RoundTripsAreExact) {
     }
   }
   // OBJ keeps the vertex order of a mesh without split normals; written positions are welded.
-  Mesh cube = readMesh(kData + "/acaffd/cube.obj");
+  Mesh cube = readMesh(kData + "/cube.obj");
   writeMesh(path("cube.obj"), cube, 17);
   Mesh back = readMesh(path("cube.obj"));
   EXPECT_EQ(back.positions, cube.positions);
   EXPECT_EQ(back.normals, cube.normals);
   EXPECT_EQ(back.triangles, cube.triangles);
   // The split cube: 8 'v' lines, 24 'vn' lines.
-  Mesh cube2 = readMesh(kData + "/acaffd/cube2.obj");
+  Mesh cube2 = readMesh(kData + "/cube2.obj");
   writeMesh(path("cube2.obj"), cube2, 9);
   std::ifstream in(path("cube2.obj"));
   std::string line;
@@ -353,7 +378,7 @@ TEST_F(MeshIo, RoundTripsAreExact) {
   EXPECT_EQ(f, 12);
   expectSameCorners(cube2, readMesh(path("cube2.obj")), true);
   // The teapot (degenerate triangles, welded seams) survives a round trip through every format.
-  Mesh teapot = readMesh(kData + "/acaffd/t.bpt");
+  Mesh teapot = readMesh(kData + "/teapot.bpt");
   for (const char* ext : {".obj", ".ply", ".off", ".stl"}) {
     std::string p = path(std::string("teapot") + ext);
     writeMesh(p, teapot, 17);
@@ -389,7 +414,7 @@ TEST_F(MeshIo, ReadsOpenMeshOm) {
   ::omlog().disable();
   OpenMesh::TriMesh_ArrayKernelT<> om;   // float points, as most .om files are
   om.request_vertex_normals();
-  Mesh src = readMesh(kData + "/acaffd/cube.obj");
+  Mesh src = readMesh(kData + "/cube.obj");
   std::vector<OpenMesh::VertexHandle> vh;
   for (size_t v = 0; v < src.positions.size(); ++v) {
     vh.push_back(om.add_vertex(OpenMesh::Vec3f(float(src.positions[v].x), float(src.positions[v].y), float(src.positions[v].z))));
@@ -601,7 +626,7 @@ TEST_F(MeshIo, BadInputIsReportedWithFileAndLine) {
   expectInputError([&] { readMesh(path("dir.obj")); }, path("dir.obj"), 0, "directory");
   MeshReadOptions o;
   o.bptResolution = 0;
-  expectInputError([&] { readMesh(kData + "/acaffd/t.bpt", o); }, kData + "/acaffd/t.bpt", 0, "resolution");
+  expectInputError([&] { readMesh(kData + "/teapot.bpt", o); }, kData + "/teapot.bpt", 0, "resolution");
 }
 
 }  // namespace

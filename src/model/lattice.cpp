@@ -1,5 +1,5 @@
 // B-spline lattice model: knots, Greville identity, validation and per-knot-box Bezier extraction
-// by Boehm knot insertion (ALGORITHM.md 1.1-1.2; Boehm, "Inserting new knots into B-spline curves", 1980).
+// by Boehm knot insertion (METHOD.md 1.1-1.2; Boehm, "Inserting new knots into B-spline curves", 1980).
 #include "model/lattice.h"
 
 #include <algorithm>

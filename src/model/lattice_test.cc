@@ -1,4 +1,4 @@
-// Properties of the lattice model and its evaluation (ALGORITHM.md 1, 3.5, 6), checked against an
+// Properties of the lattice model and its evaluation (METHOD.md 1, 3.5, 6), checked against an
 // independent Cox-de Boor evaluation written here from the textbook definition.
 #include <gtest/gtest.h>
 
@@ -71,7 +71,7 @@ TEST(Lattice, KnotsAndGreville) {
   auto k = clampedUniformKnots(5, 2, -1, 1);
   ASSERT_EQ(k.size(), 8u);
   auto xi = grevilleAbscissae(k, 2);
-  std::vector<double> want = {-1, -2.0 / 3, 0, 2.0 / 3, 1};   // ALGORITHM.md 1.1
+  std::vector<double> want = {-1, -2.0 / 3, 0, 2.0 / 3, 1};   // METHOD.md 1.1
   for (int i = 0; i < 5; ++i) EXPECT_NEAR(xi[i], want[i], 1e-15);
 }
 
@@ -154,7 +154,7 @@ TEST(Lattice, CornerControlPointsAreInterpolated) {
 }
 
 TEST(Lattice, Cgp3SederbergParryValue) {
-  // ../shared/data/other_ffd/cgp3_sederberg_parry_case.txt: 3x3x3 Bernstein lattice on [-10,10]^3.
+  // The value of github.com/muhummadPatel/cgp3 test/test_ffd.cpp: 3x3x3 Bernstein lattice on [-10,10]^3.
   Lattice L = makeIdentityLattice({-10, -10, -10}, {10, 10, 10}, {3, 3, 3}, {2, 2, 2});
   EXPECT_NEAR(glm::length(L.controlPoints[0] - glm::dvec3(-10)), 0, 1e-15);
   Evaluated E0(L);

@@ -1,4 +1,4 @@
-// Mesh preparation for smooth FFD (ALGORITHM.md 3.1, 3.2): triangle adjacency by welded position,
+// Mesh preparation for smooth FFD (METHOD.md 3.1, 3.2): triangle adjacency by welded position,
 // crease detection from split normals, per-corner neighbour normals, and the crease-angle fallback.
 //
 // Implements the input model of Cui & Feng, "Smooth free-form deformation with sharp feature
@@ -184,7 +184,7 @@ MeshTopology buildTopology(const Mesh& mesh) {
 }
 
 void applyCreaseAngle(Mesh& mesh, double creaseAngleDeg) {
-  // Normals from the file are the sharpness model itself (ALGORITHM.md 3.1): never overridden.
+  // Normals from the file are the sharpness model itself (METHOD.md 3.1): never overridden.
   if (mesh.normalsFromFile) return;
   checkMesh(mesh, "applyCreaseAngle", false);
   const size_t T = mesh.triangles.size();

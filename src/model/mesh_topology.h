@@ -1,4 +1,4 @@
-// Mesh preparation for smooth FFD (ALGORITHM.md 3.1): triangle adjacency by welded position,
+// Mesh preparation for smooth FFD (METHOD.md 3.1): triangle adjacency by welded position,
 // crease detection from split normals, and per-corner neighbour normals. Plain data in, plain data out.
 //
 // Conventions: edge e of a triangle joins its corners e and (e+1)%3. Corner slots (6 per triangle,
@@ -29,7 +29,7 @@ struct MeshTopology {
   size_t boundaryEdges = 0, nonManifoldEdges = 0, creaseEdges = 0, degenerateTriangles = 0;
 };
 
-// Normals closer than this per component count as equal (the authors' test, ALGORITHM.md 3.2).
+// Normals closer than this per component count as equal (the authors' test, METHOD.md 3.2).
 constexpr double kSameNormalTolerance = 1e-6;
 
 inline int slotEdge(int slot) { return slot % 2 ? slot / 2 : (slot / 2 + 2) % 3; }

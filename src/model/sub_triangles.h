@@ -1,4 +1,4 @@
-// Sub-triangles of a parent triangle as the clipping steps produce them (ALGORITHM.md 3.3, 4):
+// Sub-triangles of a parent triangle as the clipping steps produce them (METHOD.md 3.3, 4):
 // where each corner lies on the parent, described so that points on a shared parent edge can be
 // computed identically, bit for bit, from both triangles that share the edge.
 #pragma once

@@ -349,9 +349,9 @@ SmoothOutput DeformSession::output() {
   out.tess.resize(subCount_ * tessReals);
   for (const Chunk& c : chunks_) {
     if (!c.count) continue;
-    std::vector<unsigned char> b(c.count * tessReals * rs);
-    backend_.download(c.patches, 0, b.data(), c.count * patchReals * rs);
-    b.resize(c.count * patchReals * rs);
+    // Each download into a buffer of its own size: below level 3 a patch has more reals than its tessellation.
+    std::vector<unsigned char> b(c.count * patchReals * rs);
+    backend_.download(c.patches, 0, b.data(), b.size());
     std::vector<double> d = doublesOf(b, options_.variant.f64);
     std::copy(d.begin(), d.end(), out.patches.begin() + c.first * patchReals);
     b.resize(c.count * tessReals * rs);

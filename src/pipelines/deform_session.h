@@ -1,4 +1,4 @@
-// Device-resident smooth FFD (Lu & Feng, "Improved smooth FFD"; ALGORITHM.md 3): the pre-compute
+// Device-resident smooth FFD (Lu & Feng, "Improved smooth FFD"; METHOD.md 3): the pre-compute
 // (PN triangles, regular clipping) runs once and its sub-triangle records stay on the device; each
 // deform() uploads only the lattice's Bezier coefficients and runs the deform kernel into device
 // buffers that a caller on the same GL context can draw from (gl::glBufferObject) or download.

@@ -56,9 +56,9 @@ class DeformSessionTest : public ::testing::TestWithParam<std::string> {
 
 TEST_P(DeformSessionTest, StrictSessionEqualsCpuReferenceAcrossRedeforms) {
   OpenedBackend b = open();
-  for (auto [file, l] : {std::pair{"/acaffd/cube2.obj", 0.5}, std::pair{"/acaffd/rabbit_cym.obj", 0.05}}) {
+  for (auto [file, l] : {std::pair{"/cube2.obj", 0.5}, std::pair{"/torus.obj", 0.05}}) {
     SCOPED_TRACE(file);
-    Mesh m = readMesh(std::string(SFFD_SHARED_DATA) + file);
+    Mesh m = readMesh(std::string(SFFD_TEST_DATA) + file);
     Lattice A = latticeFor(m, 1, 0.1), B = latticeFor(m, 2, 0.2);
     DeformSessionOptions o;
     o.variant = {true, false};
@@ -87,7 +87,7 @@ TEST_P(DeformSessionTest, StrictSessionEqualsCpuReferenceAcrossRedeforms) {
 
 TEST_P(DeformSessionTest, ChunkedSplitAndKnotBoxSessionsEqualCpuReference) {
   OpenedBackend b = open();
-  Mesh m = readMesh(std::string(SFFD_SHARED_DATA) + "/acaffd/sphere.obj");
+  Mesh m = readMesh(std::string(SFFD_TEST_DATA) + "/sphere.obj");
   Lattice A = latticeFor(m, 3, 0.15);
   DeformSessionOptions o;
   o.variant = {true, false};
@@ -123,7 +123,7 @@ TEST_P(DeformSessionTest, ChunkedSplitAndKnotBoxSessionsEqualCpuReference) {
 // the same bits.
 TEST_P(DeformSessionTest, LatticeTooLargeToInlineGivesTheSameOutput) {
   OpenedBackend b = open();
-  Mesh m = readMesh(std::string(SFFD_SHARED_DATA) + "/acaffd/sphere.obj");
+  Mesh m = readMesh(std::string(SFFD_TEST_DATA) + "/sphere.obj");
   glm::dvec3 lo(1e300), hi(-1e300);
   for (const glm::dvec3& p : m.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
   Lattice big = makeIdentityLattice(lo - 0.01, hi + 0.01, {12, 12, 12}, {2, 2, 2});
@@ -143,7 +143,7 @@ TEST_P(DeformSessionTest, LatticeTooLargeToInlineGivesTheSameOutput) {
 
 TEST_P(DeformSessionTest, RefusesALatticeOfAnotherStructureAndBadOptions) {
   OpenedBackend b = open();
-  Mesh m = readMesh(std::string(SFFD_SHARED_DATA) + "/acaffd/cube2.obj");
+  Mesh m = readMesh(std::string(SFFD_TEST_DATA) + "/cube2.obj");
   Lattice A = latticeFor(m, 1, 0.1);
   DeformSession s(*b.gpu, m, A, {});
   Lattice other = makeIdentityLattice({-1, -1, -1}, {1, 1, 1}, {4, 5, 5}, {2, 2, 2});

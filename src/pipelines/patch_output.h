@@ -12,7 +12,7 @@ namespace sffd {
 // Tessellation at level L: per patch (L+1)(L+2)/2 vertices, row r = 0..L (i = L - r), position
 // t = 0..r (k = t, j = r - t), index r(r+1)/2 + t, barycentrics (i, j, k) / L in the patch's
 // sub-triangle; L^2 triangles, "up" (r,t),(r+1,t),(r+1,t+1) for t <= r and "down"
-// (r,t),(r+1,t+1),(r,t+1) for t < r (ALGORITHM.md 3.4 step 6).
+// (r,t),(r+1,t+1),(r,t+1) for t < r (METHOD.md 3.4 step 6).
 int tessVertexCount(int level);
 int tessTriangleCount(int level);
 // The L^2 triangles of one patch as local vertex indices, 3 each.

@@ -1,0 +1,33 @@
+// A lattice that throws points beyond the floating-point range of the computation gives no file of
+// inf and NaN: the run is refused (exit 2) with the vertex where it happened, and nothing is written.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "tests/support/cli_runner.h"
+
+namespace sffd::test {
+namespace {
+
+TEST(NonFinite, ResultsAreRefusedBeforeWriting) {
+  fs::path dir = tempDir("nonfinite");
+  const std::string mesh = std::string(SFFD_TEST_DATA) + "/sphere.obj", lattice = (dir / "l.json").string();
+  ASSERT_EQ(runSffd("lattice " + mesh + " -o " + lattice + " --quiet").status, 0);
+  nlohmann::json L = nlohmann::json::parse(slurp(lattice));
+  L["control_points"][62] = {1e39, 0, 0};   // finite in double, beyond float's range
+  std::ofstream(dir / "far.json") << L.dump();
+  const std::string far = (dir / "far.json").string();
+  for (const char* b : {"vulkan", "gl", "cpu"})
+    for (const char* method : {"--method smooth", "--method accurate --precision float", "--method classic --precision float"}) {
+      const std::string out = (dir / (std::string(b) + ".obj")).string();
+      RunResult r = runSffd("deform " + mesh + " -l " + far + " " + method + " --backend " + b + " -o " + out + " --quiet");
+      if (r.status == 3) continue;   // backend not here
+      EXPECT_EQ(r.status, 2) << b << " " << method << ": " << r.err;
+      EXPECT_NE(r.err.find("sffd: error: " + out + ": not written: vertex "), std::string::npos) << r.err;
+      EXPECT_FALSE(fs::exists(out)) << b << " " << method;
+    }
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace sffd::test

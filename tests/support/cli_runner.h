@@ -1,0 +1,69 @@
+// What the end-to-end tests share: running the sffd binary, fresh temporary folders, reading files,
+// and small meshes written by the test itself (so a test needs no data file).
+#pragma once
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace sffd::test {
+
+namespace fs = std::filesystem;
+
+struct RunResult {
+  int status = -1;   // exit status; 128 when the process did not exit normally (a crash)
+  std::string out, err;
+};
+
+inline std::string slurp(const fs::path& path) {
+  std::ifstream f(path, std::ios::binary);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
+// A new empty folder under the system's temporary folder, unique to this process and name.
+inline fs::path tempDir(const std::string& name) {
+  fs::path d = fs::temp_directory_path() / ("sffd_test_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+// Runs the sffd binary (SFFD_BINARY) with arguments shell-quoted by the caller, after an optional
+// environment prefix ("VAR=value ...").
+inline RunResult runSffd(const std::string& args, const std::string& env = "") {
+  static int serial = 0;
+  fs::path dir = tempDir("run" + std::to_string(serial++));
+  const std::string outFile = (dir / "stdout").string(), errFile = (dir / "stderr").string();
+  const std::string cmd = env + " " + SFFD_BINARY + " " + args + " >" + outFile + " 2>" + errFile;
+  const int raw = std::system(cmd.c_str());
+  RunResult r;
+  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : 128;
+  r.out = slurp(outFile);
+  r.err = slurp(errFile);
+  fs::remove_all(dir);
+  return r;
+}
+
+// An axis-aligned box as OBJ with one normal per face: 8 positions, 12 triangles, every edge a crease.
+inline void writeBoxObj(const fs::path& path, double cx, double cy, double cz, double half) {
+  std::ofstream f(path);
+  for (int i = 0; i < 8; ++i)
+    f << "v " << cx + ((i & 1) ? half : -half) << ' ' << cy + ((i & 2) ? half : -half) << ' '
+      << cz + ((i & 4) ? half : -half) << '\n';
+  f << "vn -1 0 0\nvn 1 0 0\nvn 0 -1 0\nvn 0 1 0\nvn 0 0 -1\nvn 0 0 1\n";
+  // Per face: four corners counter-clockwise seen from outside (1-based), and its normal.
+  const int faces[6][5] = {{1, 5, 7, 3, 1}, {2, 4, 8, 6, 2}, {1, 2, 6, 5, 3},
+                           {3, 7, 8, 4, 4}, {1, 3, 4, 2, 5}, {5, 6, 8, 7, 6}};
+  for (const auto& q : faces) {
+    f << "f " << q[0] << "//" << q[4] << ' ' << q[1] << "//" << q[4] << ' ' << q[2] << "//" << q[4] << '\n';
+    f << "f " << q[0] << "//" << q[4] << ' ' << q[2] << "//" << q[4] << ' ' << q[3] << "//" << q[4] << '\n';
+  }
+}
+
+}  // namespace sffd::test
