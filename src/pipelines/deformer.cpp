@@ -157,7 +157,10 @@ const Timings& Deformer::timings() const { return impl_->timings; }
 
 Mesh Deformer::result() const {
   ProgressReporter progress(impl_->options.progress, backendOf(*impl_->device));
-  return impl_->run->result(progress);
+  progress("download", 0);
+  Mesh mesh = impl_->run->result(progress);
+  progress("download", 1);
+  return mesh;
 }
 
 std::vector<double> Deformer::patchControlPoints() const { return impl_->run->patchControlPoints(); }

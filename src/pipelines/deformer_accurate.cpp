@@ -84,8 +84,7 @@ class AccurateRun final : public MethodRun {
     t.steps = stepsOf(dispatches);
   }
 
-  Mesh result(const ProgressReporter& progress) const override {
-    progress("download", 0);
+  Mesh result(const ProgressReporter&) const override {
     return weldPatchVertices(*patchVertices());
   }
 

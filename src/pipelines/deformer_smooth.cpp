@@ -31,8 +31,7 @@ class SmoothRun final : public MethodRun {
     t.steps = stepsOf(s.dispatches);
   }
 
-  Mesh result(const ProgressReporter& progress) const override {
-    progress("download", 0);
+  Mesh result(const ProgressReporter&) const override {
     return weldPatchVertices(*patchVertices());
   }
 
