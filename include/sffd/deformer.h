@@ -54,8 +54,8 @@ struct DeformOptions {
   bool strict = false;           // strict kernels: bit-identical on every device, the CPU included
   Precision precision = Precision::Auto;
   bool split = false;            // smooth: the deform step as four dispatches (per-step timings)
-  double creaseAngleDeg = 40;    // meshes without normals: dihedral angle above which an edge is a crease
-  uint64_t memoryLimit = 0;      // bytes of host memory a job may plan for; 0: physical memory
+  double creaseAngleDeg = 40;    // smooth, meshes without normals: dihedral angle above which an edge is a crease
+  uint64_t memoryLimit = 0;      // classic, accurate: bytes of host memory a job may plan for; 0: physical memory
   size_t maxChunkElements = 0;   // 0: chunks as large as the device allows (smaller only to test chunking)
   ProgressCallback progress;     // called during long work; may be empty
 };
@@ -64,7 +64,7 @@ struct DeformOptions {
 struct Timings {
   double pnMs = 0, clipMs = 0, deformMs = 0;
   double wallMs = 0;                                    // the whole call, waiting included
-  std::vector<std::pair<std::string, double>> steps;   // every dispatch by label (split: deform.sample, ...)
+  std::vector<std::pair<std::string, double>> steps;   // the last deform()'s dispatches by label (split: deform.sample, ...)
 };
 
 // One chunk of a Deformer's results on the device, as the interop headers hand it out
