@@ -318,13 +318,14 @@ TEST_F(Robust, HundredThousandCharacterLine) {
   expectNothingWritten("long garbage line");
 
   std::string face = "f";
-  for (int i = 0; i < 20000; ++i) face += " 1";   // a 40,001-character face line with 20,000 corners: degenerate, valid
+  for (int i = 0; i < 20000; ++i) face += " 1";   // a 40,001-character face line with 20,000 corners: valid, no area
   std::string q = write("long_ok.obj", tri + "# " + std::string(100000, 'c') + "\n" + face + "\nf 1 2 3\n");
   r = runSffd({"deform", q, "-l", lattice, "--method", "classic", "-o", out("o.obj"), "--quiet"});
   EXPECT_EQ(r.status, 0) << r.err;
   expectNoReports(r, "long comment line");
+  EXPECT_NE(r.err.find("sffd: warning: 1 polygon without area dropped"), std::string::npos) << r.err;
   sffd::Mesh m = sffd::readMesh(out("o.obj"));
-  EXPECT_EQ(m.triangles.size(), 19998u + 1);
+  EXPECT_EQ(m.triangles.size(), 1u);   // the polygon without area is dropped, not fanned into 19,998 slivers
   fs::remove(out("o.obj"));
 
   std::string ply = "ply\nformat ascii 1.0\ncomment " + std::string(100000, 'p') + "\nelement vertex 3\nproperty float x\n";

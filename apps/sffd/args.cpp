@@ -134,4 +134,10 @@ void note(const ParsedArgs& args, const std::string& line) {
   if (!args.has("--quiet")) fprintf(stderr, "sffd: %s\n", line.c_str());
 }
 
+Mesh readMeshWarning(const std::string& path, const MeshReadOptions& options) {
+  Mesh mesh = readMesh(path, options);
+  for (const std::string& w : mesh.warnings) std::fprintf(stderr, "sffd: warning: %s\n", w.c_str());
+  return mesh;
+}
+
 }  // namespace sffd::cli

@@ -72,6 +72,9 @@ Device openDeviceFromArgs(const ParsedArgs& args);
 bool wantDouble(const ParsedArgs& args, const DeviceInfo& info, bool autoDouble);
 
 void note(const ParsedArgs& args, const std::string& line);   // stderr unless --quiet
+// Reads a mesh and prints what the reader repaired or skipped (sffd: warning: ..., even with --quiet:
+// it is about the input).
+Mesh readMeshWarning(const std::string& path, const MeshReadOptions& options = {});
 
 // SFFD_MAX_CHUNK_* (elements per chunk, to test chunking): the value of the variable `name`, at
 // least 1; 0 when it is not set (no limit).

@@ -19,7 +19,7 @@ int run(const ParsedArgs& args) {
     if (counts[a] <= degree[a]) throw Error(ErrorKind::Input, "--counts must exceed --degree on every axis");
     if (counts[a] > 64) throw Error(ErrorKind::Input, "--counts above 64 per axis is not supported by `sffd lattice`");
   }
-  Mesh mesh = readMesh(args.positional[0]);
+  Mesh mesh = readMeshWarning(args.positional[0]);
   if (args.has("--normalize")) {
     double s = args.getDouble("--normalize", 1.0);
     if (!(s > 0)) throw Error(ErrorKind::Input, "--normalize needs a positive scale");

@@ -82,7 +82,7 @@ int run(const ParsedArgs& args) {
   std::vector<std::string> captions;
   std::string computedOn;
   if (!deform) {
-    Mesh mesh = readMesh(args.positional[0]);
+    Mesh mesh = readMeshWarning(args.positional[0]);
     if (args.has("--normalize")) {
       double s = args.getDouble("--normalize", 1.0);
       if (!(s > 0)) throw usageError("--normalize needs a positive scale");

@@ -55,7 +55,7 @@ int run(const ParsedArgs& args) {
     job = loadJob(args);
   } else {
     job.meshPath = args.positional[0];
-    job.mesh = readMesh(job.meshPath);
+    job.mesh = readMeshWarning(job.meshPath);
     if (args.has("--normalize")) {
       double s = args.getDouble("--normalize", 1.0);
       if (!(s > 0)) throw usageError("--normalize needs a positive scale");

@@ -64,7 +64,7 @@ Job loadJob(const ParsedArgs& args) {
     read.bptResolution = args.getInt("--bpt-resolution", 10);
     if (read.bptResolution < 1 || read.bptResolution > 1000) throw Error(ErrorKind::Input, "--bpt-resolution must be 1..1000");
   }
-  job.mesh = readMesh(job.meshPath, read);
+  job.mesh = readMeshWarning(job.meshPath, read);
   std::string ext = fs::path(job.latticePath).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
   if (args.has("--normalize")) {

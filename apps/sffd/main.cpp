@@ -6,7 +6,7 @@
 #include <string>
 
 #include "apps/sffd/cli.h"
-#include <sffd/error.h>
+#include <sffd/sffd.h>
 
 using namespace sffd;
 
@@ -26,16 +26,30 @@ static std::vector<cli::CommandSpec> commands() {
 }
 
 static void usage(FILE* f) {
-  std::fprintf(f, "usage: sffd <command> [options]   (sffd <command> --help for its options)\n\ncommands:\n");
+  std::fprintf(f, "usage: sffd <command> [options]   (sffd help <command> or sffd <command> --help: its options)\n"
+                  "       sffd --version\n\ncommands:\n");
   for (const auto& c : commands()) std::fprintf(f, "  %-9s %s\n", c.name, c.summary);
 }
 
 int main(int argc, char** argv) {
   try {
     if (argc < 2) throw Error(ErrorKind::Input, "no command given (sffd --help lists them)");
-    if (!std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h")) {
+    if (!std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h") || (!std::strcmp(argv[1], "help") && argc == 2)) {
       usage(stdout);
       return 0;
+    }
+    if (!std::strcmp(argv[1], "--version")) {
+      std::printf("sffd %d.%d.%d\n", SFFD_VERSION_MAJOR, SFFD_VERSION_MINOR, SFFD_VERSION_PATCH);
+      return 0;
+    }
+    if (!std::strcmp(argv[1], "help")) {
+      if (argc > 3) throw Error(ErrorKind::Input, "help takes one command name (sffd help deform)");
+      for (const auto& c : commands())
+        if (c.name == std::string(argv[2])) {
+          std::fputs(cli::helpText(c).c_str(), stdout);
+          return 0;
+        }
+      throw Error(ErrorKind::Input, std::string("unknown command '") + argv[2] + "' (sffd --help lists them)");
     }
     for (const auto& c : commands()) {
       if (c.name != std::string(argv[1])) continue;

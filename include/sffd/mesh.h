@@ -28,6 +28,9 @@ struct Mesh {
   std::vector<BicubicPatch> patches;
   std::vector<uint32_t> vertexPatch;
   std::vector<glm::dvec2> vertexUV;
+  // What reading the file repaired or skipped, one line each (the command-line tool prints them as
+  // warnings); empty for a clean file.
+  std::vector<std::string> warnings;
 };
 
 // A triangle mesh in the caller's memory (float or double xyz, 32-bit indices), read once when a

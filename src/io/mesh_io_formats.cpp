@@ -25,6 +25,7 @@ std::string countText(uint64_t n, const char* what) { return std::to_string(n) +
 }  // namespace
 
 Mesh readOff(const std::string& path, const std::string& text) {
+  size_t dropped = 0;   // polygons without area (addPolygon)
   io::LineReader lines(text);
   std::vector<std::string_view> tok;
   std::string_view raw;
@@ -102,8 +103,9 @@ Mesh readOff(const std::string& path, const std::string& text) {
         throw inputError(path, line, "vertex index " + std::to_string(i) + " out of range (" + countText(nv, "vertices") + ")");
       poly.push_back(uint32_t(i));
     }
-    fanTriangulate(poly.data(), poly.size(), mesh.triangles);
+    addPolygon(mesh, poly.data(), poly.size(), dropped);
   }
+  noteDroppedPolygons(mesh, dropped);
   finishMesh(mesh, fromFile, path);
   return mesh;
 }
@@ -186,6 +188,8 @@ struct BinaryCursor {
 }  // namespace
 
 Mesh readPly(const std::string& path, const std::string& text) {
+  size_t dropped = 0;   // polygons without area (addPolygon)
+  std::vector<size_t> ignoredHeaderLines;
   io::LineReader lines(text);
   std::string_view l;
   size_t line = 0;
@@ -228,6 +232,9 @@ Mesh readPly(const std::string& path, const std::string& text) {
         throw inputError(path, line, "bad property line");
       }
       elements.back().props.push_back(p);
+    } else if (elements.empty() && !ended) {
+      // Free text before the first element, which some old exporters wrote without "comment".
+      ignoredHeaderLines.push_back(line);
     } else {
       throw inputError(path, line, "unknown header line " + io::quoted(tok[0]));
     }
@@ -336,7 +343,7 @@ Mesh readPly(const std::string& path, const std::string& text) {
           mesh.positions.push_back({values[size_t(px)], values[size_t(py)], values[size_t(pz)]});
           if (hasNormals) mesh.normals.push_back({values[size_t(pnx)], values[size_t(pny)], values[size_t(pnz)]});
         } else if (isF) {
-          fanTriangulate(poly.data(), poly.size(), mesh.triangles);
+          addPolygon(mesh, poly.data(), poly.size(), dropped);
         }
       }
     }
@@ -385,12 +392,17 @@ Mesh readPly(const std::string& path, const std::string& text) {
           mesh.positions.push_back(q);
           if (hasNormals) mesh.normals.push_back({values[size_t(pnx)], values[size_t(pny)], values[size_t(pnz)]});
         } else if (isF) {
-          fanTriangulate(poly.data(), poly.size(), mesh.triangles);
+          addPolygon(mesh, poly.data(), poly.size(), dropped);
         }
       }
     }
   }
   std::vector<uint8_t> fromFile(hasNormals ? mesh.positions.size() : 0, 1);
+  noteDroppedPolygons(mesh, dropped);
+  if (!ignoredHeaderLines.empty())
+    mesh.warnings.push_back(path + ":" + std::to_string(ignoredHeaderLines[0]) + ": " +
+                            std::to_string(ignoredHeaderLines.size()) + " free-text header line" +
+                            (ignoredHeaderLines.size() == 1 ? "" : "s") + " without \"comment\" ignored");
   finishMesh(mesh, fromFile, path);
   return mesh;
 }
@@ -451,6 +463,8 @@ Mesh readStlBinary(const std::string& path, const std::string& text) {
 }
 
 Mesh readStlAscii(const std::string& path, const std::string& text) {
+  size_t dropped = 0;   // polygons without area (addPolygon)
+  size_t polygonFacets = 0, firstPolygonFacet = 0;   // facets of more than 3 vertices (STL says 3)
   io::Tokenizer tz(text);
   std::string_view t;
   size_t line = 1;
@@ -512,8 +526,14 @@ Mesh readStlAscii(const std::string& path, const std::string& text) {
     if (poly.size() < 3)
       throw inputError(path, facetLine, "facet with " + std::to_string(poly.size()) + " vertices (at least 3 needed)");
     expect("endfacet");
-    fanTriangulate(poly.data(), poly.size(), mesh.triangles);
+    if (poly.size() > 3 && !polygonFacets++) firstPolygonFacet = facetLine;
+    addPolygon(mesh, poly.data(), poly.size(), dropped);
   }
+  noteDroppedPolygons(mesh, dropped);
+  if (polygonFacets)
+    mesh.warnings.push_back(path + ":" + std::to_string(firstPolygonFacet) + ": " + std::to_string(polygonFacets) +
+                            (polygonFacets == 1 ? " facet has" : " facets have") +
+                            " more than 3 vertices (STL facets are triangles): read as polygons");
   finishMesh(mesh, {}, path);
   return mesh;
 }

@@ -30,6 +30,12 @@ inline void fanTriangulate(const uint32_t* corners, size_t n, std::vector<std::a
   for (size_t i = 1; i + 1 < n; ++i) out.push_back({corners[0], corners[i], corners[i + 1]});
 }
 
+// A polygon of a file into mesh.triangles: fanned when convex, ear-clipped when concave, dropped (and
+// counted in `dropped`) when it has no area (polygon_triangulation.cpp). Corners must be in range.
+void addPolygon(Mesh& mesh, const uint32_t* corners, size_t n, size_t& dropped);
+// One warning line in mesh.warnings for the polygons addPolygon dropped, if any.
+void noteDroppedPolygons(Mesh& mesh, size_t dropped);
+
 // Largest vertex count a mesh may have (indices are uint32).
 constexpr uint64_t kMaxVertices = 0xFFFFFFF0u;
 

@@ -34,6 +34,8 @@ struct NormalKeyHash {
 }  // namespace
 
 Mesh readObj(const std::string& path, const std::string& text) {
+  size_t dropped = 0;   // polygons without area (addPolygon)
+  std::vector<size_t> emptyFaceLines;
   std::vector<glm::dvec3> pos, nrm;
   int64_t vtCount = 0;
   std::vector<Corner> corners;
@@ -102,6 +104,10 @@ Mesh readObj(const std::string& path, const std::string& text) {
       ++vtCount;
     } else if (kw == "f") {
       size_t n = tok.size() - 1;
+      if (n == 0) {   // skipped, as Assimp, MeshLab and Blender do
+        emptyFaceLines.push_back(line);
+        continue;
+      }
       if (n < 3) throw fail(line, "face with " + std::to_string(n) + " vertices (at least 3 needed)");
       faceStart.push_back(corners.size());
       faceLine.push_back(line);
@@ -186,7 +192,7 @@ Mesh readObj(const std::string& path, const std::string& text) {
       }
       vid.push_back(v);
     }
-    fanTriangulate(vid.data(), vid.size(), mesh.triangles);
+    addPolygon(mesh, vid.data(), vid.size(), dropped);
   }
   mesh.normals.assign(mesh.positions.size(), glm::dvec3(0.0));
   std::vector<uint8_t> fromFile(mesh.positions.size(), 0);
@@ -195,6 +201,10 @@ Mesh readObj(const std::string& path, const std::string& text) {
       mesh.normals[v] = nrm[size_t(slot[v])];
       fromFile[v] = 1;
     }
+  noteDroppedPolygons(mesh, dropped);
+  if (!emptyFaceLines.empty())
+    mesh.warnings.push_back(path + ":" + std::to_string(emptyFaceLines[0]) + ": " + std::to_string(emptyFaceLines.size()) +
+                            (emptyFaceLines.size() == 1 ? " empty face line" : " empty face lines") + " skipped");
   finishMesh(mesh, fromFile, path);
   return mesh;
 }

@@ -106,6 +106,7 @@ struct Reader {
 }  // namespace
 
 Mesh readOm(const std::string& path, const std::string& text) {
+  size_t dropped = 0;   // polygons without area (addPolygon)
   if (text.size() < 16 || text[0] != 'O' || text[1] != 'M') throw inputError(path, 0, "not an OpenMesh .om file");
   uint32_t nv = 0, nf = 0, ne = 0;
   std::memcpy(&nv, text.data() + 4, 4);
@@ -198,9 +199,10 @@ Mesh readOm(const std::string& path, const std::string& text) {
     poly.resize(k);
     for (uint32_t& i : poly)
       if (!rd.get(i) || i >= n) throw damaged();
-    fanTriangulate(poly.data(), poly.size(), mesh.triangles);
+    addPolygon(mesh, poly.data(), poly.size(), dropped);
   }
   std::vector<uint8_t> fromFile(hasNormals ? n : 0, 1);
+  noteDroppedPolygons(mesh, dropped);
   finishMesh(mesh, fromFile, path);
   return mesh;
 }

@@ -1,0 +1,34 @@
+// The command line's own help: --version, and `sffd help CMD` saying exactly what `sffd CMD --help` says.
+#include <gtest/gtest.h>
+
+#include <sffd/sffd.h>
+
+#include "tests/support/cli_runner.h"
+
+namespace sffd::test {
+namespace {
+
+TEST(Usage, VersionIsTheLibrarysVersion) {
+  RunResult r = runSffd("--version");
+  EXPECT_EQ(r.status, 0);
+  EXPECT_EQ(r.out, "sffd " + std::to_string(SFFD_VERSION_MAJOR) + "." + std::to_string(SFFD_VERSION_MINOR) + "." +
+                       std::to_string(SFFD_VERSION_PATCH) + "\n");
+}
+
+TEST(Usage, HelpCommandEqualsTheCommandsHelpOption) {
+  for (const char* c : {"deform", "lattice", "devices", "conform", "clip", "error", "render", "bench", "view"}) {
+    RunResult a = runSffd(std::string("help ") + c), b = runSffd(std::string(c) + " --help");
+    EXPECT_EQ(a.status, 0) << c;
+    EXPECT_FALSE(a.out.empty()) << c;
+    EXPECT_EQ(a.out, b.out) << c;
+  }
+  RunResult all = runSffd("help");
+  EXPECT_EQ(all.status, 0);
+  EXPECT_EQ(all.out, runSffd("--help").out);
+  RunResult bad = runSffd("help nosuch");
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_EQ(bad.err, "sffd: error: unknown command 'nosuch' (sffd --help lists them)\n");
+}
+
+}  // namespace
+}  // namespace sffd::test
