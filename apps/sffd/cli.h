@@ -6,7 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "backends/backend_select.h"
+#include <sffd/device.h>
+
 #include "model/lattice.h"
 #include "model/mesh.h"
 
@@ -64,8 +65,8 @@ void meshBounds(const Mesh& mesh, glm::dvec3& lo, glm::dvec3& hi);
 // Refuses an output path that is one of the inputs (nothing is ever written over an input).
 void checkOutputPath(const std::string& out, const std::vector<std::string>& inputs);
 
-// Opens the backend the options ask for, printing fallback notes unless --quiet.
-OpenedBackend openBackendFromArgs(const ParsedArgs& args);
+// Opens the device the options ask for (--backend, --device), printing fallback notes unless --quiet.
+Device openDeviceFromArgs(const ParsedArgs& args);
 
 // --precision auto|float|double resolved for a backend (auto: double where the device has it).
 bool wantDouble(const ParsedArgs& args, const DeviceInfo& info, bool autoDouble);
@@ -75,9 +76,12 @@ void note(const ParsedArgs& args, const std::string& line);   // stderr unless -
 // it is about the input).
 Mesh readMeshWarning(const std::string& path, const MeshReadOptions& options = {});
 
+// SFFD_MAX_CHUNK_* (elements per chunk, to test chunking): the value of the variable `name`, at
+// least 1; 0 when it is not set (no limit).
+size_t chunkFromEnvironment(const char* name);
+
 // Refuses a target edge length that is not positive, or so small that the sub-triangles would
-// exceed kMaxSubTriangles (the message gives the estimate).
-constexpr double kMaxSubTriangles = 50e6;
+// exceed kMaxSubTriangles (job_budget.h; the message gives the estimate).
 void checkEdgeLength(const Mesh& mesh, double l);
 
 // Picture options shared by render and view (cmd_render.cpp): --width/--height in 16..8192 pixels,

@@ -1,5 +1,5 @@
 // sffd bench MESH -l LATTICE: per-stage times of smooth FFD (the paper's Tables 1 and 2) on each
-// backend asked, each running the device-resident DeformSession, the path `view` uses: the
+// backend asked, through sffd::Deformer (on a GPU the device-resident DeformSession, the path `view` uses): the
 // pre-compute (PN + clip) and the deform stage are timed apart, from GPU timestamps (Vulkan
 // timestamp queries, GL timestamp pairs) with the host wall time beside them; the first,
 // cold run (kernel compilation) is reported apart; then --warmup runs, then --repeat timed runs.
@@ -13,12 +13,14 @@
 
 #include <nlohmann/json.hpp>
 
+#include <sffd/deformer.h>
+#include <sffd/error.h>
+
 #include "apps/sffd/cli.h"
 #include "apps/sffd/deform_job.h"
-#include "pipelines/deform_session.h"
-#include <sffd/error.h>
-#include "pipelines/patch_output.h"
 #include "core/wall_clock.h"
+#include "kernels/smooth/smooth_deform.h"
+#include "pipelines/deformer_internal.h"
 
 namespace sffd::cli {
 namespace {
@@ -46,7 +48,7 @@ nlohmann::ordered_json summary(std::vector<double> v) {
 }
 
 struct BenchSettings {
-  DeformSessionOptions session;
+  DeformOptions options;
   int warmup = 2, repeat = 20;
 };
 
@@ -58,33 +60,36 @@ struct BackendResult {
   double peakRss = 0;
 };
 
-void addStages(Series& s, const SessionTimings& pre, const SessionTimings& def) {
+void addStages(Series& s, const Timings& pre, const Timings& def) {
   s.add("pn", pre.pnMs);
   s.add("clip", pre.clipMs);
   s.add("deform", def.deformMs);
   s.add("total", pre.pnMs + pre.clipMs + def.deformMs);
-  std::map<std::string, double> steps;
-  for (const DispatchTiming& d : def.dispatches)
-    if (d.label.find('.') != std::string::npos) steps[d.label] += std::max(d.gpuMs, 0.0);
+  std::map<std::string, double> steps;   // --split: deform.sample, ... in name order
+  for (const auto& [label, ms] : def.steps)
+    if (label.find('.') != std::string::npos) steps[label] += ms;
   for (const auto& [k, v] : steps) s.add(k, v);
 }
 
-BackendResult benchBackend(OpenedBackend& b, const Job& job, const BenchSettings& S) {
+// One device: a Deformer made and deformed once (the cold run), then per run the pre-compute again
+// (PN triangles, clipping) and a deform; nothing is downloaded.
+BackendResult benchDevice(Device& device, const Job& job, const BenchSettings& S) {
   BackendResult r;
-  r.label = b.label;
-  r.device = b.info.name;
+  r.label = device.label();
+  r.device = device.info().name;
   auto t0 = std::chrono::steady_clock::now();
-  DeformSession session(*b.backend, job.mesh, job.lattice, S.session);
-  session.deform(job.lattice);
+  Deformer deformer(device, job.mesh, job.lattice, S.options);
+  deformer.deform(job.lattice);
   r.coldMs = msSince(t0);
-  r.subTriangles = session.subTriangles();
+  r.subTriangles = deformer.subTriangles();
   for (int i = 0; i < S.warmup + S.repeat; ++i) {
-    SessionTimings p = session.precompute();
-    SessionTimings d = session.deform(job.lattice);
+    Timings pre;
+    deformer.internal().run->precompute(pre);
+    Timings def = deformer.deform(job.lattice);
     if (i < S.warmup) continue;
-    addStages(r.stages, p, d);
-    r.host.add("precompute", p.wallMs);
-    r.host.add("deform", d.wallMs);
+    addStages(r.stages, pre, def);
+    r.host.add("precompute", pre.wallMs);
+    r.host.add("deform", def.wallMs);
   }
   r.peakRss = peakRssMb();
   return r;
@@ -102,18 +107,20 @@ int run(const ParsedArgs& args) {
   if (S.repeat < 1 || S.repeat > 100000) throw Error(ErrorKind::Input, "--repeat must be 1..100000");
   if (S.warmup < 0 || S.warmup > 100000) throw Error(ErrorKind::Input, "--warmup must be 0..100000");
   Job job = loadJob(args);
-  DeformSessionOptions& o = S.session;
-  o.variant.strict = args.has("--strict");
-  o.level = tessLevel(args);
-  if (o.level < 1 || o.level > 64) throw Error(ErrorKind::Input, "--tess must be 1..64");
+  DeformOptions& o = S.options;
+  o.strict = args.has("--strict");
+  o.tess = args.getInt("--tess", 10);
+  if (o.tess < 1 || o.tess > 64) throw Error(ErrorKind::Input, "--tess must be 1..64");
   o.edgeLength = edgeLengthOf(args, job.mesh);
   checkEdgeLength(job.mesh, o.edgeLength);
   o.samples = std::max(3, args.getInt("--samples", job.lattice.degree[0] + job.lattice.degree[1] + job.lattice.degree[2]));
-  o.knotBoxClip = clipName == "knot-box";
+  o.clip = clipName == "knot-box" ? Clip::KnotBox : Clip::Regular;
   o.split = args.has("--split");
   o.creaseAngleDeg = args.getDouble("--crease-angle", 40.0);
-  if (args.get("--precision", "float") == "double") o.variant.f64 = true;
+  o.maxChunkElements = chunkFromEnvironment("SFFD_MAX_CHUNK_SUBTRIANGLES");
+  if (args.get("--precision", "float") == "double") o.precision = Precision::Double;
   else if (args.get("--precision", "float") != "float") throw Error(ErrorKind::Input, "--precision must be float or double");
+  else o.precision = Precision::Float;
 
   std::vector<std::string> names;
   std::stringstream ss(args.get("--backends", "vulkan,gl"));
@@ -123,12 +130,13 @@ int run(const ParsedArgs& args) {
 
   std::vector<BackendResult> results;
   for (const std::string& name : names) {
-    BackendRequest req;
+    DeviceRequest req;
     req.name = name;
-    req.device = args.get("--device");
+    if (name != "cpu") req.deviceSubstring = args.get("--device");
     std::vector<std::string> notes;
-    OpenedBackend b = openBackend(req, &notes);
-    results.push_back(benchBackend(b, job, S));
+    Device device = Device::open(req, &notes);
+    if (name != "cpu" && device.info().api == "cpu") throw Error(ErrorKind::Device, "backend '" + name + "' gave no GPU device");
+    results.push_back(benchDevice(device, job, S));
   }
 
   const size_t subs = results.empty() ? 0 : results.front().subTriangles;
@@ -138,10 +146,10 @@ int run(const ParsedArgs& args) {
                                 {"method", "smooth"},
                                 {"clip", clipName},
                                 {"edge_length", o.edgeLength},
-                                {"tess", o.level},
+                                {"tess", o.tess},
                                 {"input_triangles", job.mesh.triangles.size()},
                                 {"sub_triangles", subs},
-                                {"output_triangles", subs * size_t(tessTriangleCount(o.level))},
+                                {"output_triangles", subs * size_t(tessTriangleCount(o.tess))},
                                 {"runs", nlohmann::ordered_json::array()}};
     for (const BackendResult& r : results) {
       nlohmann::ordered_json run = {{"backend", r.label}, {"device", r.device}, {"repeat", S.repeat},
@@ -159,7 +167,7 @@ int run(const ParsedArgs& args) {
   }
   std::printf("%s: smooth FFD, %zu triangles -> %zu sub-triangles (l = %g, %s clipping) -> %zu output triangles (level %d)\n",
               meshName.c_str(), job.mesh.triangles.size(), subs, o.edgeLength, clipName.c_str(),
-              subs * size_t(tessTriangleCount(o.level)), o.level);
+              subs * size_t(tessTriangleCount(o.tess)), o.tess);
   std::printf("median of %d runs after %d warm-up, min..max in brackets; GPU timestamps (cpu: wall clock)\n", S.repeat, S.warmup);
   for (const BackendResult& r : results) {
     std::printf("%-10s %s\n", r.label.c_str(), r.device.c_str());

@@ -78,13 +78,15 @@ int run(const ParsedArgs& args) {
   if (!job.mesh.normalsFromFile) applyCreaseAngle(job.mesh, args.getDouble("--crease-angle", 40.0));
   double l = args.has("--edge-length") ? args.getDouble("--edge-length", 0) : defaultEdgeLength(job.mesh);
   checkEdgeLength(job.mesh, l);
-  OpenedBackend backend = openBackendFromArgs(args);
+  Device device = openDeviceFromArgs(args);
   KernelVariant variant;
   variant.strict = args.has("--strict");
-  variant.f64 = wantDouble(args, backend.info, /*autoDouble=*/false);
+  variant.f64 = wantDouble(args, device.info(), /*autoDouble=*/false);
+  // The kernels one by one (the Deformer runs them all), on the device's backend.
+  Backend& backend = device.backend();
 
   PreparedMesh prepared = prepareMesh(job.mesh);
-  PnOutput pn = pnTriangles(*backend.backend, prepared, variant);
+  PnOutput pn = pnTriangles(backend, prepared, variant, chunkFromEnvironment("SFFD_MAX_CHUNK_TRIANGLES"));
   SubTriangleRecords subs;
   size_t presplit = 0, clipTriangles = 0;
   auto tc = std::chrono::steady_clock::now();
@@ -92,7 +94,7 @@ int run(const ParsedArgs& args) {
     ClipTriangles C = buildClipTriangles(job.mesh, l, splitPatternTable().nmax());
     presplit = C.presplitParents;
     clipTriangles = C.triangles.size();
-    subs = regularClip(*backend.backend, prepared, pn, C, l, variant);
+    subs = regularClip(backend, prepared, pn, C, l, variant, chunkFromEnvironment("SFFD_MAX_CHUNK_SUBTRIANGLES"));
   } else {
     // The 2015 method runs on the CPU reference (it is the baseline, not a production path).
     subs = recordsFromSubTriangles(prepared, pn, clipAgainstKnotBoxes(job.mesh, job.lattice), variant);
@@ -115,8 +117,8 @@ int run(const ParsedArgs& args) {
     const MeshTopology& topo = prepared.topology;
     double totalMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     nlohmann::ordered_json j = {
-        {"backend", backend.label},
-        {"device", backend.info.name},
+        {"backend", device.label()},
+        {"device", device.info().name},
         {"clip", clip},
         {"edge_length", l},
         {"input", {{"vertices", job.mesh.positions.size()}, {"triangles", job.mesh.triangles.size()}}},
@@ -133,7 +135,7 @@ int run(const ParsedArgs& args) {
     std::string text = j.dump(1) + "\n";
     writeFileAtomically(args.get("--stats"), [&](std::ostream& o) { o << text; });
   }
-  note(args, "wrote " + out + " (" + std::to_string(subs.size()) + " sub-triangles, " + clip + " clipping, " + backend.label + ")");
+  note(args, "wrote " + out + " (" + std::to_string(subs.size()) + " sub-triangles, " + clip + " clipping, " + device.label() + ")");
   return 0;
 }
 

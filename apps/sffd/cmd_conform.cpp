@@ -62,22 +62,24 @@ int run(const ParsedArgs& args) {
 
   std::vector<BackendRun> runs;
   for (const std::string& name : names) {
-    BackendRequest req;
+    DeviceRequest req;
     req.name = name;
-    req.device = args.get("--device");
-    OpenedBackend b = openBackend(req);
+    req.deviceSubstring = args.get("--device");
+    Device device = Device::open(req);
+    Backend& backend = device.backend();
     BackendRun r;
-    r.label = b.label;
-    r.isCpu = b.info.api == "cpu";
+    r.label = device.label();
+    r.isCpu = device.info().api == "cpu";
     // The CPU backend runs in the kernels' precision (in float, in the strict kernels' operation
     // order): conformance compares the same arithmetic on the same inputs. Accuracy against the
     // double reference is a separate matter (docs/CONFORMANCE.md).
-    ClassicOutput classic = classicFfd(*b.backend, job.mesh, packed, variant);
+    ClassicOutput classic = classicFfd(backend, job.mesh, packed, variant, chunkFromEnvironment("SFFD_MAX_CHUNK_VERTICES"));
     r.buffers.push_back({"classic.positions", std::move(classic.positions)});
     r.buffers.push_back({"classic.normals", std::move(classic.normals)});
-    PnOutput pn = pnTriangles(*b.backend, prepared, variant);
+    PnOutput pn = pnTriangles(backend, prepared, variant, chunkFromEnvironment("SFFD_MAX_CHUNK_TRIANGLES"));
     // Each backend clips from its own PN records: the whole pre-compute stage is compared.
-    SubTriangleRecords subs = regularClip(*b.backend, prepared, pn, clip, l, variant);
+    SubTriangleRecords subs =
+        regularClip(backend, prepared, pn, clip, l, variant, chunkFromEnvironment("SFFD_MAX_CHUNK_SUBTRIANGLES"));
     r.buffers.push_back({"pn.records", std::move(pn.records)});
     r.buffers.push_back({"clip.headers", std::vector<double>(subs.headers.begin(), subs.headers.end())});
     r.buffers.push_back({"clip.records", std::move(subs.records)});

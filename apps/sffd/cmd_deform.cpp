@@ -6,7 +6,6 @@
 #include <nlohmann/json.hpp>
 
 #include "io/atomic_file.h"
-#include "kernels/classic/classic_ffd.h"
 #include "apps/sffd/cli.h"
 #include <sffd/error.h>
 #include "apps/sffd/deform_job.h"
@@ -17,16 +16,17 @@ namespace {
 
 // The patch file (docs/CLI.md "Patch files"): a header line, then per patch its parent triangle and
 // 10 geometry and 10 normal control points of the cubic triangular Bezier patch, one per line.
-void writePatchFile(const std::string& path, const DeformRun& run) {
-  const size_t n = run.patches->patchCount();
+void writePatchFile(const std::string& path, DeformRun& run, const std::vector<double>& controlPoints) {
+  const PatchVertices patches = *run.patches();
+  const size_t n = patches.patchCount();
+  const int digits = run.deformer.doublePrecision() ? 17 : 9;
   writeFileAtomically(path, [&](std::ostream& o) {
     char line[128];
     o << "sffd-patches 1 " << n << " 3\n";
     for (size_t p = 0; p < n; ++p) {
-      o << "patch " << run.patches->parent[p] << "\n";
+      o << "patch " << patches.parent[p] << "\n";
       for (int k = 0; k < 20; ++k) {
-        const double* c = &run.patchControlPoints[(p * 20 + k) * 4];
-        int digits = run.variant.f64 ? 17 : 9;
+        const double* c = &controlPoints[(p * 20 + k) * 4];
         std::snprintf(line, sizeof line, "%.*g %.*g %.*g\n", digits, c[0], digits, c[1], digits, c[2]);
         o << line;
       }
@@ -38,8 +38,7 @@ int run(const ParsedArgs& args) {
   std::string out = args.requireValue("--output");
   args.requireValue("--lattice");
   std::string method = args.get("--method", "smooth");
-  if (method != "smooth" && method != "accurate" && method != "classic")
-    throw Error(ErrorKind::Input, "--method must be smooth, accurate or classic, not '" + method + "'");
+  methodOf(method);   // an input Error for another name, before any work
   std::string clip = args.get("--clip", "regular");
   if (clip != "regular" && clip != "knot-box") throw Error(ErrorKind::Input, "--clip must be regular or knot-box");
   auto opt = [&](const char* o) { return args.has(o) ? std::optional<std::string>(args.get(o)) : std::nullopt; };
@@ -50,35 +49,41 @@ int run(const ParsedArgs& args) {
 
   auto t0 = std::chrono::steady_clock::now();
   Job job = loadJob(args);
-  OpenedBackend backend = openBackendFromArgs(args);
-  DeformRun run = runDeformJob(args, job, backend);
+  Device device = openDeviceFromArgs(args);
+  DeformRun run = runDeformJob(args, job, device);
+  const Timings& t = run.deformer.timings();
+  const bool f64 = run.deformer.doublePrecision();
   Mesh& deformed = run.mesh;
-  writeMesh(out, deformed, run.variant.f64 ? 17 : 9);
+  writeMesh(out, deformed, f64 ? 17 : 9);
   if (args.has("--patches")) {
-    if (run.patchControlPoints.empty()) throw Error(ErrorKind::Input, "--patches needs --method smooth");
-    writePatchFile(args.get("--patches"), run);
+    std::vector<double> controlPoints = run.deformer.patchControlPoints();
+    if (controlPoints.empty()) throw Error(ErrorKind::Input, "--patches needs --method smooth");
+    writePatchFile(args.get("--patches"), run, controlPoints);
   }
   double totalMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 
   if (args.has("--stats")) {
     nlohmann::ordered_json j = {
-        {"backend", backend.label},
-        {"device", backend.info.name},
+        {"backend", device.label()},
+        {"device", device.info().name},
         {"method", run.method},
         {"clip", run.clip},
-        {"precision", run.variant.f64 ? "double" : "float"},
-        {"strict", run.variant.strict},
+        {"precision", f64 ? "double" : "float"},
+        {"strict", args.has("--strict")},
         {"input", {{"vertices", job.mesh.positions.size()}, {"triangles", job.mesh.triangles.size()}}},
-        {"sub_triangles", run.subTriangles},
+        {"sub_triangles", run.deformer.subTriangles()},
         {"output", {{"vertices", deformed.positions.size()}, {"triangles", deformed.triangles.size()}}},
-        {"timings_ms", {{"pn", run.pnMs}, {"clip", run.clipMs}, {"deform", run.deformMs}, {"total", totalMs}}},
+        {"timings_ms", {{"pn", t.pnMs}, {"clip", t.clipMs}, {"deform", t.deformMs}, {"total", totalMs}}},
     };
-    for (const auto& [step, ms] : run.stepMs) j["timings_ms"][step] = ms;
+    // --split: the deform steps (deform.sample, ...), which the fused kernel does not have.
+    if (args.has("--split"))
+      for (const auto& [step, ms] : t.steps)
+        if (step.find('.') != std::string::npos) j["timings_ms"][step] = ms;
     std::string text = j.dump(1) + "\n";
     writeFileAtomically(args.get("--stats"), [&](std::ostream& o) { o << text; });
   }
-  note(args, "wrote " + out + " (" + std::to_string(deformed.triangles.size()) + " triangles, " + backend.label + ", " +
-                 backend.info.name + ")");
+  note(args, "wrote " + out + " (" + std::to_string(deformed.triangles.size()) + " triangles, " + device.label() + ", " +
+                 device.info().name + ")");
   return 0;
 }
 

@@ -9,9 +9,8 @@ namespace {
 
 int run(const ParsedArgs& args) {
   std::vector<std::string> problems;
-  auto found = listBackends(problems);
   bool anyGpuApi = false;
-  for (const auto& [label, info] : found) {
+  for (const auto& [label, info] : listDevices(&problems)) {
     if (label != "cpu") anyGpuApi = true;
     std::printf("%-10s %-40s %-10s %s%s\n", label.c_str(), info.name.c_str(), info.type.c_str(), info.driver.c_str(),
                 info.limits.float64 ? " [f64]" : "");

@@ -19,24 +19,20 @@ nlohmann::ordered_json statsJson(const ErrorStats& s) { return {{"avg", s.avg}, 
 int run(const ParsedArgs& args) {
   args.requireValue("--lattice");
   std::string method = args.get("--method", "smooth");
-  if (method != "smooth" && method != "accurate" && method != "classic")
-    throw Error(ErrorKind::Input, "--method must be smooth, accurate or classic, not '" + method + "'");
+  methodOf(method);   // an input Error for another name, before any work
   std::string clip = args.get("--clip", "regular");
   if (clip != "regular" && clip != "knot-box") throw Error(ErrorKind::Input, "--clip must be regular or knot-box");
   auto opt = [&](const char* o) { return args.has(o) ? std::optional<std::string>(args.get(o)) : std::nullopt; };
   checkSizeOptions(opt("--edge-length"), opt("--tess"));
 
   Job job = loadJob(args);
-  OpenedBackend backend = openBackendFromArgs(args);
-  DeformRun run = runDeformJob(args, job, backend);
+  Device device = openDeviceFromArgs(args);
+  DeformRun run = runDeformJob(args, job, device);
+  const bool f64 = run.deformer.doublePrecision();
   // job.mesh as the method used it (its triangles are the patches' parents).
   PackedLattice packed = packLattice(job.lattice);
-  PatchVertices classicTess;
-  const PatchVertices* samples = run.patches ? &*run.patches : nullptr;
-  if (!samples) {
-    classicTess = linearPatchVertices(run.mesh, args.getInt("--tess", 10));
-    samples = &classicTess;
-  }
+  std::optional<PatchVertices> samples = run.patches();
+  if (!samples) samples = linearPatchVertices(run.mesh, args.getInt("--tess", 10));
   ErrorReport rep = measureErrors(job.mesh, packed, *samples);
   rep.volume = measureVolume(job.mesh, job.lattice, run.mesh);
 
@@ -51,15 +47,15 @@ int run(const ParsedArgs& args) {
                                                        {"result", rep.volume->result},
                                                        {"rel_error", rep.volume->relError}}
                               : nlohmann::ordered_json(nullptr)},
-        {"sub_triangles", run.subTriangles},
-        {"backend", backend.label},
-        {"precision", run.variant.f64 ? "double" : "float"},
+        {"sub_triangles", run.deformer.subTriangles()},
+        {"backend", device.label()},
+        {"precision", f64 ? "double" : "float"},
     };
     std::printf("%s\n", j.dump(1).c_str());
   } else {
     std::printf("%s FFD (%s clipping) against exact FFD, %zu tessellation vertices (%s, %s)\n", run.method.c_str(),
-                run.method == "classic" ? "no" : run.clip.c_str(), rep.vertices, backend.label.c_str(),
-                run.variant.f64 ? "double" : "float");
+                run.method == "classic" ? "no" : run.clip.c_str(), rep.vertices, device.label().c_str(),
+                f64 ? "double" : "float");
     std::printf("  geometry    avg %.6g  max %.6g  std %.6g\n", rep.geometry.avg, rep.geometry.max, rep.geometry.std);
     std::printf("  normal deg  avg %.6g  max %.6g  std %.6g\n", rep.normalDeg.avg, rep.normalDeg.max, rep.normalDeg.std);
     if (rep.volume)

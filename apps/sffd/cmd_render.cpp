@@ -61,8 +61,7 @@ int run(const ParsedArgs& args) {
   ro.wireframe = args.has("--wireframe");
   const bool deform = args.has("--lattice");
   const std::string method = args.get("--method", "smooth");
-  if (method != "smooth" && method != "accurate" && method != "classic")
-    throw usageError("--method must be smooth, accurate or classic, not '" + method + "'");
+  methodOf(method);   // an input Error for another name, before any work
   const std::string clip = args.get("--clip", "regular");
   if (clip != "regular" && clip != "knot-box") throw usageError("--clip must be regular or knot-box");
   const std::string colorBy = args.get("--color-by");
@@ -93,22 +92,23 @@ int run(const ParsedArgs& args) {
     captions.push_back("");
   } else {
     Job job = loadJob(args);
-    OpenedBackend backend = openBackendFromArgs(args);
-    computedOn = ", deformed on " + backend.label;
+    Device device = openDeviceFromArgs(args);
+    computedOn = ", deformed on " + device.label();
     if (compare == "input") {
       meshes.push_back(job.mesh);
       captions.push_back("input");
     } else if (compare == "classic") {
       Job classicJob = job;   // the methods may prepare the job's mesh in place
-      meshes.push_back(runClassic(args, classicJob, backend).mesh);
+      meshes.push_back(runMethod(args, classicJob, device, Method::Classic).mesh);
       captions.push_back("classic FFD");
     }
-    DeformRun run = runDeformJob(args, job, backend);
+    DeformRun run = runDeformJob(args, job, device);
     if (colorBy.empty()) {
       meshes.push_back(std::move(run.mesh));
     } else {
       // Every tessellation vertex coloured by its error against the exact FFD of its pre-image.
-      PatchVertices pv = run.patches ? *run.patches : linearPatchVertices(run.mesh, args.getInt("--tess", 10));
+      std::optional<PatchVertices> patches = run.patches();
+      PatchVertices pv = patches ? std::move(*patches) : linearPatchVertices(run.mesh, args.getInt("--tess", 10));
       PackedLattice packed = packLattice(job.lattice);
       ExactReference ref(job.mesh, packed);
       meshes.push_back(unweldedPatchMesh(pv));

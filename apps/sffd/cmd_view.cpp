@@ -8,6 +8,7 @@
 
 #include "apps/sffd/cli.h"
 #include "apps/sffd/deform_job.h"
+#include <sffd/deformer.h>
 #include <sffd/error.h>
 #include "backends/opengl/gl_backend.h"
 #include "backends/opengl/gl_context.h"
@@ -47,7 +48,6 @@ int run(const ParsedArgs& args) {
   cfg.quiet = args.has("--quiet");
   auto opt = [&](const char* o) { return args.has(o) ? std::optional<std::string>(args.get(o)) : std::nullopt; };
   checkSizeOptions(opt("--edge-length"), opt("--tess"));
-  cfg.level = args.getInt("--tess", 10);
 
   // The job: the mesh and its lattice, or an identity 5x5x5 quadratic lattice around the mesh.
   Job job;
@@ -84,48 +84,29 @@ int run(const ParsedArgs& args) {
   wo.title = "sffd view - " + cfg.meshName;
   cfg.window = std::shared_ptr<gl::Context>(gl::createGlfwContext(wo));
   const std::string name = args.get("--backend", "gl");
-  OpenedBackend backend;
+  std::optional<Device> device;
   if (name == "auto" || name == "gl" || name == "gl-glfw") {
-    backend.backend = gl::createBackendOn(cfg.window);
-    backend.info = backend.backend->info();
-    backend.label = "gl-glfw";
+    device.emplace("gl-glfw", gl::createBackendOn(cfg.window));
     cfg.zeroCopy = true;
   } else {
-    backend = openBackendFromArgs(args);
+    device.emplace(openDeviceFromArgs(args));
   }
-  cfg.gpu = backend.backend.get();
-  cfg.backendLabel = backend.label;
-  note(args, "view: " + cfg.meshName + " on " + backend.label + " (" + backend.info.name + ")");
-  DeformSessionOptions so;
-  so.variant.strict = args.has("--strict");
-  so.edgeLength = l;
-  so.level = cfg.level;
-  so.samples = args.getInt("--samples", 0);
-  so.split = args.has("--split");
-  so.creaseAngleDeg = args.getDouble("--crease-angle", 40.0);
-  cfg.session = so;
-  const Mesh raw = job.mesh;
-  cfg.host = [&args, &backend, &raw, &job](const Lattice& lattice, const std::string& method, const std::string& clip) {
-    ParsedArgs a = args;
-    a.values["--method"] = method;
-    a.values["--clip"] = clip;
-    Job j;
-    j.meshPath = job.meshPath;
-    j.latticePath = job.latticePath;
-    j.mesh = raw;
-    j.lattice = lattice;
-    DeformRun r = method == "classic" ? runClassic(a, j, backend) : method == "accurate" ? runAccurate(a, j, backend)
-                                                                                         : runSmooth(a, j, backend);
-    view::HostResult h;
-    h.input = std::move(j.mesh);
-    h.mesh = std::move(r.mesh);
-    h.patches = std::move(r.patches);
-    h.pnMs = r.pnMs, h.clipMs = r.clipMs, h.deformMs = r.deformMs;
-    return h;
-  };
-  int status = view::runViewer(cfg);
-  cfg.host = nullptr;
-  return status;
+  cfg.device = &*device;
+  cfg.backendLabel = device->label();
+  note(args, "view: " + cfg.meshName + " on " + device->label() + " (" + device->info().name + ")");
+  // The job options as `deform` reads them; the method and clipping change with the viewer's keys.
+  DeformOptions& o = cfg.options;
+  o.strict = args.has("--strict");
+  o.edgeLength = l;
+  o.tess = args.getInt("--tess", 10);
+  o.samples = args.getInt("--samples", 0);
+  o.split = args.has("--split");
+  o.creaseAngleDeg = args.getDouble("--crease-angle", 40.0);
+  const std::string precision = args.get("--precision", "auto");
+  if (precision != "auto" && precision != "float" && precision != "double")
+    throw usageError("--precision must be auto, float or double");
+  o.precision = precision == "double" ? Precision::Double : precision == "float" ? Precision::Float : Precision::Auto;
+  return view::runViewer(cfg);
 }
 
 }  // namespace

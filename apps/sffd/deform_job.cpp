@@ -1,46 +1,98 @@
 #include "apps/sffd/deform_job.h"
 
+#include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 
-#include "kernels/classic/classic_ffd.h"
 #include <sffd/error.h>
+
+#include "apps/sffd/progress_line.h"
 #include "core/job_budget.h"
 #include "model/lattice_fold.h"
+#include "model/lattice_pack.h"
+#include "pipelines/deformer_internal.h"
 
 namespace sffd::cli {
+namespace {
 
-double stageMs(const std::vector<DispatchTiming>& timings, double wallMs) {
-  double ms = 0;
-  for (const DispatchTiming& t : timings) ms += t.gpuMs > 0 ? t.gpuMs : 0;
-  return ms > 0 ? ms : wallMs;
+// The library's name for a limit the tool took from SFFD_MEMORY_LIMIT, in its messages.
+constexpr const char* kLibraryLimitName = "(DeformOptions::memoryLimit)";
+
+}  // namespace
+
+Method methodOf(const std::string& name) {
+  if (name == "smooth") return Method::Smooth;
+  if (name == "accurate") return Method::Accurate;
+  if (name == "classic") return Method::Classic;
+  throw Error(ErrorKind::Input, "--method must be smooth, accurate or classic, not '" + name + "'");
 }
 
-DeformRun runClassic(const ParsedArgs& args, Job& job, OpenedBackend& backend) {
-  DeformRun run;
-  run.variant.strict = args.has("--strict");
-  run.variant.f64 = wantDouble(args, backend.info, /*autoDouble=*/true);
-  PackedLattice packed = packLattice(job.lattice);
-  const DeviceLimits* limits = &backend.info.limits;
-  int realBytes = run.variant.f64 ? 8 : 4;
-  checkJobFits(estimateClassicJob(job.mesh, packed, realBytes, limits), packed, realBytes, limits);
-  ClassicOutput result = classicFfd(*backend.backend, job.mesh, packed, run.variant);
-  run.mesh = applyClassicOutput(job.mesh, result);
-  run.deformMs = stageMs(result.timings, result.wallMs);
+double edgeLengthOf(const ParsedArgs& args, const Mesh& mesh) {
+  if (args.has("--edge-length")) return args.getDouble("--edge-length", 0);
+  glm::dvec3 lo, hi;
+  meshBounds(mesh, lo, hi);
+  return 0.1 * std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
+}
+
+DeformOptions deformOptionsOf(const ParsedArgs& args, const Job& job, Device& device, Method method) {
+  DeformOptions o;
+  o.method = method;
+  o.precision = wantDouble(args, device.info(), method != Method::Smooth) ? Precision::Double : Precision::Float;
+  o.strict = args.has("--strict");
+  o.clip = args.get("--clip", "regular") == "knot-box" ? Clip::KnotBox : Clip::Regular;
+  o.tess = args.getInt("--tess", 10);
+  o.creaseAngleDeg = args.getDouble("--crease-angle", 40.0);
+  o.split = args.has("--split");
+  const Lattice& L = job.lattice;
+  o.samples = std::max(3, args.getInt("--samples", L.degree[0] + L.degree[1] + L.degree[2]));
+  if (method == Method::Smooth) {
+    o.edgeLength = edgeLengthOf(args, job.mesh);
+    checkEdgeLength(job.mesh, o.edgeLength);
+    o.maxChunkElements = chunkFromEnvironment("SFFD_MAX_CHUNK_SUBTRIANGLES");
+  } else {
+    if (const char* s = std::getenv("SFFD_MEMORY_LIMIT"); s && *s) {
+      o.memoryLimit = parseByteSize(s);
+      if (o.memoryLimit == 0)
+        throw Error(ErrorKind::Input, std::string("SFFD_MEMORY_LIMIT must be a size like 4096, 512M or 2G, not '") + s + "'");
+    }
+    o.maxChunkElements = chunkFromEnvironment(method == Method::Classic ? "SFFD_MAX_CHUNK_VERTICES" : "SFFD_MAX_CHUNK_PATCHES");
+  }
+  return o;
+}
+
+std::optional<PatchVertices> DeformRun::patches() {
+  std::optional<PatchVertices> p = deformer.internal().run->patchVertices();
+  line->clear();
+  return p;
+}
+
+DeformRun runMethod(const ParsedArgs& args, Job& job, Device& device, Method method) {
+  DeformOptions o = deformOptionsOf(args, job, device, method);
+  auto line = std::make_shared<ProgressLine>(progressWanted(args));   // cleared also when a call throws
+  o.progress = line->callback();
+  auto make = [&] {
+    try {
+      return Deformer(device, job.mesh, job.lattice, o);
+    } catch (const Error& e) {
+      std::string what = e.what();
+      size_t at = what.find(kLibraryLimitName);
+      if (at == std::string::npos) throw;
+      throw Error(e.kind(), what.replace(at, std::string(kLibraryLimitName).size(), "(SFFD_MEMORY_LIMIT)"));
+    }
+  };
+  const char* name = method == Method::Smooth ? "smooth" : method == Method::Accurate ? "accurate" : "classic";
+  DeformRun run{name, method == Method::Accurate ? "knot-box" : args.get("--clip", "regular"), line, make(), {}};
+  run.deformer.deform(job.lattice);
+  run.mesh = run.deformer.result();
+  line->clear();
+  if (method == Method::Smooth) job.mesh = run.deformer.internal().input;
   return run;
 }
 
-DeformRun runDeformJob(const ParsedArgs& args, Job& job, OpenedBackend& backend) {
-  std::string method = args.get("--method", "smooth");
-  std::string clip = args.get("--clip", "regular");
+DeformRun runDeformJob(const ParsedArgs& args, Job& job, Device& device) {
   std::string warning = foldWarning(checkLatticeFold(packLattice(job.lattice)), job.latticePath);
-  DeformRun run = method == "classic" ? runClassic(args, job, backend)
-                  : method == "accurate" ? runAccurate(args, job, backend)
-                                         : runSmooth(args, job, backend);
-  // After the work, so a job that fails prints its one error line only. Shown even with --quiet: it
-  // is about the result.
+  DeformRun run = runMethod(args, job, device, methodOf(args.get("--method", "smooth")));
   if (!warning.empty()) std::fprintf(stderr, "sffd: warning: %s\n", warning.c_str());
-  run.method = method;
-  run.clip = method == "accurate" ? "knot-box" : clip;
   return run;
 }
 

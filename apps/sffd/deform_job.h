@@ -1,42 +1,47 @@
-// Running one deformation as the options say: the part of `sffd deform` that `render`, `error`,
-// `bench` and `view` share. Each method is one function; runDeformJob picks it.
+// Running one deformation as the options say, through sffd::Deformer: the part of `sffd deform`
+// that `render`, `error` and `view` share.
 #pragma once
+#include <memory>
 #include <optional>
 #include <string>
 
-#include "backends/backend_select.h"
+#include <sffd/deformer.h>
+
 #include "apps/sffd/cli.h"
 #include "pipelines/patch_output.h"
 
 namespace sffd::cli {
 
+// --method smooth|accurate|classic; an input Error for another name.
+Method methodOf(const std::string& name);
+
+// The job options (--clip, --edge-length, --tess, --samples, --split, --precision, --strict,
+// --crease-angle) for `method` on `device`, and what the library takes as options but the tool reads
+// from the environment: SFFD_MEMORY_LIMIT (classic and accurate, the methods with a host-memory
+// estimate) and SFFD_MAX_CHUNK_VERTICES, _PATCHES, _SUBTRIANGLES (classic, accurate, smooth).
+DeformOptions deformOptionsOf(const ParsedArgs& args, const Job& job, Device& device, Method method);
+
+class ProgressLine;
+
 struct DeformRun {
-  std::string method, clip;
-  KernelVariant variant;
-  Mesh mesh;                               // the result as `deform` writes it
-  std::optional<PatchVertices> patches;    // smooth and accurate: the tessellation with pre-images
-  // Smooth: per patch SFFD_PATCH_STRIDE control points (x, y, z, 0): 10 geometry then 10 normal, in
-  // the linear index order of METHOD.md 0 (what `deform --patches` writes).
-  std::vector<double> patchControlPoints;
-  size_t subTriangles = 0;
-  double pnMs = 0, clipMs = 0, deformMs = 0;   // per stage: GPU time where measured, else wall time
-  std::vector<std::pair<std::string, double>> stepMs;   // --split: the deform steps (deform.sample, ...)
+  std::string method, clip;   // as the stats and messages name them
+  std::shared_ptr<ProgressLine> line;   // what the Deformer's progress callback draws on
+  Deformer deformer;
+  Mesh mesh;                  // the result as `deform` writes it
+  // Smooth and accurate: the tessellation with the pre-images of its vertices (downloaded again).
+  std::optional<PatchVertices> patches();
 };
 
-// Reads --method, --clip, --edge-length, --tess, --precision, --strict and runs the job on `backend`.
-DeformRun runDeformJob(const ParsedArgs& args, Job& job, OpenedBackend& backend);
+// A Deformer for the job on `device`, deformed once. For smooth, job.mesh becomes the mesh as the
+// method used it (creases split): the pre-images index its triangles. A progress line on stderr shows
+// how far it is (progress_line.h).
+DeformRun runMethod(const ParsedArgs& args, Job& job, Device& device, Method method);
+// runMethod for --method, then the lattice's fold warning (after the work, so a job that fails prints
+// its one error line only; shown even with --quiet: it is about the result).
+DeformRun runDeformJob(const ParsedArgs& args, Job& job, Device& device);
 
-// One function per method (deform_job.cpp, smooth_job.cpp, accurate_job.cpp).
-DeformRun runClassic(const ParsedArgs& args, Job& job, OpenedBackend& backend);
-DeformRun runSmooth(const ParsedArgs& args, Job& job, OpenedBackend& backend);
-DeformRun runAccurate(const ParsedArgs& args, Job& job, OpenedBackend& backend);
-
-// --tess (default 10) and --edge-length (default: a tenth of the mesh's largest extent, the reference
-// implementation's l = 0.2 for models in [-1, 1]).
-int tessLevel(const ParsedArgs& args);
+// --edge-length, or a tenth of the mesh's largest extent (the reference implementation's l = 0.2 for
+// models in [-1, 1]).
 double edgeLengthOf(const ParsedArgs& args, const Mesh& mesh);
-
-// Sum of the GPU times of the timings (wall time when the device measured none).
-double stageMs(const std::vector<DispatchTiming>& timings, double wallMs);
 
 }  // namespace sffd::cli

@@ -5,6 +5,7 @@
 
 #include "apps/sffd/cli.h"
 #include <sffd/error.h>
+#include "core/job_budget.h"
 #include "io/lattice_io.h"
 
 namespace sffd::cli {
@@ -103,29 +104,30 @@ void checkOutputPath(const std::string& out, const std::vector<std::string>& inp
   }
 }
 
-OpenedBackend openBackendFromArgs(const ParsedArgs& args) {
-  BackendRequest r;
+Device openDeviceFromArgs(const ParsedArgs& args) {
+  DeviceRequest r;
   r.name = args.get("--backend", "auto");
-  r.device = args.get("--device");
+  r.deviceSubstring = args.get("--device");
   std::vector<std::string> notes;
-  OpenedBackend b = openBackend(r, &notes);
+  Device d = Device::open(r, &notes);
   for (const std::string& n : notes) note(args, n);
-  return b;
+  return d;
 }
 
 void checkEdgeLength(const Mesh& mesh, double l) {
   if (!(l > 0) || !std::isfinite(l)) throw Error(ErrorKind::Input, "--edge-length must be a positive number");
-  // A near-regular split gives about area / (sqrt(3)/4 l^2) sub-triangles, and at least one a triangle.
-  double area = 0;
-  for (const auto& t : mesh.triangles)
-    area += 0.5 * glm::length(glm::cross(mesh.positions[t[1]] - mesh.positions[t[0]], mesh.positions[t[2]] - mesh.positions[t[0]]));
-  double estimate = area / (std::sqrt(3.0) / 4 * l * l) + double(mesh.triangles.size());
+  double estimate = estimateSubTriangles(mesh, l);
   if (estimate > kMaxSubTriangles) {
     char buf[200];
     std::snprintf(buf, sizeof buf, "--edge-length %g would make about %.3g sub-triangles, above the limit of %.3g", l,
                   estimate, kMaxSubTriangles);
     throw Error(ErrorKind::Input, buf);
   }
+}
+
+size_t chunkFromEnvironment(const char* name) {
+  const char* v = std::getenv(name);
+  return v ? std::max<size_t>(1, std::strtoull(v, nullptr, 10)) : 0;
 }
 
 bool wantDouble(const ParsedArgs& args, const DeviceInfo& info, bool autoDouble) {

@@ -120,7 +120,7 @@ App::App(ViewConfig& c)
   renderer_ = std::make_unique<gl::Renderer>(c.window);
   c.window->activate();
   overlays_ = std::make_unique<Overlays>();
-  scene_ = std::make_unique<Scene>(*renderer_, c.gpu, c.zeroCopy, c.sessionMesh, c.host, c.session, c.level);
+  scene_ = std::make_unique<Scene>(*renderer_, *c.device, c.zeroCopy, c.sessionMesh, c.options);
   glfwGetFramebufferSize(window_, &fbW_, &fbH_);
   if (fbW_ <= 0 || fbH_ <= 0) fbW_ = ro_.width, fbH_ = ro_.height;
   glfwSetWindowUserPointer(window_, this);

@@ -14,13 +14,11 @@ namespace sffd::view {
 
 struct ViewConfig {
   std::shared_ptr<gl::Context> window;    // a visible GLFW context (gl::createGlfwContext)
-  Backend* gpu = nullptr;                 // null: the CPU reference
-  bool zeroCopy = false;                  // gpu is a GL backend on `window`
+  Device* device = nullptr;               // where the kernels run
+  bool zeroCopy = false;                  // the device is a GL backend on `window`
   std::string backendLabel;               // for the HUD ("gl-glfw", "vulkan", "cpu")
   Mesh sessionMesh;                       // the input as loaded (after --normalize)
-  HostDeform host;
-  std::optional<DeformSessionOptions> session;   // smooth on a GPU: the device-resident path
-  int level = 10;
+  DeformOptions options;                  // the job options; method and clipping come from `settings`
   Lattice lattice;
   std::string meshName, latticeName;
   gl::RenderOptions render;               // window size, view direction, up axis, wireframe

@@ -13,6 +13,7 @@
 #include "model/lattice_pack.h"
 #include "model/mesh_topology.h"
 #include "core/wall_clock.h"
+#include "pipelines/deformer_internal.h"
 
 namespace sffd::view {
 
@@ -30,26 +31,15 @@ std::vector<float> geometryErrors(const Mesh& input, const Lattice& lattice, con
   return out;
 }
 
-Scene::Scene(gl::Renderer& renderer, Backend* gpu, bool zeroCopy, Mesh mesh, HostDeform host,
-             std::optional<DeformSessionOptions> sessionOptions, int level)
-    : renderer_(renderer),
-      gpu_(gpu),
-      zeroCopy_(zeroCopy && gpu),
-      sessionMesh_(std::move(mesh)),
-      host_(std::move(host)),
-      sessionOptions_(std::move(sessionOptions)),
-      level_(level) {
-  if (sessionOptions_) {
-    creasedMesh_ = sessionMesh_;
-    applyCreaseAngle(creasedMesh_, sessionOptions_->creaseAngleDeg);   // as the session does
-  }
+Scene::Scene(gl::Renderer& renderer, Device& device, bool zeroCopy, Mesh mesh, DeformOptions options)
+    : renderer_(renderer), device_(device), zeroCopy_(zeroCopy), mesh_(std::move(mesh)), options_(std::move(options)), level_(options_.tess) {
   glm::dvec3 lo(1e300), hi(-1e300);
-  for (const auto& p : sessionMesh_.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
-  if (!sessionMesh_.positions.empty()) normalLength_ = float(0.03 * glm::length(hi - lo));
+  for (const auto& p : mesh_.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
+  if (!mesh_.positions.empty()) normalLength_ = float(0.03 * glm::length(hi - lo));
 }
 
 Scene::~Scene() {
-  session_.reset();
+  deformer_.reset();
   try {
     renderer_.context().activate();
     if (hostTess_) glDeleteBuffers(1, &hostTess_);
@@ -60,50 +50,39 @@ Scene::~Scene() {
 
 std::string Scene::path() const { return path_; }
 
-bool Scene::sessionUsable(const Lattice&, const SceneSettings& s) const {
-  return s.method == "smooth" && sessionOptions_ && gpu_;
-}
-
 void Scene::update(const Lattice& lattice, const SceneSettings& settings,
                    const std::function<void(const std::string&)>& progress) {
   const auto t0 = std::chrono::steady_clock::now();
-  if (sessionUsable(lattice, settings)) {
-    const bool knotBox = settings.clip == "knot-box";
-    if (!session_ || knotBox != sessionClipKnotBox_ || !sameLatticeStructure(lattice, sessionLattice_)) {
-      if (progress)
-        progress("PREPARING: PN TRIANGLES AND " + std::string(knotBox ? "KNOT-BOX" : "REGULAR") + " CLIPPING OF " +
-                 std::to_string(sessionMesh_.triangles.size()) + " TRIANGLES");
-      session_.reset();
-      sessionRecords_.reset();
-      DeformSessionOptions o = *sessionOptions_;
-      o.knotBoxClip = knotBox;
-      session_ = std::make_unique<DeformSession>(*gpu_, sessionMesh_, lattice, o);
-      sessionLattice_ = lattice;
-      sessionClipKnotBox_ = knotBox;
-      times_.pnMs = session_->timings().pnMs;
-      times_.clipMs = session_->timings().clipMs;
-    }
-    const SessionTimings& t = session_->deform(lattice);
-    times_.deformMs = t.deformMs;
-    subTriangles_ = session_->subTriangles();
-    if (zeroCopy_ && !settings.heatmap) {
-      drawSession({});
-      path_ = "zero-copy";
-    } else {
-      if (!sessionRecords_) sessionRecords_ = session_->records();
-      PatchVertices pv = patchVerticesOf(*sessionRecords_, session_->output());
-      drawHost(creasedMesh_, lattice, settings.heatmap ? Mesh{} : weldPatchVertices(pv), pv, settings);
-      path_ = "session+copy";
-    }
+  const bool smooth = settings.method == "smooth", knotBox = settings.clip == "knot-box";
+  if (!deformer_ || settings.method != deformerSettings_.method || (smooth && settings.clip != deformerSettings_.clip) ||
+      !sameLatticeStructure(lattice, deformerLattice_)) {
+    if (progress && smooth)
+      progress("PREPARING: PN TRIANGLES AND " + std::string(knotBox ? "KNOT-BOX" : "REGULAR") + " CLIPPING OF " +
+               std::to_string(mesh_.triangles.size()) + " TRIANGLES");
+    else if (progress && !drawn_.positions.size())
+      progress("PREPARING: " + settings.method + " FFD");
+    deformer_.reset();
+    DeformOptions o = options_;
+    o.method = smooth ? Method::Smooth : settings.method == "accurate" ? Method::Accurate : Method::Classic;
+    o.clip = knotBox ? Clip::KnotBox : Clip::Regular;
+    deformer_ = std::make_unique<Deformer>(device_, mesh_, lattice, o);
+    deformerLattice_ = lattice;
+    deformerSettings_ = settings;
+  }
+  const Timings& t = deformer_->deform(lattice);
+  times_.pnMs = t.pnMs;
+  times_.clipMs = t.clipMs;
+  times_.deformMs = t.deformMs;
+  subTriangles_ = deformer_->subTriangles();
+  if (smooth && zeroCopy_ && !settings.heatmap) {
+    drawSession({});
+    path_ = "zero-copy";
   } else {
-    if (progress && !drawn_.positions.size()) progress("PREPARING: " + settings.method + " FFD");
-    HostResult r = host_(lattice, settings.method, settings.clip);
-    times_.pnMs = r.pnMs;
-    times_.clipMs = r.clipMs;
-    times_.deformMs = r.deformMs;
-    subTriangles_ = r.patches ? r.patches->patchCount() : 0;
-    drawHost(r.input, lattice, std::move(r.mesh), r.patches, settings);
-    path_ = "host";
+    std::optional<PatchVertices> pv = deformer_->internal().run->patchVertices();
+    Mesh mesh = settings.heatmap && pv ? Mesh{} : pv ? weldPatchVertices(*pv) : deformer_->result();
+    drawHost(deformer_->internal().input, lattice, std::move(mesh), pv, settings);
+    // The names the HUD and --stats have always given: smooth on a device, or the others.
+    path_ = smooth && device_.info().api != "cpu" ? "session+copy" : "host";
   }
   times_.updateMs = msSince(t0);
 }
@@ -150,8 +129,8 @@ void Scene::drawSession(std::vector<glm::vec3> fitPoints) {
   renderer_.context().activate();
   // The deform kernel wrote the buffers as storage; they are read as vertex attributes next.
   glMemoryBarrier(GL_VERTEX_ATTRIB_ARRAY_BARRIER_BIT | GL_ELEMENT_ARRAY_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
-  const auto& chunks = session_->chunks();
-  const int L = session_->level();
+  const std::vector<OutputChunk> chunks = deformer_->deviceOutput();
+  const int L = level_;
   const size_t nv = size_t(tessVertexCount(L)), nt = size_t(tessTriangleCount(L));
   size_t maxCount = 0;
   for (const auto& c : chunks) maxCount = std::max(maxCount, c.count);
@@ -172,8 +151,8 @@ void Scene::drawSession(std::vector<glm::vec3> fitPoints) {
   tess_.clear();
   outputTriangles_ = 0;
   for (const auto& c : chunks) {
-    const unsigned buffer = gl::glBufferObject(*gpu_, c.tess);
-    if (!buffer) throw Error(ErrorKind::Internal, "view: the session's buffer is not a GL buffer of the window");
+    const unsigned buffer = gl::glBufferObject(device_.backend(), c.buffer);
+    if (!buffer) throw Error(ErrorKind::Internal, "view: the Deformer's buffer is not a GL buffer of the window");
     item.draws.push_back({buffer, sessionIndex_, 0, nv * 16, c.count * nt * 3});
     tess_.push_back({buffer, c.count, L});
     outputTriangles_ += c.count * nt;
@@ -185,15 +164,10 @@ void Scene::drawSession(std::vector<glm::vec3> fitPoints) {
 std::vector<glm::vec3> Scene::resultPoints() {
   std::vector<glm::vec3> pts;
   if (drawingSession_) {
-    SmoothOutput out = session_->output();
-    const size_t nv = size_t(tessVertexCount(out.level));
-    const size_t patches = out.tess.size() / (2 * nv * 4);
-    pts.reserve(patches * nv);
-    for (size_t p = 0; p < patches; ++p)
-      for (size_t v = 0; v < nv; ++v) {
-        const double* x = &out.tess[(2 * nv * p + v) * 4];
-        pts.push_back(glm::vec3(float(x[0]), float(x[1]), float(x[2])));
-      }
+    PatchVertices pv = *deformer_->internal().run->patchVertices();
+    pts.reserve(pv.vertexCount());
+    for (size_t v = 0; v < pv.vertexCount(); ++v)
+      pts.push_back(glm::vec3(float(pv.position[3 * v]), float(pv.position[3 * v + 1]), float(pv.position[3 * v + 2])));
   } else {
     pts.reserve(drawn_.positions.size());
     for (const auto& p : drawn_.positions) pts.push_back(glm::vec3(p));
@@ -206,10 +180,7 @@ void Scene::prepareFit() {
 }
 
 Mesh Scene::resultMesh() {
-  if (drawingSession_) {
-    if (!sessionRecords_) sessionRecords_ = session_->records();
-    return weldPatchVertices(patchVerticesOf(*sessionRecords_, session_->output()));
-  }
+  if (drawingSession_) return deformer_->result();
   return result_;
 }
 

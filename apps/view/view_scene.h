@@ -1,10 +1,7 @@
-// What `sffd view` draws and how it is computed. Two paths:
-//  - device-resident: --method smooth on a GPU backend goes through DeformSession (pre-compute once,
-//    deform on every move). On the GL backend of the window's own context the renderer draws the
-//    session's tessellation buffers in place (zero copy); on another backend (Vulkan) the output is
-//    downloaded and uploaded to GL;
-//  - host: every other case (accurate, classic, the CPU reference, the heat map) runs the same job
-//    functions as `sffd deform/render` (HostDeform, given by apps/sffd/cmd_view.cpp) and uploads the mesh.
+// What `sffd view` draws and how it is computed: an sffd::Deformer for the method, clipping and
+// lattice structure shown (prepared once, deformed on every move). Smooth FFD on the GL backend of the
+// window's own context is drawn from the Deformer's tessellation buffers in place (zero copy); every
+// other case (another device, accurate, classic, the heat map) downloads the result and uploads it to GL.
 #pragma once
 #include <functional>
 #include <memory>
@@ -13,7 +10,7 @@
 #include <vector>
 
 #include "core/backend.h"
-#include "pipelines/deform_session.h"
+#include <sffd/deformer.h>
 #include "apps/render/gl_renderer.h"
 #include "model/lattice.h"
 #include "model/mesh.h"
@@ -21,14 +18,6 @@
 #include "apps/view/view_draw.h"
 
 namespace sffd::view {
-
-struct HostResult {
-  Mesh input;                             // the input as the method prepared it (pre-images index its triangles)
-  Mesh mesh;                              // the result, as `sffd deform` writes it
-  std::optional<PatchVertices> patches;   // smooth and accurate
-  double pnMs = 0, clipMs = 0, deformMs = 0;
-};
-using HostDeform = std::function<HostResult(const Lattice& lattice, const std::string& method, const std::string& clip)>;
 
 struct SceneSettings {
   std::string method = "smooth", clip = "regular";
@@ -42,10 +31,10 @@ struct StageTimes {
 
 class Scene {
  public:
-  // `gpu` may be null (CPU reference). `zeroCopy`: gpu is a GL backend on the renderer's context.
-  // `mesh` is the input as loaded (DeformSession applies the crease angle of its options itself).
-  Scene(gl::Renderer& renderer, Backend* gpu, bool zeroCopy, Mesh mesh, HostDeform host,
-        std::optional<DeformSessionOptions> sessionOptions, int level);
+  // `zeroCopy`: the device is a GL backend on the renderer's context. `mesh` is the input as loaded
+  // (the Deformer applies the crease angle of `options` itself); `options` as for `sffd deform`, the
+  // method and clipping coming from each update's settings.
+  Scene(gl::Renderer& renderer, Device& device, bool zeroCopy, Mesh mesh, DeformOptions options);
   ~Scene();
 
   // Deforms with the lattice and settings and sets up the drawing. `progress` is told before slow
@@ -54,7 +43,7 @@ class Scene {
               const std::function<void(const std::string&)>& progress = {});
 
   const StageTimes& times() const { return times_; }
-  std::string path() const;                      // "zero-copy", "session+copy" or "host", for the HUD
+  std::string path() const;                      // "zero-copy", "session+copy" (smooth, downloaded) or "host" (others), for the HUD
   const std::vector<TessSource>& tessSources() const { return tess_; }
   size_t subTriangles() const { return subTriangles_; }
   size_t outputTriangles() const { return outputTriangles_; }
@@ -71,21 +60,17 @@ class Scene {
                 const SceneSettings& settings);
   void uploadTess(const PatchVertices& pv);
   void drawSession(std::vector<glm::vec3> fitPoints);
-  bool sessionUsable(const Lattice& lattice, const SceneSettings& settings) const;
 
   gl::Renderer& renderer_;
-  Backend* gpu_;
+  Device& device_;
   bool zeroCopy_;
-  Mesh sessionMesh_;                // as loaded: what DeformSession prepares
-  Mesh creasedMesh_;                // with the crease angle applied: the heat map's pre-images
-  HostDeform host_;
-  std::optional<DeformSessionOptions> sessionOptions_;
+  Mesh mesh_;                       // as loaded: what the Deformer prepares
+  DeformOptions options_;
   int level_;
-  std::unique_ptr<DeformSession> session_;
-  Lattice sessionLattice_;          // the structure the session was made for
-  bool sessionClipKnotBox_ = false;
-  std::optional<SubTriangleRecords> sessionRecords_;
-  bool drawingSession_ = false;     // the renderer draws the session's buffers
+  std::unique_ptr<Deformer> deformer_;
+  Lattice deformerLattice_;         // the structure the Deformer was made for
+  SceneSettings deformerSettings_;  // the method and clipping it was made for
+  bool drawingSession_ = false;     // the renderer draws the Deformer's buffers
   Mesh drawn_;                      // host path: the mesh given to the renderer
   Mesh result_;                     // host path: the result as deform writes it
   unsigned hostTess_ = 0, sessionIndex_ = 0;

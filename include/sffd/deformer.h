@@ -54,8 +54,8 @@ struct DeformOptions {
   bool strict = false;           // strict kernels: bit-identical on every device, the CPU included
   Precision precision = Precision::Auto;
   bool split = false;            // smooth: the deform step as four dispatches (per-step timings)
-  double creaseAngleDeg = 40;    // meshes without normals: dihedral angle above which an edge is a crease
-  uint64_t memoryLimit = 0;      // bytes of host memory a job may plan for; 0: physical memory
+  double creaseAngleDeg = 40;    // smooth, meshes without normals: dihedral angle above which an edge is a crease
+  uint64_t memoryLimit = 0;      // classic, accurate: bytes of host memory a job may plan for; 0: physical memory
   size_t maxChunkElements = 0;   // 0: chunks as large as the device allows (smaller only to test chunking)
   ProgressCallback progress;     // called during long work; may be empty
 };
@@ -64,14 +64,14 @@ struct DeformOptions {
 struct Timings {
   double pnMs = 0, clipMs = 0, deformMs = 0;
   double wallMs = 0;                                    // the whole call, waiting included
-  std::vector<std::pair<std::string, double>> steps;   // every dispatch by label (split: deform.sample, ...)
+  std::vector<std::pair<std::string, double>> steps;   // the last deform()'s dispatches by label (split: deform.sample, ...)
 };
 
-// A range of a device buffer holding results, as the interop headers hand it out
-// (sffd::vulkan::bufferOf, sffd::opengl::bufferOf).
+// One chunk of a Deformer's results on the device, as the interop headers hand it out
+// (sffd::vulkan::bufferOf, sffd::opengl::bufferOf). Layout: see Deformer::deviceOutput().
 struct OutputChunk {
-  size_t firstPatch = 0, patchCount = 0;   // Smooth/Accurate: the sub-triangles whose tessellation it holds
-  uint32_t buffer = 0;                     // internal id; see the interop headers
+  size_t first = 0, count = 0;   // Smooth, Accurate: the patches [first, first + count); Classic: the vertices
+  uint32_t buffer = 0;           // internal id; see the interop headers
   uint64_t offset = 0, bytes = 0;
 };
 
@@ -101,10 +101,14 @@ class Deformer {
   std::vector<double> patchControlPoints() const;
   size_t subTriangles() const;   // Smooth, Accurate: the patches made; Classic: 0
 
-  // The last deform()'s output where it lives on the device, for drawing from it without a copy.
-  // Smooth and Accurate: per patch, tessVertexCount(tess) positions then as many unit normals, each 4
-  // reals (w = 0; float, or double in double precision). Classic: per vertex a position (w: 1 inside
-  // the lattice box, 0 outside), then per vertex a normal, 4 reals each.
+  // The last deform()'s output where it lives on the device, for drawing from it without a copy; 4
+  // reals (float, or double when doublePrecision()) a position or unit normal, w = 0 unless said.
+  //   Smooth    per patch of the chunk, tessVertexCount(tess) positions then as many normals.
+  //   Accurate  the positions of the chunk's patches' vertices (tessVertexCount(tess) a patch), then
+  //             from offset + bytes / 2 their normals.
+  //   Classic   per vertex a position (w: 1 inside the lattice box, 0 outside), then from
+  //             offset + bytes / 2 the normals.
+  // Empty on a device that keeps nothing (the CPU reference).
   std::vector<OutputChunk> deviceOutput() const;
   bool doublePrecision() const;   // whether the reals above are doubles
   const DeformOptions& options() const;

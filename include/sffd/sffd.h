@@ -20,6 +20,7 @@
 //
 // A whole program (link sffd::sffd from find_package(sffd CONFIG)):
 //
+//   #include <cstdio>
 //   #include <sffd/sffd.h>
 //   int main() try {
 //     sffd::Device device = sffd::Device::open();            // Vulkan, else GL, else the CPU

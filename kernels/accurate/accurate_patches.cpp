@@ -160,31 +160,20 @@ AccurateJob makeAccurateJob(const Mesh& mesh, const Lattice& lattice, std::vecto
 
 namespace {
 
-// A_n^{-1} transposed (sample-major), as the kernel reads it.
 template <class Real>
 std::vector<Real> kernelMatrix(int n) {
-  const std::vector<double>& inv = interpolationInverse(n);
-  const int m = triangleControlPoints(n);
-  std::vector<Real> t(size_t(m) * m);
-  for (int k = 0; k < m; ++k)
-    for (int l = 0; l < m; ++l) t[size_t(l) * m + k] = Real(inv[size_t(k) * m + l]);
-  return t;
+  return convertReals<Real>(accurateKernelMatrix(n));
 }
 
 template <class Real>
-void accurateRun(Backend& backend, const AccurateJob& job, const PackedLattice& P, KernelVariant variant, AccurateOutput& out) {
+void accurateRun(Backend& backend, const AccurateJob& job, const PackedLattice& P, KernelVariant variant, size_t maxChunk,
+                 AccurateOutput& out) {
   const DeviceLimits& lim = backend.info().limits;
-  const uint32_t n = uint32_t(job.degree), m = uint32_t(triangleControlPoints(job.degree));
+  const uint32_t m = uint32_t(triangleControlPoints(job.degree));
   const uint32_t nv = uint32_t(tessVertexCount(job.level));
   const size_t ns = job.count();
   const size_t r4 = 4 * sizeof(Real);
-  // The largest per-sub-triangle binding decides the chunk (positions and normals: nv real4 each).
-  const size_t perSub = std::max<size_t>({SFFD_ACC_CORNER_STRIDE, m, nv}) * r4;
-  size_t chunk = size_t(lim.maxStorageBufferRange / perSub);
-  chunk = std::min<size_t>(chunk, size_t(lim.maxWorkGroupCount[0]) * lim.maxWorkGroupCount[1] * SFFD_LOCAL_SIZE / std::max(m, nv));
-  chunk = std::min<size_t>(chunk, size_t(UINT32_MAX) / std::max(m, nv));   // thread indices are 32-bit
-  if (const char* forced = std::getenv("SFFD_MAX_CHUNK_PATCHES")) chunk = std::min<size_t>(chunk, std::strtoull(forced, nullptr, 10));
-  chunk = std::max<size_t>(1, std::min(chunk, std::max<size_t>(ns, 1)));
+  const size_t chunk = accurateChunkPatches(lim, job, sizeof(Real), maxChunk);
 
   std::vector<Real> frame = convertReals<Real>(P.frame), coeffs = convertReals<Real>(P.coeffs);
   std::vector<Real> matrix = kernelMatrix<Real>(job.degree);
@@ -213,27 +202,12 @@ void accurateRun(Backend& backend, const AccurateJob& job, const PackedLattice& 
     const size_t cw = 4 * SFFD_ACC_CORNER_STRIDE;
     for (size_t i = 0; i < cw * count; ++i) corners[i] = Real(job.corners[cw * first + i]);
     backend.upload(bCorners, 0, corners.data(), count * SFFD_ACC_CORNER_STRIDE * r4);
-    // Samples, then control points, then the tessellation: three dispatches, a barrier between each.
-    for (uint32_t stage : {SFFD_ACC_STAGE_SAMPLES, SFFD_ACC_STAGE_PATCHES, SFFD_ACC_STAGE_TESSELLATE}) {
-      gpu::AccurateParams params;
-      params.lattice = P.params;
-      params.range = {0, uint32_t(count), stage, 0};
-      params.shape = {n, m, uint32_t(job.level), nv};
-      Dispatch d;
-      d.kernel = "accurate_patches";
-      d.variant = variant;
-      d.params = &params;
-      d.paramsSize = sizeof(params);
-      d.label = stage == SFFD_ACC_STAGE_SAMPLES ? "accurate_samples" : stage == SFFD_ACC_STAGE_PATCHES ? "accurate_patches" : "accurate_tessellate";
-      d.buffers = {{SFFD_BINDING_LATTICE_COEFFS, bCoeffs},  {SFFD_BINDING_LATTICE_FRAME, bFrame},
-                   {SFFD_BINDING_ACC_MATRIX, bMatrix},      {SFFD_BINDING_ACC_TESS_BASIS, bBasis},
-                   {SFFD_BINDING_ACC_CORNERS, bCorners},    {SFFD_BINDING_ACC_PATCHES, bPatches},
-                   {SFFD_BINDING_ACC_POSITIONS, bPos},      {SFFD_BINDING_ACC_NORMALS, bNrm},
-                   {SFFD_BINDING_ACC_SAMPLES, bSamples}};
-      gridFor(uint64_t(count) * (stage == SFFD_ACC_STAGE_TESSELLATE ? nv : m), lim, d.groups);
-      backend.dispatch(d);
-      backend.barrier();
-    }
+    dispatchAccurateChunk(backend, P.params, variant, job, count,
+                          {{SFFD_BINDING_LATTICE_COEFFS, bCoeffs}, {SFFD_BINDING_LATTICE_FRAME, bFrame},
+                           {SFFD_BINDING_ACC_MATRIX, bMatrix},     {SFFD_BINDING_ACC_TESS_BASIS, bBasis},
+                           {SFFD_BINDING_ACC_CORNERS, bCorners},   {SFFD_BINDING_ACC_PATCHES, bPatches},
+                           {SFFD_BINDING_ACC_POSITIONS, bPos},     {SFFD_BINDING_ACC_NORMALS, bNrm},
+                           {SFFD_BINDING_ACC_SAMPLES, bSamples}});
     backend.download(bPatches, 0, cps.data(), count * m * r4);
     backend.download(bPos, 0, pos.data(), count * nv * r4);
     backend.download(bNrm, 0, nrm.data(), count * nv * r4);
@@ -248,14 +222,59 @@ void accurateRun(Backend& backend, const AccurateJob& job, const PackedLattice& 
 
 }  // namespace
 
-AccurateOutput accurateFfd(Backend& backend, const AccurateJob& job, const PackedLattice& lattice, KernelVariant variant) {
+std::vector<double> accurateKernelMatrix(int n) {
+  const std::vector<double>& inv = interpolationInverse(n);
+  const int m = triangleControlPoints(n);
+  std::vector<double> t(size_t(m) * m);
+  for (int k = 0; k < m; ++k)
+    for (int l = 0; l < m; ++l) t[size_t(l) * m + k] = inv[size_t(k) * m + l];
+  return t;
+}
+
+size_t accurateChunkPatches(const DeviceLimits& lim, const AccurateJob& job, size_t realBytes, size_t maxChunk) {
+  const size_t m = size_t(triangleControlPoints(job.degree)), nv = size_t(tessVertexCount(job.level));
+  const size_t r4 = 4 * realBytes;
+  // The largest per-sub-triangle binding decides the chunk (positions and normals: nv real4 each).
+  const size_t perSub = std::max<size_t>({SFFD_ACC_CORNER_STRIDE, m, nv}) * r4;
+  size_t chunk = size_t(lim.maxStorageBufferRange / perSub);
+  chunk = std::min<size_t>(chunk, size_t(lim.maxWorkGroupCount[0]) * lim.maxWorkGroupCount[1] * SFFD_LOCAL_SIZE / std::max(m, nv));
+  chunk = std::min<size_t>(chunk, size_t(UINT32_MAX) / std::max(m, nv));   // thread indices are 32-bit
+  if (maxChunk) chunk = std::min(chunk, maxChunk);
+  return std::max<size_t>(1, std::min(chunk, std::max<size_t>(job.count(), 1)));
+}
+
+void dispatchAccurateChunk(Backend& backend, const gpu::LatticeParams& lattice, KernelVariant variant, const AccurateJob& job,
+                           size_t count, const AccurateBindings& bindings) {
+  const uint32_t n = uint32_t(job.degree), m = uint32_t(triangleControlPoints(job.degree));
+  const uint32_t nv = uint32_t(tessVertexCount(job.level));
+  // Samples, then control points, then the tessellation: three dispatches, a barrier between each.
+  for (uint32_t stage : {SFFD_ACC_STAGE_SAMPLES, SFFD_ACC_STAGE_PATCHES, SFFD_ACC_STAGE_TESSELLATE}) {
+    gpu::AccurateParams params;
+    params.lattice = lattice;
+    params.range = {0, uint32_t(count), stage, 0};
+    params.shape = {n, m, uint32_t(job.level), nv};
+    Dispatch d;
+    d.kernel = "accurate_patches";
+    d.variant = variant;
+    d.params = &params;
+    d.paramsSize = sizeof(params);
+    d.label = stage == SFFD_ACC_STAGE_SAMPLES ? "accurate_samples" : stage == SFFD_ACC_STAGE_PATCHES ? "accurate_patches" : "accurate_tessellate";
+    d.buffers = bindings;
+    gridFor(uint64_t(count) * (stage == SFFD_ACC_STAGE_TESSELLATE ? nv : m), backend.info().limits, d.groups);
+    backend.dispatch(d);
+    backend.barrier();
+  }
+}
+
+AccurateOutput accurateFfd(Backend& backend, const AccurateJob& job, const PackedLattice& lattice, KernelVariant variant,
+                           size_t maxChunk) {
   if (variant.f64 && !backend.info().limits.float64)
     throw deviceError(backend.info().name + " has no double-precision shader support; use --precision float");
   AccurateOutput out;
   auto t0 = std::chrono::steady_clock::now();
   if (job.count() > 0) {
-    if (variant.f64) accurateRun<double>(backend, job, lattice, variant, out);
-    else accurateRun<float>(backend, job, lattice, variant, out);
+    if (variant.f64) accurateRun<double>(backend, job, lattice, variant, maxChunk, out);
+    else accurateRun<float>(backend, job, lattice, variant, maxChunk, out);
   }
   out.wallMs = msSince(t0);
   return out;

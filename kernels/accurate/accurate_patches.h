@@ -75,9 +75,22 @@ struct AccurateOutput {
   double wallMs = 0;
 };
 
-// The kernel on a backend, chunked within the device's binding and group-count limits
-// (SFFD_MAX_CHUNK_PATCHES forces smaller chunks, for tests).
-AccurateOutput accurateFfd(Backend& backend, const AccurateJob& job, const PackedLattice& lattice, KernelVariant variant);
+// The kernel on a backend, chunked within the device's binding and group-count limits (`maxChunk`
+// patches at most when not 0, to test chunking); everything downloaded. sffd::Deformer keeps its
+// output on the device instead (src/pipelines/deformer_accurate.cpp), with the three functions below.
+AccurateOutput accurateFfd(Backend& backend, const AccurateJob& job, const PackedLattice& lattice, KernelVariant variant,
+                           size_t maxChunk = 0);
+
+// A_n^{-1} transposed (sample-major), as the kernel reads it (SFFD_BINDING_ACC_MATRIX).
+std::vector<double> accurateKernelMatrix(int n);
+// Sub-triangles one chunk may hold on the device with reals of `realBytes`; `maxChunk` caps it when not 0.
+size_t accurateChunkPatches(const DeviceLimits& limits, const AccurateJob& job, size_t realBytes, size_t maxChunk);
+// The three dispatches (samples, control points, tessellation) over `count` sub-triangles, each
+// followed by a barrier. The bindings: coefficients, frame, matrix, tessellation basis
+// (tessellationBasis), corners, control points, positions, normals, samples.
+using AccurateBindings = std::vector<BufferBinding>;
+void dispatchAccurateChunk(Backend& backend, const gpu::LatticeParams& lattice, KernelVariant variant, const AccurateJob& job,
+                           size_t count, const AccurateBindings& bindings);
 
 // Per patch its parent, per tessellation vertex its pre-image barycentrics in the parent
 // (sum_i lambda_i lam_i), its position and normal.

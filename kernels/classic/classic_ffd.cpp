@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstdlib>
 
 #include <sffd/error.h>
 #include "kernels/common/cpu_kernel.h"
@@ -12,15 +11,11 @@ namespace sffd {
 namespace {
 
 template <class Real>
-void classicRun(Backend& backend, const Mesh& mesh, const PackedLattice& P, KernelVariant variant, ClassicOutput& out) {
+void classicRun(Backend& backend, const Mesh& mesh, const PackedLattice& P, KernelVariant variant, size_t maxChunk, ClassicOutput& out) {
   const DeviceLimits& lim = backend.info().limits;
   const size_t n = mesh.positions.size();
   const size_t vertexBytes = 4 * sizeof(Real);
-  // Every binding of a chunk stays within the device's storage range and group-count limits.
-  size_t maxByRange = size_t(lim.maxStorageBufferRange / vertexBytes);
-  size_t maxByGroups = size_t(lim.maxWorkGroupCount[0]) * lim.maxWorkGroupCount[1] * SFFD_LOCAL_SIZE;
-  size_t chunk = std::max<size_t>(1, std::min({maxByRange, maxByGroups, std::max<size_t>(n, 1)}));
-  if (const char* forced = std::getenv("SFFD_MAX_CHUNK_VERTICES")) chunk = std::max<size_t>(1, std::min<size_t>(chunk, std::strtoull(forced, nullptr, 10)));
+  const size_t chunk = classicChunkVertices(lim, n, sizeof(Real), maxChunk);
 
   std::vector<Real> frame = convertReals<Real>(P.frame), coeffs = convertReals<Real>(P.coeffs);
   if (coeffs.size() * sizeof(Real) > lim.maxStorageBufferRange)
@@ -46,20 +41,10 @@ void classicRun(Backend& backend, const Mesh& mesh, const PackedLattice& P, Kern
     }
     backend.upload(io[0], 0, pos.data(), count * vertexBytes);
     backend.upload(io[1], 0, nrm.data(), count * vertexBytes);
-    gpu::ClassicParams params;
-    params.lattice = P.params;
-    params.range = {0, uint32_t(count), 0, 0};
-    Dispatch d;
-    d.kernel = "classic_ffd";
-    d.variant = variant;
-    d.params = &params;
-    d.paramsSize = sizeof(params);
-    d.buffers = {{SFFD_BINDING_LATTICE_COEFFS, bCoeffs}, {SFFD_BINDING_LATTICE_FRAME, bFrame},
-                 {SFFD_BINDING_CLASSIC_POS_IN, io[0]}, {SFFD_BINDING_CLASSIC_NRM_IN, io[1]},
-                 {SFFD_BINDING_CLASSIC_POS_OUT, io[2]}, {SFFD_BINDING_CLASSIC_NRM_OUT, io[3]}};
-    gridFor(count, lim, d.groups);
-    backend.dispatch(d);
-    backend.barrier();
+    dispatchClassicFfd(backend, P.params, variant, count,
+                       {{SFFD_BINDING_LATTICE_COEFFS, bCoeffs}, {SFFD_BINDING_LATTICE_FRAME, bFrame},
+                        {SFFD_BINDING_CLASSIC_POS_IN, io[0]}, {SFFD_BINDING_CLASSIC_NRM_IN, io[1]},
+                        {SFFD_BINDING_CLASSIC_POS_OUT, io[2]}, {SFFD_BINDING_CLASSIC_NRM_OUT, io[3]}});
     backend.download(io[2], 0, pos.data(), count * vertexBytes);
     backend.download(io[3], 0, nrm.data(), count * vertexBytes);
     for (size_t i = 0; i < 4 * count; ++i) {
@@ -76,13 +61,39 @@ void classicRun(Backend& backend, const Mesh& mesh, const PackedLattice& P, Kern
 
 }  // namespace
 
-ClassicOutput classicFfd(Backend& backend, const Mesh& mesh, const PackedLattice& lattice, KernelVariant variant) {
+size_t classicChunkVertices(const DeviceLimits& lim, size_t n, size_t realBytes, size_t maxChunk) {
+  // Every binding of a chunk stays within the device's storage range and group-count limits.
+  size_t maxByRange = size_t(lim.maxStorageBufferRange / (4 * realBytes));
+  size_t maxByGroups = size_t(lim.maxWorkGroupCount[0]) * lim.maxWorkGroupCount[1] * SFFD_LOCAL_SIZE;
+  size_t chunk = std::min({maxByRange, maxByGroups, std::max<size_t>(n, 1)});
+  if (maxChunk) chunk = std::min(chunk, maxChunk);
+  return std::max<size_t>(1, chunk);
+}
+
+void dispatchClassicFfd(Backend& backend, const gpu::LatticeParams& lattice, KernelVariant variant, size_t count,
+                        const ClassicBindings& b) {
+  gpu::ClassicParams params;
+  params.lattice = lattice;
+  params.range = {0, uint32_t(count), 0, 0};
+  Dispatch d;
+  d.kernel = "classic_ffd";
+  d.variant = variant;
+  d.params = &params;
+  d.paramsSize = sizeof(params);
+  d.buffers = {b.coeffs, b.frame, b.posIn, b.nrmIn, b.posOut, b.nrmOut};
+  gridFor(count, backend.info().limits, d.groups);
+  backend.dispatch(d);
+  backend.barrier();
+}
+
+ClassicOutput classicFfd(Backend& backend, const Mesh& mesh, const PackedLattice& lattice, KernelVariant variant,
+                         size_t maxChunk) {
   if (variant.f64 && !backend.info().limits.float64)
     throw deviceError(backend.info().name + " has no double-precision shader support; use --precision float");
   ClassicOutput out;
   auto t0 = std::chrono::steady_clock::now();
-  if (variant.f64) classicRun<double>(backend, mesh, lattice, variant, out);
-  else classicRun<float>(backend, mesh, lattice, variant, out);
+  if (variant.f64) classicRun<double>(backend, mesh, lattice, variant, maxChunk, out);
+  else classicRun<float>(backend, mesh, lattice, variant, maxChunk, out);
   out.wallMs = msSince(t0);
   return out;
 }

@@ -19,8 +19,22 @@ struct ClassicOutput {
   double wallMs = 0;
 };
 
-// The kernel on a backend, chunked within the device's binding and group-count limits.
-ClassicOutput classicFfd(Backend& backend, const Mesh& mesh, const PackedLattice& lattice, KernelVariant variant);
+// The kernel on a backend, chunked within the device's binding and group-count limits (`maxChunk`
+// vertices at most when not 0, to test chunking); everything downloaded. sffd::Deformer keeps its
+// output on the device instead (src/pipelines/deformer_classic.cpp), with the two functions below.
+ClassicOutput classicFfd(Backend& backend, const Mesh& mesh, const PackedLattice& lattice, KernelVariant variant,
+                         size_t maxChunk = 0);
+
+// Vertices one dispatch may cover on the device with reals of `realBytes`; `maxChunk` caps it when not 0.
+size_t classicChunkVertices(const DeviceLimits& limits, size_t vertices, size_t realBytes, size_t maxChunk);
+
+// One dispatch of the kernel over `count` vertices (4 reals each: positions with w = 1, normals w = 0),
+// followed by a barrier.
+struct ClassicBindings {
+  BufferBinding coeffs, frame, posIn, nrmIn, posOut, nrmOut;
+};
+void dispatchClassicFfd(Backend& backend, const gpu::LatticeParams& lattice, KernelVariant variant, size_t count,
+                        const ClassicBindings& bindings);
 
 struct CpuKernelArgs;
 namespace cpu {

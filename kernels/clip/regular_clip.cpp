@@ -179,7 +179,7 @@ namespace {
 
 template <class Real>
 SubTriangleRecords clipRun(Backend& backend, const PreparedMesh& M, const PnOutput& pn, const ClipTriangles& clip,
-                           double l, KernelVariant variant) {
+                           double l, KernelVariant variant, size_t maxChunk) {
   const DeviceLimits& lim = backend.info().limits;
   const PackedTable& T = packedTable();
   PackedClip pc = packClip(clip);
@@ -241,7 +241,7 @@ SubTriangleRecords clipRun(Backend& backend, const PreparedMesh& M, const PnOutp
   R.records.resize(total * SFFD_SUB_STRIDE * 4);
   const uint64_t recordBytes = SFFD_SUB_STRIDE * 4 * sizeof(Real);
   uint64_t maxSubs = lim.maxStorageBufferRange / recordBytes;
-  if (const char* forced = std::getenv("SFFD_MAX_CHUNK_SUBTRIANGLES")) maxSubs = std::min<uint64_t>(maxSubs, std::strtoull(forced, nullptr, 10));
+  if (maxChunk) maxSubs = std::min<uint64_t>(maxSubs, maxChunk);
   maxSubs = std::max<uint64_t>(maxSubs, 1);
   uint64_t largest = 0;
   for (uint32_t c : counts) largest = std::max<uint64_t>(largest, c);
@@ -277,12 +277,12 @@ SubTriangleRecords clipRun(Backend& backend, const PreparedMesh& M, const PnOutp
 }  // namespace
 
 SubTriangleRecords regularClip(Backend& backend, const PreparedMesh& mesh, const PnOutput& pn,
-                               const ClipTriangles& clip, double l, KernelVariant variant) {
+                               const ClipTriangles& clip, double l, KernelVariant variant, size_t maxChunk) {
   if (variant.f64 && !backend.info().limits.float64)
     throw deviceError(backend.info().name + " has no double-precision shader support; use --precision float");
   auto t0 = std::chrono::steady_clock::now();
-  SubTriangleRecords R = variant.f64 ? clipRun<double>(backend, mesh, pn, clip, l, variant)
-                                     : clipRun<float>(backend, mesh, pn, clip, l, variant);
+  SubTriangleRecords R = variant.f64 ? clipRun<double>(backend, mesh, pn, clip, l, variant, maxChunk)
+                                     : clipRun<float>(backend, mesh, pn, clip, l, variant, maxChunk);
   R.wallMs = msSince(t0);
   return R;
 }

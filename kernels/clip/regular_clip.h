@@ -43,8 +43,9 @@ struct SubTriangleRecords {
 };
 
 // Regular clipping on a backend: clip_count, the exclusive scan on the host, clip_write in chunks.
+// `maxChunk` (not 0) caps the sub-triangles of one chunk, to test chunking.
 SubTriangleRecords regularClip(Backend& backend, const PreparedMesh& mesh, const PnOutput& pn, const ClipTriangles& clip,
-                               double l, KernelVariant variant);
+                               double l, KernelVariant variant, size_t maxChunk = 0);
 
 // Records of sub-triangles given by their parent sites (knot-box clipping), on the host (clip_sites.h).
 SubTriangleRecords recordsFromSubTriangles(const PreparedMesh& mesh, const PnOutput& pn,

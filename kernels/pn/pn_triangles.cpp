@@ -53,7 +53,7 @@ void pnThreads(const CpuKernelArgs& a, uint64_t first, uint64_t last) {
 }
 
 template <class Real>
-void pnRun(Backend& backend, const PreparedMesh& M, KernelVariant variant, PnOutput& out) {
+void pnRun(Backend& backend, const PreparedMesh& M, KernelVariant variant, size_t maxChunk, PnOutput& out) {
   const DeviceLimits& lim = backend.info().limits;
   const size_t nt = M.triangleCount(), nv = M.positions.size() / 4;
   const uint64_t vertexBytes = nv * 4 * sizeof(Real);
@@ -64,7 +64,7 @@ void pnRun(Backend& backend, const PreparedMesh& M, KernelVariant variant, PnOut
   const size_t perTriangle = SFFD_PN_STRIDE * 4 * sizeof(Real);
   size_t chunk = size_t(lim.maxStorageBufferRange / perTriangle);
   chunk = std::min<size_t>(chunk, size_t(lim.maxWorkGroupCount[0]) * lim.maxWorkGroupCount[1] * SFFD_LOCAL_SIZE);
-  if (const char* forced = std::getenv("SFFD_MAX_CHUNK_TRIANGLES")) chunk = std::min<size_t>(chunk, std::strtoull(forced, nullptr, 10));
+  if (maxChunk) chunk = std::min(chunk, maxChunk);
   chunk = std::max<size_t>(1, std::min(chunk, std::max<size_t>(nt, 1)));
 
   std::vector<Real> pos = convertReals<Real>(M.positions), nrm = convertReals<Real>(M.normals);
@@ -106,14 +106,14 @@ void pnRun(Backend& backend, const PreparedMesh& M, KernelVariant variant, PnOut
 
 }  // namespace
 
-PnOutput pnTriangles(Backend& backend, const PreparedMesh& mesh, KernelVariant variant) {
+PnOutput pnTriangles(Backend& backend, const PreparedMesh& mesh, KernelVariant variant, size_t maxChunk) {
   if (variant.f64 && !backend.info().limits.float64)
     throw deviceError(backend.info().name + " has no double-precision shader support; use --precision float");
   PnOutput out;
   auto t0 = std::chrono::steady_clock::now();
   if (mesh.triangleCount() > 0) {
-    if (variant.f64) pnRun<double>(backend, mesh, variant, out);
-    else pnRun<float>(backend, mesh, variant, out);
+    if (variant.f64) pnRun<double>(backend, mesh, variant, maxChunk, out);
+    else pnRun<float>(backend, mesh, variant, maxChunk, out);
   }
   out.wallMs = msSince(t0);
   return out;

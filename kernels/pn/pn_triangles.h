@@ -15,7 +15,8 @@ struct PnOutput {
   double wallMs = 0;
 };
 
-PnOutput pnTriangles(Backend& backend, const PreparedMesh& mesh, KernelVariant variant);
+// `maxChunk` (not 0) caps the triangles of one dispatch, to test chunking.
+PnOutput pnTriangles(Backend& backend, const PreparedMesh& mesh, KernelVariant variant, size_t maxChunk = 0);
 
 struct CpuKernelArgs;
 namespace cpu {

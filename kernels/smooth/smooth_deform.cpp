@@ -37,7 +37,7 @@ namespace {
 
 template <class Real>
 void deformRun(Backend& backend, const PackedLattice& P, const SubTriangleRecords& subs, const FitTable& F, int level,
-               KernelVariant variant, bool split, SmoothOutput& out) {
+               KernelVariant variant, bool split, size_t maxChunk, SmoothOutput& out) {
   const DeviceLimits& lim = backend.info().limits;
   const size_t n = subs.size(), nv = size_t(tessVertexCount(level));
   const size_t recReals = SFFD_SUB_STRIDE * 4, patchReals = SFFD_PATCH_STRIDE * 4, tessReals = 2 * nv * 4;
@@ -45,7 +45,7 @@ void deformRun(Backend& backend, const PackedLattice& P, const SubTriangleRecord
   // Chunks of sub-triangles whose every per-sub-triangle buffer fits one binding.
   size_t chunk = size_t(lim.maxStorageBufferRange / (std::max({recReals, patchReals, tessReals, sampleReals}) * sizeof(Real)));
   chunk = std::min<size_t>(chunk, size_t(lim.maxWorkGroupCount[0]) * lim.maxWorkGroupCount[1] * SFFD_LOCAL_SIZE);
-  if (const char* forced = std::getenv("SFFD_MAX_CHUNK_SUBTRIANGLES")) chunk = std::min<size_t>(chunk, std::strtoull(forced, nullptr, 10));
+  if (maxChunk) chunk = std::min(chunk, maxChunk);
   chunk = std::max<size_t>(1, std::min(chunk, std::max<size_t>(n, 1)));
   std::vector<Real> frame = convertReals<Real>(P.frame), coeffs = convertReals<Real>(P.coeffs), fit = convertReals<Real>(F.data);
   auto make = [&](const void* data, size_t bytes) {
@@ -84,15 +84,15 @@ void deformRun(Backend& backend, const PackedLattice& P, const SubTriangleRecord
 }  // namespace
 
 SmoothOutput smoothDeform(Backend& backend, const PackedLattice& lattice, const SubTriangleRecords& subs,
-                          const FitTable& fit, int level, KernelVariant variant, bool split) {
+                          const FitTable& fit, int level, KernelVariant variant, bool split, size_t maxChunk) {
   if (variant.f64 && !backend.info().limits.float64)
     throw deviceError(backend.info().name + " has no double-precision shader support; use --precision float");
   SmoothOutput out;
   out.level = level;
   auto t0 = std::chrono::steady_clock::now();
   if (subs.size()) {
-    if (variant.f64) deformRun<double>(backend, lattice, subs, fit, level, variant, split, out);
-    else deformRun<float>(backend, lattice, subs, fit, level, variant, split, out);
+    if (variant.f64) deformRun<double>(backend, lattice, subs, fit, level, variant, split, maxChunk, out);
+    else deformRun<float>(backend, lattice, subs, fit, level, variant, split, maxChunk, out);
   }
   out.wallMs = msSince(t0);
   return out;

@@ -33,8 +33,9 @@ struct SmoothOutput {
 // The deform stage on a backend, chunked within its limits. split: one dispatch per step (deform.sample:
 // steps 1, 2, 4; deform.fit: 3; deform.adjust: 5; deform.tessellate: 6), for per-step timings; the same
 // output as the fused kernel.
+// `maxChunk` (not 0) caps the sub-triangles of one chunk, to test chunking.
 SmoothOutput smoothDeform(Backend& backend, const PackedLattice& lattice, const SubTriangleRecords& subs,
-                          const FitTable& fit, int level, KernelVariant variant, bool split = false);
+                          const FitTable& fit, int level, KernelVariant variant, bool split = false, size_t maxChunk = 0);
 
 // The deform stage's dispatches over `count` sub-triangles (params.range set by the caller): the
 // fused kernel, or with `split` the four step kernels (`samples` then holds their intermediate data).

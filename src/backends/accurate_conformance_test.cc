@@ -114,9 +114,7 @@ TEST_P(AccurateConformance, ChunkedJobEqualsOneDispatch) {
   PackedLattice P = packLattice(L);
   AccurateJob job = makeAccurateJob(mesh, L, clipAgainstKnotBoxes(mesh, L), 10);
   AccurateOutput whole = accurateFfd(*b.backend, job, P, {true, false});
-  setenv("SFFD_MAX_CHUNK_PATCHES", "97", 1);   // many chunks, the last one partial
-  AccurateOutput chunked = accurateFfd(*b.backend, job, P, {true, false});
-  unsetenv("SFFD_MAX_CHUNK_PATCHES");
+  AccurateOutput chunked = accurateFfd(*b.backend, job, P, {true, false}, 97);   // many chunks, the last one partial
   EXPECT_EQ(whole.controlPoints, chunked.controlPoints);
   EXPECT_EQ(whole.positions, chunked.positions);
   EXPECT_EQ(whole.normals, chunked.normals);

@@ -90,9 +90,7 @@ TEST_P(ClassicConformance, ChunkedJobEqualsOneDispatch) {
   Mesh mesh = sphereMesh(30, 50, 0.9);
   PackedLattice P = packLattice(deformedLattice(OutsideMode::Extrapolate));
   ClassicOutput whole = classicFfd(*b.backend, mesh, P, {true, false});
-  setenv("SFFD_MAX_CHUNK_VERTICES", "97", 1);   // many small chunks, last one partial
-  ClassicOutput chunked = classicFfd(*b.backend, mesh, P, {true, false});
-  unsetenv("SFFD_MAX_CHUNK_VERTICES");
+  ClassicOutput chunked = classicFfd(*b.backend, mesh, P, {true, false}, 97);   // many small chunks, last one partial
   EXPECT_EQ(whole.positions, chunked.positions);
   EXPECT_EQ(whole.normals, chunked.normals);
 }
@@ -120,9 +118,8 @@ TEST_P(ClassicConformance, PnKernelAgreesWithCpuReference) {
     EXPECT_EQ(fast.mismatched, 0u) << "fast float: max_abs " << fast.maxAbs << " max_ulp " << fast.maxUlp;
     CompareResult strict = compareBuffers(pnTriangles(*b.backend, P, {true, false}).records, cpuFloat.records, true, {true, 0, 0});
     EXPECT_EQ(strict.mismatched, 0u) << "strict float: max_abs " << strict.maxAbs << " max_ulp " << strict.maxUlp;
-    setenv("SFFD_MAX_CHUNK_TRIANGLES", "1000", 1);   // several chunks, the last one partial
-    CompareResult chunked = compareBuffers(pnTriangles(*b.backend, P, {true, false}).records, cpuFloat.records, true, {true, 0, 0});
-    unsetenv("SFFD_MAX_CHUNK_TRIANGLES");
+    // Several chunks, the last one partial.
+    CompareResult chunked = compareBuffers(pnTriangles(*b.backend, P, {true, false}, 1000).records, cpuFloat.records, true, {true, 0, 0});
     EXPECT_EQ(chunked.mismatched, 0u);
     if (b.info.limits.float64) {
       CompareResult d = compareBuffers(pnTriangles(*b.backend, P, {true, true}).records, cpuDouble.records, false, {true, 0, 0});
@@ -150,9 +147,7 @@ TEST_P(ClassicConformance, ClipKernelsAgreeWithCpuReference) {
     }
     // Written in several chunks, the output is the same.
     PnOutput pn = pnTriangles(sffd::testing::cpuBackend(), P, {true, false});
-    setenv("SFFD_MAX_CHUNK_SUBTRIANGLES", "777", 1);
-    SubTriangleRecords chunked = regularClip(*b.backend, P, pn, C, l, {true, false});
-    unsetenv("SFFD_MAX_CHUNK_SUBTRIANGLES");
+    SubTriangleRecords chunked = regularClip(*b.backend, P, pn, C, l, {true, false}, 777);
     EXPECT_EQ(chunked.records, regularClip(sffd::testing::cpuBackend(), P, pn, C, l, {true, false}).records);
   }
   EXPECT_EQ(vk::validationMessageCount(), 0u);
@@ -180,9 +175,7 @@ TEST_P(ClassicConformance, SmoothDeformKernelAgreesWithCpuReference) {
   EXPECT_EQ(split.patches, cpu.patches);
   EXPECT_EQ(split.tess, cpu.tess);
   EXPECT_EQ(split.timings.size(), 4u);
-  setenv("SFFD_MAX_CHUNK_SUBTRIANGLES", "50", 1);
-  SmoothOutput chunked = smoothDeform(*b.backend, L, subs, fit, 10, {true, false});
-  unsetenv("SFFD_MAX_CHUNK_SUBTRIANGLES");
+  SmoothOutput chunked = smoothDeform(*b.backend, L, subs, fit, 10, {true, false}, false, 50);
   EXPECT_EQ(chunked.tess, cpu.tess);
   EXPECT_EQ(vk::validationMessageCount(), 0u);
 }

@@ -43,8 +43,9 @@ uint64_t meshBytes(const Mesh& m, bool withPatches) {
   return b;
 }
 
-// Parses "123", "4K", "1.5G" (powers of 1024); 0 when it does not parse.
-uint64_t parseBytes(const char* s) {
+}  // namespace
+
+uint64_t parseByteSize(const char* s) {
   char* end = nullptr;
   double v = std::strtod(s, &end);
   if (end == s || !std::isfinite(v) || v <= 0) return 0;
@@ -62,7 +63,12 @@ uint64_t parseBytes(const char* s) {
   return bytes >= 1.8e19 ? UINT64_MAX : uint64_t(bytes);
 }
 
-}  // namespace
+double estimateSubTriangles(const Mesh& mesh, double l) {
+  double area = 0;
+  for (const auto& t : mesh.triangles)
+    area += 0.5 * glm::length(glm::cross(mesh.positions[t[1]] - mesh.positions[t[0]], mesh.positions[t[2]] - mesh.positions[t[0]]));
+  return area / (std::sqrt(3.0) / 4 * l * l) + double(mesh.triangles.size());
+}
 
 std::string formatBytes(uint64_t bytes) {
   static const char* units[] = {"bytes", "KiB", "MiB", "GiB", "TiB"};
@@ -95,18 +101,14 @@ JobEstimate estimateClassicJob(const Mesh& mesh, const PackedLattice& P, size_t 
                   + (1u << 20);                  // the writer's buffer
   if (limits) {
     host += 2 * vertexBytes * e.chunkVertices;    // upload/download staging of one chunk
-    e.deviceBytes = lattice + 4 * vertexBytes * e.chunkVertices;
+    e.deviceBytes = lattice + 4 * vertexBytes * n;   // every chunk's inputs and outputs stay on the device
   }
   e.hostBytes = host;
   return e;
 }
 
-uint64_t hostMemoryLimit() {
-  if (const char* s = std::getenv("SFFD_MEMORY_LIMIT"); s && *s) {
-    uint64_t v = parseBytes(s);
-    if (v == 0) throw Error(ErrorKind::Input, std::string("SFFD_MEMORY_LIMIT must be a size like 4096, 512M or 2G, not '") + s + "'");
-    return v;
-  }
+uint64_t hostMemoryLimit(uint64_t requested) {
+  if (requested) return requested;
   uint64_t limit = 0;
   long pages = ::sysconf(_SC_PHYS_PAGES), pageSize = ::sysconf(_SC_PAGE_SIZE);
   if (pages > 0 && pageSize > 0) limit = uint64_t(pages) * uint64_t(pageSize);
@@ -115,17 +117,18 @@ uint64_t hostMemoryLimit() {
     std::ifstream in(f);
     std::string text;
     if (!(in >> text) || text == "max") continue;
-    uint64_t v = parseBytes(text.c_str());
+    uint64_t v = parseByteSize(text.c_str());
     if (v > 0 && (limit == 0 || v < limit)) limit = v;
   }
   return limit;
 }
 
-void checkJobFits(const JobEstimate& e, const PackedLattice& P, size_t realBytes, const DeviceLimits* limits) {
-  const uint64_t limit = hostMemoryLimit();
+void checkJobFits(const JobEstimate& e, const PackedLattice& P, size_t realBytes, const DeviceLimits* limits,
+                  uint64_t memoryLimit, const char* limitName) {
+  const uint64_t limit = hostMemoryLimit(memoryLimit);
   if (limit > 0 && e.hostBytes > limit)
     throw Error(ErrorKind::Input, "the job needs about " + formatBytes(e.hostBytes) + " of host memory, more than the limit of " +
-                                      formatBytes(limit) + (std::getenv("SFFD_MEMORY_LIMIT") ? " (SFFD_MEMORY_LIMIT)" : " (physical memory)") +
+                                      formatBytes(limit) + (memoryLimit ? " (" + std::string(limitName) + ")" : std::string(" (physical memory)")) +
                                       "; use a smaller mesh or split it");
   if (limits) {
     uint64_t coeffBytes = P.coeffs.size() * uint64_t(realBytes);

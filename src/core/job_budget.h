@@ -28,19 +28,29 @@ struct JobEstimate {
   uint64_t chunks = 0;
 };
 
+// Smooth FFD with target edge length l splits a mesh into about area / (sqrt(3)/4 l^2) sub-triangles,
+// and at least one a triangle; jobs above kMaxSubTriangles are refused.
+constexpr double kMaxSubTriangles = 50e6;
+double estimateSubTriangles(const Mesh& mesh, double l);
+
 // Estimate for `deform --method classic`: the input mesh, the kernel outputs widened to double, the
-// deformed copy, the writer's position index; on a GPU the lattice buffers and four chunk buffers of
-// realBytes * 4 per vertex, chunked as classicFfdGpu does. `limits` null: the CPU reference.
+// deformed copy, the writer's position index; on a GPU the lattice buffers and, kept on the device by
+// sffd::Deformer, every vertex's position and normal in and out (realBytes * 4 each), chunked as
+// classicChunkVertices does. `limits` null: the CPU reference.
 JobEstimate estimateClassicJob(const Mesh& mesh, const PackedLattice& lattice, size_t realBytes, const DeviceLimits* limits);
 
-// The host memory a job may use: SFFD_MEMORY_LIMIT (bytes, or with a K, M, G or T suffix) when set,
-// else the machine's physical memory. 0 when neither is known (no limit).
-uint64_t hostMemoryLimit();
+// "123", "4K", "1.5G", "2GB" (powers of 1024) as bytes; 0 when it does not parse.
+uint64_t parseByteSize(const char* text);
 
-// Throws an input Error ("... needs about X of host memory, more than the limit of Y ...") when the job
-// cannot fit: host bytes above hostMemoryLimit(), or one unchunkable buffer (the lattice coefficients)
-// above the device's storage-binding range.
-void checkJobFits(const JobEstimate& estimate, const PackedLattice& lattice, size_t realBytes, const DeviceLimits* limits);
+// The host memory a job may use: `requested` when not 0, else the machine's physical memory (or the
+// container's limit when lower). 0 when neither is known (no limit).
+uint64_t hostMemoryLimit(uint64_t requested);
+
+// Throws an input Error ("... needs about X of host memory, more than the limit of Y (NAME)") when the
+// job cannot fit: host bytes above hostMemoryLimit(memoryLimit), or one unchunkable buffer (the lattice
+// coefficients) above the device's storage-binding range. `limitName` names a memoryLimit given.
+void checkJobFits(const JobEstimate& estimate, const PackedLattice& lattice, size_t realBytes, const DeviceLimits* limits,
+                  uint64_t memoryLimit, const char* limitName = "memoryLimit");
 
 // "1.50 GiB" style.
 std::string formatBytes(uint64_t bytes);

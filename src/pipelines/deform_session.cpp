@@ -7,7 +7,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdlib>
 #include <cstring>
 
 #include <sffd/error.h>
@@ -19,35 +18,9 @@
 #include "model/prepared_mesh.h"
 #include "kernels/clip/split_pattern_table.h"
 #include "core/wall_clock.h"
+#include "pipelines/device_reals.h"
 
 namespace sffd {
-namespace {
-
-// The reals of a host array in the kernel's storage type, as bytes.
-std::vector<unsigned char> realBytes(const std::vector<double>& v, bool f64) {
-  std::vector<unsigned char> out(v.size() * (f64 ? 8 : 4));
-  if (f64) std::memcpy(out.data(), v.data(), out.size());
-  else
-    for (size_t i = 0; i < v.size(); ++i) {
-      float f = float(v[i]);
-      std::memcpy(&out[4 * i], &f, 4);
-    }
-  return out;
-}
-
-std::vector<double> doublesOf(const std::vector<unsigned char>& bytes, bool f64) {
-  std::vector<double> out(bytes.size() / (f64 ? 8 : 4));
-  if (f64) std::memcpy(out.data(), bytes.data(), out.size() * 8);
-  else
-    for (size_t i = 0; i < out.size(); ++i) {
-      float f;
-      std::memcpy(&f, &bytes[4 * i], 4);
-      out[i] = f;
-    }
-  return out;
-}
-
-}  // namespace
 
 struct DeformSession::Impl {
   Lattice structure;            // degrees, counts, knots, frame of the session's lattice
@@ -75,8 +48,21 @@ struct DeformSession::Impl {
   }
 };
 
-DeformSession::DeformSession(Backend& backend, const Mesh& input, const Lattice& lattice, const DeformSessionOptions& options)
+DeformSession::DeformSession(Backend& backend, const Mesh& input, const Lattice& lattice, const DeformSessionOptions& options,
+                             const StageProgress& progress)
     : backend_(backend), options_(options), impl_(std::make_unique<Impl>()) {
+  try {
+    prepare(input, lattice, progress);
+  } catch (...) {
+    for (BufferId b : impl_->owned) backend_.destroyBuffer(b);   // the destructor does not run
+    throw;
+  }
+}
+
+void DeformSession::prepare(const Mesh& input, const Lattice& lattice, const StageProgress& progress) {
+  Backend& backend = backend_;
+  const DeformSessionOptions& options = options_;
+  if (progress) progress("prepare", 0);
   if (!(options.edgeLength > 0) || !std::isfinite(options.edgeLength))
     throw Error(ErrorKind::Input, "the edge length must be a finite number > 0");
   if (options.level < 1 || options.level > 64) throw Error(ErrorKind::Input, "the tessellation level must be 1..64");
@@ -127,7 +113,7 @@ DeformSession::DeformSession(Backend& backend, const Mesh& input, const Lattice&
   I.frame = up(packed.frame);
   I.coeffs = up(packed.coeffs);
   I.fitBuf = up(I.fit.data);
-  precompute();
+  precompute(progress);
 }
 
 DeformSession::~DeformSession() {
@@ -149,7 +135,7 @@ void sumStages(SessionTimings& t) {
 
 }  // namespace
 
-const SessionTimings& DeformSession::precompute() {
+const SessionTimings& DeformSession::precompute(const StageProgress& progress) {
   Impl& I = *impl_;
   Backend& B = backend_;
   const DeviceLimits& lim = B.info().limits;
@@ -186,6 +172,7 @@ const SessionTimings& DeformSession::precompute() {
     b.insert(b.end(), extra.begin(), extra.end());
     return b;
   };
+  if (progress) progress("pn", 0.1);
   if (nt) {
     gpu::PnParams params;
     params.range = {0, uint32_t(nt), 0, 0};
@@ -199,12 +186,13 @@ const SessionTimings& DeformSession::precompute() {
                  patchBytes = SFFD_PATCH_STRIDE * 16 * (I.realSize / 4),
                  sampleBytes = (SFFD_SAMPLE_FIXED + uint64_t(I.fit.points)) * 16 * (I.realSize / 4);
   uint64_t maxSubs = lim.maxStorageBufferRange / std::max({recordBytes, tessBytes, patchBytes, sampleBytes});
-  if (const char* forced = std::getenv("SFFD_MAX_CHUNK_SUBTRIANGLES")) maxSubs = std::min<uint64_t>(maxSubs, std::strtoull(forced, nullptr, 10));
+  if (options_.maxChunkSubTriangles) maxSubs = std::min<uint64_t>(maxSubs, options_.maxChunkSubTriangles);
   maxSubs = std::max<uint64_t>(maxSubs, 1);
 
   std::vector<uint64_t> offsets;   // per clip triangle (regular) exclusive scan of the counts
   SubTriangleRecords knotRecords;
   size_t clipN = 0;
+  if (progress) progress("clip", 0.2);
   if (!options_.knotBoxClip) {
     clipN = I.clip.triangles.size();
     gpu::ClipParams params = clipParams(0, clipN);
@@ -287,6 +275,7 @@ const SessionTimings& DeformSession::precompute() {
       std::vector<unsigned char> b = realBytes(part, options_.variant.f64);
       B.upload(cb.records, 0, b.data(), b.size());
     }
+    if (progress) progress("clip", 0.2 + 0.8 * double(ci + 1) / double(plan.size() + 1));
   }
   if (options_.split && !chunks_.empty()) {
     size_t largest = 0;
@@ -305,7 +294,7 @@ const SessionTimings& DeformSession::precompute() {
   return timings_;
 }
 
-const SessionTimings& DeformSession::deform(const Lattice& lattice) {
+const SessionTimings& DeformSession::deform(const Lattice& lattice, const StageProgress& progress) {
   Impl& I = *impl_;
   Backend& B = backend_;
   if (!sameLatticeStructure(lattice, I.structure))
@@ -324,6 +313,7 @@ const SessionTimings& DeformSession::deform(const Lattice& lattice) {
                    {I.coeffs, I.frame, I.fitBuf, I.chunkBuffers[ci].headers, I.chunkBuffers[ci].records, c.patches, c.tess,
                     options_.split ? I.samples : 0},
                    c.count, options_.variant, options_.split);
+    if (progress) progress("deform", double(ci + 1) / double(chunks_.size() + 1));
   }
   B.finish();
   timings_.dispatches = B.takeTimings();

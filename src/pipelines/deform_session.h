@@ -9,6 +9,7 @@
 //   s.deform(lattice);                          // after every lattice edit
 //   for (const DeformSession::Chunk& c : s.chunks()) draw(c.tess, c.count);
 #pragma once
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -29,7 +30,12 @@ struct DeformSessionOptions {
   bool knotBoxClip = false;    // the 2015 clipping (computed on the CPU, records uploaded once)
   bool split = false;          // deform as four dispatches (per-step timings) instead of the fused kernel
   double creaseAngleDeg = 40;  // for a mesh without normals: dihedral angle above which an edge is a crease
+  size_t maxChunkSubTriangles = 0;   // 0: chunks as large as the device allows (smaller only to test chunking)
 };
+
+// Told the stage and the fraction of the call done, at stage boundaries and after each chunk; it may
+// throw (a cancelled Deformer), and the session stays usable for another precompute() or deform().
+using StageProgress = std::function<void(const char* stage, double fraction)>;
 
 // Times of the last precompute() or deform(): GPU time where the device measures it, else wall time.
 struct SessionTimings {
@@ -43,16 +49,17 @@ class DeformSession {
   // Prepares the mesh (topology, creases from its normals, clip triangles) and runs precompute().
   // The lattice fixes the degrees, counts, knots and box that later deform() calls must keep.
   // Throws an input Error for bad options and a device Error when the device refuses the work.
-  DeformSession(Backend& backend, const Mesh& mesh, const Lattice& lattice, const DeformSessionOptions& options);
+  DeformSession(Backend& backend, const Mesh& mesh, const Lattice& lattice, const DeformSessionOptions& options,
+                const StageProgress& progress = {});
   ~DeformSession();
   DeformSession(const DeformSession&) = delete;
   DeformSession& operator=(const DeformSession&) = delete;
 
   // Runs the pre-compute stage again (PN triangles and clipping; the records stay on the device).
-  const SessionTimings& precompute();
+  const SessionTimings& precompute(const StageProgress& progress = {});
   // Deforms with the lattice's current control points into the chunks' buffers (undefined before the
   // first call); an input Error if the lattice's structure differs from the session's.
-  const SessionTimings& deform(const Lattice& lattice);
+  const SessionTimings& deform(const Lattice& lattice, const StageProgress& progress = {});
   const SessionTimings& timings() const { return timings_; }
 
   // Sub-triangles in groups whose buffers each fit one storage binding. Tessellation buffer layout
@@ -74,6 +81,7 @@ class DeformSession {
   SmoothOutput output();
 
  private:
+  void prepare(const Mesh& mesh, const Lattice& lattice, const StageProgress& progress);
   struct Impl;
   Backend& backend_;
   DeformSessionOptions options_;

@@ -95,14 +95,14 @@ TEST_P(DeformSessionTest, ChunkedSplitAndKnotBoxSessionsEqualCpuReference) {
   o.edgeLength = 0.3;
   o.level = 3;
   Reference ra = reference(m, A, o);
-  setenv("SFFD_MAX_CHUNK_SUBTRIANGLES", "97", 1);
+  o.maxChunkSubTriangles = 97;
   {
     DeformSession s(*b.backend, m, A, o);
     EXPECT_GT(s.chunks().size(), 2u);
     s.deform(A);
     EXPECT_EQ(s.output().tess, ra.out.tess);
   }
-  unsetenv("SFFD_MAX_CHUNK_SUBTRIANGLES");
+  o.maxChunkSubTriangles = 0;
   o.split = true;
   {
     DeformSession s(*b.backend, m, A, o);

@@ -1,0 +1,270 @@
+// sffd::Deformer through the public headers only, on every device there is (the required GPU
+// backends, and the CPU reference): every method, strict results equal across devices, re-deforming,
+// refusals, views of the caller's arrays, cancelling, chunking. Meshes are made here.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+
+#include <sffd/sffd.h>
+
+#include "backends/backend_test_support.h"
+
+namespace {
+
+using namespace sffd;
+
+// An icosphere of radius 1: the icosahedron with every triangle split in four `levels` times.
+Mesh icosphere(int levels) {
+  const double t = (1 + std::sqrt(5.0)) / 2;
+  std::vector<double> xyz = {-1, t, 0, 1, t, 0, -1, -t, 0, 1, -t, 0, 0, -1, t, 0, 1, t,
+                             0, -1, -t, 0, 1, -t, t, 0, -1, t, 0, 1, -t, 0, -1, -t, 0, 1};
+  std::vector<uint32_t> tri = {0, 11, 5, 0, 5, 1, 0, 1, 7, 0, 7, 10, 0, 10, 11, 1, 5, 9, 5, 11, 4, 11, 10, 2, 10, 7, 6, 7, 1, 8,
+                               3, 9, 4, 3, 4, 2, 3, 2, 6, 3, 6, 8, 3, 8, 9, 4, 9, 5, 2, 4, 11, 6, 2, 10, 8, 6, 7, 9, 8, 1};
+  for (int l = 0; l < levels; ++l) {
+    std::map<std::pair<uint32_t, uint32_t>, uint32_t> mid;
+    auto middle = [&](uint32_t a, uint32_t b) {
+      auto key = std::minmax(a, b);
+      auto it = mid.find(key);
+      if (it != mid.end()) return it->second;
+      for (int c = 0; c < 3; ++c) xyz.push_back((xyz[3 * a + c] + xyz[3 * b + c]) / 2);
+      return mid[key] = uint32_t(xyz.size() / 3 - 1);
+    };
+    std::vector<uint32_t> next;
+    for (size_t i = 0; i < tri.size(); i += 3) {
+      uint32_t a = tri[i], b = tri[i + 1], c = tri[i + 2], ab = middle(a, b), bc = middle(b, c), ca = middle(c, a);
+      next.insert(next.end(), {a, ab, ca, b, bc, ab, c, ca, bc, ab, bc, ca});
+    }
+    tri = next;
+  }
+  for (size_t v = 0; v < xyz.size(); v += 3) {
+    double n = std::sqrt(xyz[v] * xyz[v] + xyz[v + 1] * xyz[v + 1] + xyz[v + 2] * xyz[v + 2]);
+    for (int c = 0; c < 3; ++c) xyz[v + c] /= n;
+  }
+  MeshView view;
+  view.positions = xyz.data();
+  view.vertexCount = xyz.size() / 3;
+  view.triangles = tri.data();
+  view.triangleCount = tri.size() / 3;
+  return meshFromView(view);
+}
+
+// The devices there are: the required GPU backends (skipped when absent) and the CPU reference.
+std::vector<std::string> deviceNames() {
+  std::vector<std::string> names = sffd::testing::requiredBackends();
+  names.push_back("cpu");
+  return names;
+}
+
+Device openDevice(const std::string& name) {
+  DeviceRequest r;
+  r.name = name;
+  r.validation = true;
+  return Device::open(r);
+}
+
+Lattice twisted(const Mesh& mesh, double amount) {
+  Lattice L = fitLattice(mesh, {4, 5, 5}, {2, 2, 3});
+  applyLatticePreset(L, "twist", amount);
+  return L;
+}
+
+DeformOptions strictOptions(Method method) {
+  DeformOptions o;
+  o.method = method;
+  o.strict = true;
+  o.precision = Precision::Float;   // every device has it
+  o.tess = 3;
+  o.edgeLength = 0.4;
+  return o;
+}
+
+// Bit-for-bit equality of two meshes' vertices, normals and triangles.
+void expectSameBits(const Mesh& a, const Mesh& b, const std::string& what) {
+  ASSERT_EQ(a.positions.size(), b.positions.size()) << what;
+  ASSERT_EQ(a.triangles.size(), b.triangles.size()) << what;
+  EXPECT_EQ(std::memcmp(a.positions.data(), b.positions.data(), a.positions.size() * sizeof(glm::dvec3)), 0) << what;
+  EXPECT_EQ(std::memcmp(a.normals.data(), b.normals.data(), a.normals.size() * sizeof(glm::dvec3)), 0) << what;
+  EXPECT_EQ(a.triangles, b.triangles) << what;
+}
+
+const Method kMethods[] = {Method::Smooth, Method::Accurate, Method::Classic};
+const char* nameOf(Method m) { return m == Method::Smooth ? "smooth" : m == Method::Accurate ? "accurate" : "classic"; }
+
+TEST(Deformer, EveryMethodOnEveryDeviceGivesTheCpuReferenceBits) {
+  const Mesh mesh = icosphere(2);
+  const Lattice lattice = twisted(mesh, 0.6);
+  for (Method method : kMethods) {
+    Device cpu = openDevice("cpu");
+    Deformer reference(cpu, mesh, lattice, strictOptions(method));
+    reference.deform(lattice);
+    const Mesh expected = reference.result();
+    EXPECT_GT(expected.triangles.size(), 0u);
+    if (method != Method::Classic) EXPECT_GT(reference.subTriangles(), mesh.triangles.size() - 1);
+    for (const std::string& name : deviceNames()) {
+      if (name == "cpu") continue;
+      Device device = openDevice(name);
+      Deformer deformer(device, mesh, lattice, strictOptions(method));
+      deformer.deform(lattice);
+      expectSameBits(deformer.result(), expected, name + " " + nameOf(method));
+      EXPECT_EQ(deformer.subTriangles(), reference.subTriangles());
+      std::vector<OutputChunk> chunks = deformer.deviceOutput();
+      ASSERT_FALSE(chunks.empty()) << name;
+      EXPECT_GT(chunks[0].bytes, 0u);
+    }
+  }
+}
+
+TEST(Deformer, RedeformingEqualsAFreshDeformerAndOtherStructuresAreRefused) {
+  const Mesh mesh = icosphere(2);
+  const Lattice a = twisted(mesh, 0.3), b = twisted(mesh, -0.5);
+  for (const std::string& name : deviceNames())
+    for (Method method : kMethods) {
+      SCOPED_TRACE(name + " " + nameOf(method));
+      Device device = openDevice(name);
+      Deformer reused(device, mesh, a, strictOptions(method));
+      reused.deform(a);
+      reused.deform(b);
+      Deformer fresh(device, mesh, b, strictOptions(method));
+      fresh.deform(b);
+      expectSameBits(reused.result(), fresh.result(), "re-deformed");
+      Lattice other = fitLattice(mesh, {5, 5, 5}, {2, 2, 2});
+      try {
+        reused.deform(other);
+        ADD_FAILURE() << "a lattice of another structure was accepted";
+      } catch (const Error& e) {
+        EXPECT_EQ(e.kind(), ErrorKind::Input);
+      }
+    }
+}
+
+TEST(Deformer, MeshViewsOfFloatsDoublesAndStridesEqualTheFile) {
+  // A cube (coordinates exact in float), as an OBJ file and as the caller's arrays.
+  const std::vector<double> corners = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, 0, 0, 1, 1, 0, 1, 1, 1, 1, 0, 1, 1};
+  const std::vector<uint32_t> tri = {0, 2, 1, 0, 3, 2, 4, 5, 6, 4, 6, 7, 0, 1, 5, 0, 5, 4,
+                                     1, 2, 6, 1, 6, 5, 2, 3, 7, 2, 7, 6, 3, 0, 4, 3, 4, 7};
+  const std::string path = (std::filesystem::temp_directory_path() / "sffd_api_cube.obj").string();
+  {
+    std::ofstream obj(path);
+    for (size_t v = 0; v < 8; ++v) obj << "v " << corners[3 * v] << " " << corners[3 * v + 1] << " " << corners[3 * v + 2] << "\n";
+    for (size_t t = 0; t < tri.size(); t += 3) obj << "f " << tri[t] + 1 << " " << tri[t + 1] + 1 << " " << tri[t + 2] + 1 << "\n";
+  }
+  const Mesh fromFile = readMesh(path);
+  std::filesystem::remove(path);
+  std::vector<double> strided(8 * 5, -7.0);   // 5 doubles a vertex, 2 of them padding
+  std::vector<float> floats(corners.begin(), corners.end());
+  for (size_t v = 0; v < 8; ++v)
+    for (int c = 0; c < 3; ++c) strided[5 * v + c] = corners[3 * v + c];
+  MeshView doubles, singles;
+  doubles.positions = strided.data();
+  doubles.positionStride = 5;
+  singles.positionsF32 = floats.data();
+  for (MeshView* v : {&doubles, &singles}) v->vertexCount = 8, v->triangles = tri.data(), v->triangleCount = 12;
+
+  Lattice lattice = twisted(fromFile, 0.4);
+  Device device = openDevice(deviceNames().front());
+  for (Method method : kMethods) {
+    Deformer file(device, fromFile, lattice, strictOptions(method));
+    file.deform(lattice);
+    const Mesh expected = file.result();
+    for (const MeshView* view : {&doubles, &singles}) {
+      Deformer fromView(device, *view, lattice, strictOptions(method));
+      fromView.deform(lattice);
+      expectSameBits(fromView.result(), expected, std::string(nameOf(method)) + (view == &doubles ? " doubles" : " floats"));
+    }
+  }
+}
+
+TEST(Deformer, CancellingThrowsCancelledAndLeavesItUsable) {
+  const Mesh mesh = icosphere(2);
+  const Lattice lattice = twisted(mesh, 0.5);
+  for (const std::string& name : deviceNames())
+    for (Method method : kMethods) {
+      SCOPED_TRACE(name + " " + nameOf(method));
+      Device device = openDevice(name);
+      bool cancel = true;
+      std::vector<std::string> stages;
+      DeformOptions o = strictOptions(method);
+      o.progress = [&](const Progress& p) {
+        stages.push_back(p.stage);
+        EXPECT_GE(p.fraction, 0.0);
+        EXPECT_LE(p.fraction, 1.0);
+        return !(cancel && std::string(p.stage) == "deform" && p.fraction > 0);   // after some of the work
+      };
+      Deformer deformer(device, mesh, lattice, o);
+      EXPECT_FALSE(stages.empty());
+      try {
+        deformer.deform(lattice);
+        ADD_FAILURE() << "not cancelled";
+      } catch (const Error& e) {
+        EXPECT_EQ(e.kind(), ErrorKind::Cancelled);
+        EXPECT_EQ(e.exitStatus(), 1);
+      }
+      cancel = false;
+      deformer.deform(lattice);
+      Deformer fresh(device, mesh, lattice, strictOptions(method));
+      fresh.deform(lattice);
+      expectSameBits(deformer.result(), fresh.result(), "after a cancelled deform");
+      // Cancelled while it prepares: no Deformer, nothing left behind on the device.
+      o.progress = [](const Progress&) { return false; };
+      try {
+        Deformer never(device, mesh, lattice, o);
+        ADD_FAILURE() << "not cancelled";
+      } catch (const Error& e) {
+        EXPECT_EQ(e.kind(), ErrorKind::Cancelled);
+      }
+    }
+}
+
+TEST(Deformer, SmallChunksGiveTheSameBits) {
+  const Mesh mesh = icosphere(2);
+  const Lattice lattice = twisted(mesh, 0.5);
+  for (const std::string& name : deviceNames())
+    for (Method method : kMethods) {
+      SCOPED_TRACE(name + " " + nameOf(method));
+      Device device = openDevice(name);
+      Deformer whole(device, mesh, lattice, strictOptions(method));
+      whole.deform(lattice);
+      DeformOptions o = strictOptions(method);
+      o.maxChunkElements = 37;   // many chunks, the last one partial
+      Deformer chunked(device, mesh, lattice, o);
+      chunked.deform(lattice);
+      expectSameBits(chunked.result(), whole.result(), "chunked");
+      if (name != "cpu") EXPECT_GT(chunked.deviceOutput().size(), 2u);
+    }
+}
+
+TEST(Deformer, OptionsAreCheckedAndDefaulted) {
+  const Mesh mesh = icosphere(1);
+  const Lattice lattice = twisted(mesh, 0.2);
+  Device device = openDevice("cpu");
+  for (int tess : {0, 65}) {
+    DeformOptions o;
+    o.tess = tess;
+    EXPECT_THROW(Deformer(device, mesh, lattice, o), Error) << tess;
+  }
+  DeformOptions o;
+  o.edgeLength = -1;
+  EXPECT_THROW(Deformer(device, mesh, lattice, o), Error);
+  // Auto precision: double for classic and accurate where the device has it, float for smooth.
+  DeformOptions classic;
+  classic.method = Method::Classic;
+  EXPECT_TRUE(Deformer(device, mesh, lattice, classic).doublePrecision());
+  EXPECT_FALSE(Deformer(device, mesh, lattice, {}).doublePrecision());
+  // A memory limit too small for the job is an input error naming it.
+  classic.memoryLimit = 1024;
+  try {
+    Deformer(device, mesh, lattice, classic);
+    ADD_FAILURE() << "the memory limit was not applied";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Input);
+    EXPECT_NE(std::string(e.what()).find("memoryLimit"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace

@@ -1,0 +1,170 @@
+// sffd::Deformer (<sffd/deformer.h>): the options resolved and checked once, then one MethodRun per
+// method (deformer_internal.h) doing the device work.
+#include <sffd/deformer.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+#include <sffd/error.h>
+
+#include "core/job_budget.h"
+#include "core/wall_clock.h"
+#include "model/mesh_topology.h"
+#include "pipelines/deform_session.h"
+#include "pipelines/deformer_internal.h"
+
+namespace sffd {
+
+void ProgressReporter::operator()(const char* stage, double fraction) const {
+  if (!callback_) return;
+  Progress p;
+  p.stage = stage;
+  p.fraction = lo_ + (hi_ - lo_) * std::clamp(fraction, 0.0, 1.0);
+  if (callback_(p)) return;
+  // Queued work is finished and its timings dropped, so that the next call starts from a clean device.
+  if (backend_) {
+    backend_->finish();
+    backend_->takeTimings();
+  }
+  throw Error(ErrorKind::Cancelled, "cancelled");
+}
+
+ProgressReporter ProgressReporter::part(double lo, double hi) const {
+  ProgressReporter r = *this;
+  r.lo_ = lo_ + (hi_ - lo_) * lo;
+  r.hi_ = lo_ + (hi_ - lo_) * hi;
+  return r;
+}
+
+std::vector<std::pair<std::string, double>> stepsOf(const std::vector<DispatchTiming>& dispatches) {
+  std::vector<std::pair<std::string, double>> steps;
+  for (const DispatchTiming& d : dispatches) {
+    auto it = std::find_if(steps.begin(), steps.end(), [&](const auto& s) { return s.first == d.label; });
+    if (it == steps.end()) steps.push_back({d.label, 0.0}), it = steps.end() - 1;
+    it->second += std::max(d.gpuMs, 0.0);
+  }
+  return steps;
+}
+
+double stageMs(const std::vector<DispatchTiming>& dispatches, double wallMs) {
+  double ms = 0;
+  for (const DispatchTiming& d : dispatches) ms += d.gpuMs > 0 ? d.gpuMs : 0;
+  return ms > 0 ? ms : wallMs;
+}
+
+namespace {
+
+ResolvedOptions resolve(const DeformOptions& o, const DeviceInfo& info, const Mesh& mesh, const Lattice& lattice) {
+  ResolvedOptions r;
+  r.method = o.method;
+  r.variant.strict = o.strict;
+  if (o.precision == Precision::Double && !info.limits.float64)
+    throw deviceError(info.name + " has no double-precision shader support");
+  // Classic and accurate FFD default to double: PyGeM's 1.5e-6 is below float resolution at its
+  // coordinates, and accurate FFD is the reference the others are measured against.
+  r.variant.f64 = o.precision == Precision::Double ||
+                  (o.precision == Precision::Auto && o.method != Method::Smooth && info.limits.float64);
+  if (o.tess < 1 || o.tess > kMaxTessLevel)
+    throw Error(ErrorKind::Input, "the tessellation level must be 1.." + std::to_string(kMaxTessLevel) + ", not " + std::to_string(o.tess));
+  r.tess = o.tess;
+  if (!std::isfinite(o.edgeLength) || o.edgeLength < 0)
+    throw Error(ErrorKind::Input, "the edge length must be a finite number > 0 (or 0: a tenth of the mesh's size)");
+  r.edgeLength = o.edgeLength;
+  if (r.edgeLength == 0) {
+    // The reference implementation's l = 0.2 for models in [-1,1]: a tenth of the largest extent.
+    glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi = -lo;
+    for (const auto& p : mesh.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
+    r.edgeLength = 0.1 * std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
+  }
+  const int degrees = lattice.degree[0] + lattice.degree[1] + lattice.degree[2];
+  r.samples = std::max(3, o.samples > 0 ? o.samples : degrees);
+  r.knotBoxClip = o.clip == Clip::KnotBox;
+  r.split = o.split;
+  r.creaseAngleDeg = o.creaseAngleDeg;
+  r.memoryLimit = o.memoryLimit;
+  r.maxChunkElements = o.maxChunkElements;
+  return r;
+}
+
+// Smooth FFD's size limit, before any work: the number of sub-triangles the edge length makes.
+void checkSmoothSize(const Mesh& mesh, double l) {
+  if (!(l > 0) || !std::isfinite(l)) throw Error(ErrorKind::Input, "the edge length must be a positive number");
+  double estimate = estimateSubTriangles(mesh, l);
+  if (estimate > kMaxSubTriangles) {
+    char buf[200];
+    std::snprintf(buf, sizeof buf, "the edge length %g would make about %.3g sub-triangles, above the limit of %.3g", l,
+                  estimate, kMaxSubTriangles);
+    throw Error(ErrorKind::Input, buf);
+  }
+}
+
+}  // namespace
+
+Deformer::Deformer(Device& device, const MeshView& mesh, const Lattice& lattice, const DeformOptions& options)
+    : Deformer(device, meshFromView(mesh), lattice, options) {}
+
+Deformer::Deformer(Device& device, const Mesh& mesh, const Lattice& lattice, const DeformOptions& options)
+    : impl_(std::make_unique<Impl>()) {
+  const auto t0 = std::chrono::steady_clock::now();
+  Impl& I = *impl_;
+  I.device = &device;
+  I.options = options;
+  validateLattice(lattice, "lattice");
+  I.resolved = resolve(options, device.info(), mesh, lattice);
+  I.structure = lattice;
+  I.input = mesh;
+  const ResolvedOptions& r = I.resolved;
+  Backend& backend = device.backend();
+  ProgressReporter progress(I.options.progress, &backend);
+  progress("prepare", 0);
+  if (r.method == Method::Smooth) {
+    // Smooth FFD's pre-images index the mesh with its creases split (the error analysis needs it).
+    if (!I.input.normalsFromFile) applyCreaseAngle(I.input, r.creaseAngleDeg);
+    checkSmoothSize(I.input, r.edgeLength);
+  }
+  if (r.method == Method::Smooth) I.run = makeSmoothRun(backend, I.input, lattice, r, I.timings, progress);
+  else if (r.method == Method::Classic) I.run = makeClassicRun(backend, I.input, lattice, r, I.timings, progress);
+  else I.run = makeAccurateRun(backend, I.input, lattice, r, I.timings, progress);
+  progress("prepare", 1);
+  I.timings.wallMs = msSince(t0);
+}
+
+Deformer::Deformer(Deformer&&) noexcept = default;
+Deformer& Deformer::operator=(Deformer&&) noexcept = default;
+Deformer::~Deformer() = default;
+
+const Timings& Deformer::deform(const Lattice& lattice) {
+  Impl& I = *impl_;
+  if (!sameLatticeStructure(lattice, I.structure))
+    throw Error(ErrorKind::Input, "the lattice's degrees, counts, knots, frame or outside rule differ from the Deformer's");
+  const auto t0 = std::chrono::steady_clock::now();
+  ProgressReporter progress(I.options.progress, &I.device->backend());
+  progress("deform", 0);
+  I.timings.steps.clear();
+  I.run->deform(lattice, I.timings, progress);
+  progress("deform", 1);
+  I.timings.wallMs = msSince(t0);
+  return I.timings;
+}
+
+const Timings& Deformer::timings() const { return impl_->timings; }
+
+Mesh Deformer::result() const {
+  ProgressReporter progress(impl_->options.progress, &impl_->device->backend());
+  progress("download", 0);
+  Mesh mesh = impl_->run->result(progress);
+  progress("download", 1);
+  return mesh;
+}
+
+std::vector<double> Deformer::patchControlPoints() const { return impl_->run->patchControlPoints(); }
+size_t Deformer::subTriangles() const { return impl_->run->subTriangles(); }
+std::vector<OutputChunk> Deformer::deviceOutput() const { return impl_->run->deviceOutput(); }
+bool Deformer::doublePrecision() const { return impl_->resolved.variant.f64; }
+const DeformOptions& Deformer::options() const { return impl_->options; }
+Device& Deformer::device() const { return *impl_->device; }
+Deformer::Impl& Deformer::internal() { return *impl_; }
+
+}  // namespace sffd

@@ -1,0 +1,94 @@
+// What sffd::Deformer (<sffd/deformer.h>) is made of, for the library's own files and the
+// command-line tool's analysis (pre-images, sub-triangle records). Not part of the public API.
+//
+// deformer.cpp resolves the options and picks one MethodRun per method, each in its own file:
+//   deformer_smooth.cpp    DeformSession (PN triangles, clipping, deform; all on the device)
+//   deformer_classic.cpp   kernels/classic: vertices and normals, in per-chunk device buffers
+//   deformer_accurate.cpp  knot-box clipping (host), then kernels/accurate, in per-chunk device buffers
+#pragma once
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include <sffd/deformer.h>
+
+#include "core/backend.h"
+#include "pipelines/patch_output.h"
+
+namespace sffd {
+
+class DeformSession;
+
+// Tells DeformOptions::progress how far the current call is (`fraction` of it, 0..1). When the
+// callback answers false, the device's queued work is finished and an Error of kind Cancelled thrown.
+class ProgressReporter {
+ public:
+  ProgressReporter(const ProgressCallback& callback, Backend* backend) : callback_(callback), backend_(backend) {}
+  void operator()(const char* stage, double fraction) const;
+  // `fraction` of [lo, hi] of the call: for a step that is part of a larger one.
+  ProgressReporter part(double lo, double hi) const;
+
+ private:
+  const ProgressCallback& callback_;
+  Backend* backend_;
+  double lo_ = 0, hi_ = 1;
+};
+
+// DeformOptions with every default resolved, as the method runs use them.
+struct ResolvedOptions {
+  Method method = Method::Smooth;
+  KernelVariant variant;
+  double edgeLength = 0;   // > 0
+  int tess = 10;
+  int samples = 3;         // >= 3
+  bool knotBoxClip = false;
+  bool split = false;
+  double creaseAngleDeg = 40;
+  uint64_t memoryLimit = 0;
+  size_t maxChunkElements = 0;
+};
+
+// One method's work on the device: the constructor prepares, deform() runs for a lattice.
+class MethodRun {
+ public:
+  virtual ~MethodRun() = default;
+  // Uploads the lattice's control points and runs the kernels; fills deformMs and steps.
+  virtual void deform(const Lattice& lattice, Timings& timings, const ProgressReporter& progress) = 0;
+  virtual Mesh result(const ProgressReporter& progress) const = 0;
+  virtual std::vector<OutputChunk> deviceOutput() const = 0;
+  virtual size_t subTriangles() const { return 0; }
+  // Smooth: the patches' control points (deformer.h); others: empty.
+  virtual std::vector<double> patchControlPoints() const { return {}; }
+  // Smooth and Accurate: the tessellation with each vertex's pre-image in Impl::input.
+  virtual std::optional<PatchVertices> patchVertices() const { return std::nullopt; }
+  // Smooth: runs the pre-compute again (PN triangles, clipping), filling pnMs and clipMs: what
+  // `sffd bench` times. Others: nothing.
+  virtual void precompute(Timings&) {}
+  // Smooth on a device: the session whose buffers the viewer draws; others: null.
+  virtual DeformSession* session() { return nullptr; }
+};
+
+std::unique_ptr<MethodRun> makeSmoothRun(Backend& backend, const Mesh& input, const Lattice& lattice,
+                                         const ResolvedOptions& options, Timings& timings, const ProgressReporter& progress);
+std::unique_ptr<MethodRun> makeClassicRun(Backend& backend, const Mesh& input, const Lattice& lattice,
+                                          const ResolvedOptions& options, Timings& timings, const ProgressReporter& progress);
+std::unique_ptr<MethodRun> makeAccurateRun(Backend& backend, const Mesh& input, const Lattice& lattice,
+                                           const ResolvedOptions& options, Timings& timings, const ProgressReporter& progress);
+
+
+struct Deformer::Impl {
+  Device* device = nullptr;
+  DeformOptions options;
+  ResolvedOptions resolved;
+  Mesh input;           // the mesh as the method uses it (smooth: creases applied); pre-images index its triangles
+  Lattice structure;    // the lattice the Deformer was made for (its structure is what deform() checks)
+  Timings timings;
+  std::unique_ptr<MethodRun> run;
+};
+
+// Sums dispatch times by label in first-seen order (GPU time; a negative time counts 0).
+std::vector<std::pair<std::string, double>> stepsOf(const std::vector<DispatchTiming>& dispatches);
+// The sum of the dispatches' GPU times; `wallMs` when the device measured none.
+double stageMs(const std::vector<DispatchTiming>& dispatches, double wallMs);
+
+}  // namespace sffd
