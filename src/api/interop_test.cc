@@ -13,7 +13,9 @@
 #include <cstring>
 #include <vector>
 
+#include <sffd/deformer.h>
 #include <sffd/error.h>
+#include <sffd/opengl.h>
 #include "backends/opengl/gl_backend.h"
 #include "backends/opengl/gl_context.h"
 #include "backends/vulkan/vk_interop.h"
@@ -174,6 +176,31 @@ TEST(VulkanInterop, QueueFamilyWithoutComputeIsRefused) {
     EXPECT_EQ(e.kind(), ErrorKind::Device);
     EXPECT_NE(std::string(e.what()).find("queue family 99"), std::string::npos) << e.what();
   }
+}
+
+// bufferOf on sffd's own Vulkan device too, refused where the output is not a Vulkan (or GL) buffer.
+TEST(VulkanInterop, BufferOfNamesTheDeformersBuffersAndRefusesOtherDevices) {
+  Job j = strictJob();
+  DeformOptions classic;
+  classic.method = Method::Classic;
+  classic.strict = true;
+  classic.precision = Precision::Float;
+  DeviceRequest vkRequest, cpuRequest;
+  vkRequest.name = "vulkan";
+  cpuRequest.name = "cpu";
+  Device gpu = Device::open(vkRequest);
+  Deformer d(gpu, j.mesh, j.lattice, classic);
+  d.deform(j.lattice);
+  ASSERT_FALSE(d.deviceOutput().empty());
+  for (const OutputChunk& c : d.deviceOutput()) {
+    vulkan::BufferRange r = vulkan::bufferOf(d, c);
+    EXPECT_NE(r.buffer, VK_NULL_HANDLE);
+    EXPECT_EQ(r.size, c.bytes);
+  }
+  EXPECT_THROW(opengl::bufferOf(d, d.deviceOutput()[0]), Error);
+  Device cpu = Device::open(cpuRequest);
+  Deformer onCpu(cpu, j.mesh, j.lattice, classic);
+  EXPECT_THROW(vulkan::bufferOf(onCpu, OutputChunk{}), Error);
 }
 
 // ---- GL: the application's GLFW window, with bindings of its own ----
