@@ -3,6 +3,8 @@
 #include <sstream>
 
 #include "apps/sffd/cli.h"
+
+#include <utility>
 #include <sffd/error.h>
 
 namespace sffd::cli {
@@ -134,9 +136,20 @@ void note(const ParsedArgs& args, const std::string& line) {
   if (!args.has("--quiet")) fprintf(stderr, "sffd: %s\n", line.c_str());
 }
 
+namespace {
+std::vector<std::string>& warnings() {
+  static std::vector<std::string> w;
+  return w;
+}
+}  // namespace
+
+void warnOnSuccess(const std::string& line) { warnings().push_back(line); }
+
+std::vector<std::string> takeWarnings() { return std::exchange(warnings(), {}); }
+
 Mesh readMeshWarning(const std::string& path, const MeshReadOptions& options) {
   Mesh mesh = readMesh(path, options);
-  for (const std::string& w : mesh.warnings) std::fprintf(stderr, "sffd: warning: %s\n", w.c_str());
+  for (const std::string& w : mesh.warnings) warnOnSuccess(w);
   return mesh;
 }
 

@@ -72,8 +72,12 @@ Device openDeviceFromArgs(const ParsedArgs& args);
 bool wantDouble(const ParsedArgs& args, const DeviceInfo& info, bool autoDouble);
 
 void note(const ParsedArgs& args, const std::string& line);   // stderr unless --quiet
-// Reads a mesh and prints what the reader repaired or skipped (sffd: warning: ..., even with --quiet:
-// it is about the input).
+// A warning about the result or the input ("sffd: warning: LINE" on stderr, even with --quiet), printed
+// once the command has succeeded: a command that fails prints its one error line only.
+void warnOnSuccess(const std::string& line);
+// The warnings so far, in order, taken (main prints them when the command returns 0).
+std::vector<std::string> takeWarnings();
+// Reads a mesh; what the reader repaired or skipped becomes warnings (warnOnSuccess).
 Mesh readMeshWarning(const std::string& path, const MeshReadOptions& options = {});
 
 // SFFD_MAX_CHUNK_* (elements per chunk, to test chunking): the value of the variable `name`, at

@@ -8,6 +8,7 @@
 
 #include "apps/sffd/progress_line.h"
 #include "core/job_budget.h"
+#include "model/lattice_coverage.h"
 #include "model/lattice_fold.h"
 #include "model/lattice_pack.h"
 #include "pipelines/deformer_internal.h"
@@ -90,9 +91,12 @@ DeformRun runMethod(const ParsedArgs& args, Job& job, Device& device, Method met
 }
 
 DeformRun runDeformJob(const ParsedArgs& args, Job& job, Device& device) {
-  std::string warning = foldWarning(checkLatticeFold(packLattice(job.lattice)), job.latticePath);
+  const std::string warnings[] = {foldWarning(checkLatticeFold(packLattice(job.lattice)), job.latticePath),
+                                  discontinuityWarning(job.lattice, job.latticePath),
+                                  outsideWarning(shareOutsideLattice(job.mesh, job.lattice), job.lattice, job.latticePath)};
   DeformRun run = runMethod(args, job, device, methodOf(args.get("--method", "smooth")));
-  if (!warning.empty()) std::fprintf(stderr, "sffd: warning: %s\n", warning.c_str());
+  for (const std::string& w : warnings)
+    if (!w.empty()) warnOnSuccess(w);
   return run;
 }
 

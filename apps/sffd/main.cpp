@@ -61,7 +61,10 @@ int main(int argc, char** argv) {
         std::fputs(cli::helpText(c).c_str(), stdout);
         return 0;
       }
-      return c.run(args);
+      const int status = c.run(args);
+      if (status == 0)
+        for (const std::string& w : cli::takeWarnings()) std::fprintf(stderr, "sffd: warning: %s\n", oneLine(w.c_str()).c_str());
+      return status;
     }
     throw Error(ErrorKind::Input, std::string("unknown command '") + argv[1] + "' (sffd --help lists them)");
   } catch (const Error& e) {

@@ -1,0 +1,22 @@
+// What a lattice does to a given mesh that the user may not expect: vertices outside the lattice's
+// box (extrapolated or left unmoved, by the lattice's outside rule) and knots that make the volume
+// discontinuous (an interior knot repeated more than the degree: the map jumps there). The CLI
+// prints each as one warning line; a library user can call them the same way.
+#pragma once
+#include <string>
+
+#include <sffd/lattice.h>
+#include <sffd/mesh.h>
+
+namespace sffd {
+
+// Share of the mesh's vertices whose lattice parameter lies outside the lattice's domain, 0..1.
+double shareOutsideLattice(const Mesh& mesh, const Lattice& lattice);
+
+// One line (without "sffd: warning: ") when more than half of the vertices lie outside; else empty.
+std::string outsideWarning(double shareOutside, const Lattice& lattice, const std::string& latticeName);
+
+// One line naming the first interior knot whose multiplicity exceeds its axis' degree; else empty.
+std::string discontinuityWarning(const Lattice& lattice, const std::string& latticeName);
+
+}  // namespace sffd

@@ -1,0 +1,44 @@
+// Warnings about what a lattice does to the mesh at hand: most of the mesh outside the lattice's box,
+// and knots that make the deformation discontinuous. One "sffd: warning:" line each, exit 0.
+#include <gtest/gtest.h>
+
+#include "tests/support/cli_runner.h"
+
+namespace sffd::test {
+namespace {
+
+TEST(LatticeWarnings, MeshOutsideTheBoxAndDiscontinuousKnots) {
+  fs::path dir = tempDir("lattice_warnings");
+  writeBoxObj(dir / "box.obj", 0, 0, 0, 1);
+  writeBoxObj(dir / "far.obj", 40, -25, 10, 1);
+  const std::string box = (dir / "box.obj").string(), far = (dir / "far.obj").string();
+  const std::string fitted = (dir / "fitted.json").string();
+  ASSERT_EQ(runSffd("lattice " + box + " -o " + fitted + " --preset bend:0.3 --quiet").status, 0);
+
+  // The lattice fits the mesh: nothing to say.
+  RunResult clean = runSffd("deform " + box + " -l " + fitted + " --backend cpu -o " + (dir / "a.obj").string() + " --quiet");
+  EXPECT_EQ(clean.status, 0) << clean.err;
+  EXPECT_EQ(clean.err, "");
+
+  // The same lattice on a mesh 40 units away: every vertex outside, extrapolated.
+  RunResult outside = runSffd("deform " + far + " -l " + fitted + " --method classic --backend cpu -o " + (dir / "b.obj").string() + " --quiet");
+  EXPECT_EQ(outside.status, 0) << outside.err;
+  EXPECT_NE(outside.err.find("sffd: warning: 100% of the mesh's vertices lie outside the box of lattice " + fitted +
+                             ": they follow the nearest knot box's polynomial"),
+            std::string::npos)
+      << outside.err;
+
+  // A degree-1 lattice whose interior knot is doubled: the map jumps at u = 0.5.
+  std::ofstream(dir / "jump.json") << R"({"format": "sffd-lattice", "version": 1, "degree": [1, 1, 1], "counts": [4, 2, 2],
+    "box": {"min": [-1.5, -1.5, -1.5], "max": [1.5, 1.5, 1.5]},
+    "knots": {"u": [-1.5, -1.5, 0, 0, 1.5, 1.5]}})";
+  RunResult jump = runSffd("deform " + box + " -l " + (dir / "jump.json").string() + " --method classic --backend cpu -o " +
+                           (dir / "c.obj").string() + " --quiet");
+  EXPECT_EQ(jump.status, 0) << jump.err;
+  EXPECT_NE(jump.err.find("the knot 0 of axis u is repeated 2 times, more than the degree 1"), std::string::npos) << jump.err;
+  EXPECT_EQ(std::count(jump.err.begin(), jump.err.end(), '\n'), 1) << jump.err;
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace sffd::test
