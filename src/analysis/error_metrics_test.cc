@@ -146,7 +146,9 @@ TEST(ErrorMetrics, ExactVolumeAgreesWithFineClassicAndAccurateDeformations) {
     ASSERT_TRUE(isClosed(fine));
     const double err = std::abs(signedVolume(classic(fine, L)) - exact) / std::abs(exact);
     std::printf("classic, %zu triangles: volume rel. error %.3g\n", fine.triangles.size(), err);
-    if (prevErr > 0) EXPECT_LT(err, prevErr / 3);
+    if (prevErr > 0) {
+      EXPECT_LT(err, prevErr / 3);
+    }
     prevErr = err;
   }
   EXPECT_LT(prevErr, 1e-4);
