@@ -4,6 +4,7 @@ The parameters are PyGeM's, held the way PyGeM holds them; a call builds the lat
 these parameters reads as (sffd::pygemLattice: a Bernstein lattice of degree n-1 on the rotated box)
 and moves the points inside the box on the device, leaving those outside where they are.
 """
+import copy
 import os
 
 import numpy as np
@@ -88,6 +89,27 @@ class FFD:
         """The lattice's control points (i slowest, k fastest), deformed or not, as PyGeM gives them."""
         counts, length, origin, angle, mu = self._values()
         return _sffd._pygem_lattice(counts, length, origin, angle, mu if deformed else 0 * mu).control_points.copy()
+
+    def reflect(self, axis=0, in_place=True):
+        """Mirrors the lattice across the box face opposite the origin along axis (0, 1, 2), as PyGeM
+        does: 2n-1 points and twice the length along it, the displacements mirrored (the one along
+        axis negated). The face's points must not be displaced along axis."""
+        if axis not in (0, 1, 2):
+            raise ValueError(f"The axis has to be 0, 1, or 2. Current value {axis}.")
+        mus = [self.array_mu_x, self.array_mu_y, self.array_mu_z]
+        if np.count_nonzero(np.take(mus[axis], -1, axis=axis)):
+            raise RuntimeError(f"the control points on the symmetry plane are displaced along axis {axis}: cannot reflect")
+        target = self if in_place else copy.deepcopy(self)
+        mirrored = []
+        for c, mu in enumerate(mus):
+            tail = np.flip(mu, axis).take(range(1, mu.shape[axis]), axis=axis)   # the plane itself is kept once
+            mirrored.append(np.concatenate([mu, -tail if c == axis else tail], axis=axis))
+        target._n_control_points = np.array(target._n_control_points)
+        target._n_control_points[axis] = 2 * target._n_control_points[axis] - 1
+        target.box_length = np.array(target.box_length, dtype=float)
+        target.box_length[axis] *= 2
+        target.array_mu_x, target.array_mu_y, target.array_mu_z = mirrored
+        return None if in_place else target
 
     def read_parameters(self, filename="parameters.prm"):
         """Reads a .prm file; as PyGeM does, a missing file is written with the current parameters."""

@@ -110,3 +110,20 @@ def test_bad_parameters_raise_sffds_message(tmp_path):
     ffd.array_mu_x = np.zeros((3, 3, 3))
     with pytest.raises(ValueError, match="array_mu_x has shape"):
         ffd(np.zeros((1, 3)))
+
+
+def test_reflect_is_symmetric():
+    ffd = sffd.FFD([2, 3, 2], backend="cpu")
+    ffd.box_length = np.array([1.0, 2.0, 1.0])
+    ffd.array_mu_x[0, 1, 1] = 0.2
+    ffd.array_mu_y[1, 2, 0] = -0.1
+    wide = ffd.reflect(axis=0, in_place=False)
+    assert list(wide.n_control_points) == [3, 3, 2] and wide.box_length[0] == 2.0 and ffd.box_length[0] == 1.0
+    assert wide.array_mu_x[2, 1, 1] == -0.2 and wide.array_mu_y[1, 2, 0] == -0.1
+    rng = np.random.default_rng(2)
+    p = rng.random((50, 3)) * [1.0, 2.0, 1.0]
+    mirror = p * [-1, 1, 1] + [2.0, 0, 0]
+    np.testing.assert_allclose(wide(mirror), wide(p) * [-1, 1, 1] + [2.0, 0, 0], rtol=0, atol=1e-12)
+    ffd.array_mu_x[1, 0, 0] = 0.1
+    with pytest.raises(RuntimeError):
+        ffd.reflect(axis=0)
