@@ -145,3 +145,29 @@ def test_repeated_calls_do_not_leak(sphere):
     positions = out[0]
     del out
     assert sys.getrefcount(positions) == 2   # nothing but this name holds the result (and the call's argument)
+
+
+def test_lattice_files_round_trip(sphere, tmp_path):
+    lat = sffd.Lattice.fitted(sphere[0], counts=(4, 5, 6)).preset("bulge", 0.3)
+    lat.save(str(tmp_path / "l.json"))
+    again = sffd.Lattice.from_file(str(tmp_path / "l.json"))
+    assert again.same_structure(lat)
+    np.testing.assert_array_equal(again.control_points, lat.control_points)
+    # .npy holds the control points only: the box and degree come from the caller.
+    lat.save(str(tmp_path / "l.npy"))
+    lo = [k[d] for k, d in zip(lat.knots, lat.degree)]
+    hi = [k[-d - 1] for k, d in zip(lat.knots, lat.degree)]
+    again = sffd.Lattice.from_file(str(tmp_path / "l.npy"), box=(lo, hi), degree=lat.degree)
+    assert again.counts == (4, 5, 6)
+    np.testing.assert_array_equal(again.control_points, lat.control_points)
+    np.testing.assert_allclose(np.concatenate(again.knots), np.concatenate(lat.knots), rtol=0, atol=1e-15)
+
+
+@pytest.mark.parametrize("label", [d.label for d in sffd.devices()])
+def test_every_device_gives_the_cpu_bits_in_strict_mode(sphere, label):
+    v, t, n = sphere
+    lat = sffd.Lattice.fitted(v).preset("twist", 0.6)
+    ref = sffd.deform(v, t, lat, backend="cpu", tess=3, strict=True)
+    got = sffd.deform(v, t, lat, backend=label, tess=3, strict=True)
+    for a, b in zip(ref, got):
+        np.testing.assert_array_equal(a, b)
