@@ -68,7 +68,9 @@ std::shared_ptr<Device> deviceFor(py::handle backend) {
   auto& cache = deviceCache();
   auto it = cache.find(name);
   if (it != cache.end()) return it->second;
-  auto device = std::make_shared<Device>(Device::open({.name = name}));
+  DeviceRequest request;
+  request.name = name;
+  auto device = std::make_shared<Device>(Device::open(request));
   cache[name] = device;
   return device;
 }
