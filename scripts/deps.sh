@@ -12,6 +12,7 @@ SFFD_PACKAGES=(
   libgtest-dev libbenchmark-dev
   clang libclang-rt-14-dev
   xvfb xauth
+  python3-dev python3-numpy python3-pytest python3-venv python3-pip python3-setuptools python3-wheel pybind11-dev
 )
 
 missing=()

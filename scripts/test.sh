@@ -7,7 +7,8 @@ cd "$(dirname "$0")/.."
 scripts/deps.sh
 
 build=build
-flags=(-DCMAKE_BUILD_TYPE=Release)
+# The Python package too (python/, built for Debian's interpreter; docs/PYTHON.md).
+flags=(-DCMAKE_BUILD_TYPE=Release -DSFFD_BUILD_PYTHON=ON -DPython_EXECUTABLE=/usr/bin/python3)
 sanitize=0
 if [ "${1:-}" = "--sanitize" ]; then
   sanitize=1
@@ -26,6 +27,10 @@ cmake --build "$build" -j"$(nproc)"
 export LIBGL_ALWAYS_SOFTWARE=1 VK_DRIVER_FILES=/usr/share/vulkan/icd.d/lvp_icd.x86_64.json
 export VK_ICD_FILENAMES=$VK_DRIVER_FILES
 xvfb-run -a -s "-screen 0 640x480x24" ctest --test-dir "$build" --output-on-failure -j"$(nproc)"
+if [ "$sanitize" = 0 ]; then
+  # The Python package's tests (seconds), on the module just built in build/python.
+  PYTHONPATH="$build/python" SFFD_CLI="$build/sffd" /usr/bin/python3 -m pytest -q -p no:cacheprovider python/tests
+fi
 if [ "$sanitize" = 1 ]; then
   ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 "$build/tests/sffd_core_tests" --gtest_brief=1
 fi

@@ -89,4 +89,21 @@ void writeLattice(const std::string& path, const Lattice& lattice);
 // file renamed into place.
 void writeLatticeJson(const std::string& path, const Lattice& lattice);
 
+// PyGeM's FFD parameters as a .prm file holds them (mathLab/PyGeM pygem/ffd.py): counts[a] control
+// points (degree counts[a] - 1) on the box origin + R diag(length) [0,1]^3, R = Rx Ry Rz of the angles
+// in degrees, point (i, j, k) displaced by mu (box-length units, the box's axes). What the Python
+// package's sffd.FFD holds; readLattice of a .prm file is pygemLattice(readPygemParameters(path)).
+struct PygemParameters {
+  std::array<int, 3> counts{2, 2, 2};   // 2..6 (degree 1..5)
+  glm::dvec3 length{1.0}, origin{0.0}, angleDeg{0.0};
+  std::vector<glm::dvec3> mu;   // counts[0]*counts[1]*counts[2], indexed as Lattice::index; empty: all 0
+};
+
+// Reads a .prm file whatever its name; an input Error ("file:line: what") on a bad one.
+PygemParameters readPygemParameters(const std::string& path);
+// Writes every mu (PyGeM's layout), to a temporary file renamed into place.
+void writePygemParameters(const std::string& path, const PygemParameters& parameters);
+// The lattice the parameters mean (OutsideMode::Keep); an input Error for bad parameters.
+Lattice pygemLattice(const PygemParameters& parameters);
+
 }  // namespace sffd

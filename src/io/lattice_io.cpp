@@ -314,6 +314,23 @@ Lattice readLattice(const std::string& path, const LatticeReadOptions& options) 
   }
 }
 
+PygemParameters readPygemParameters(const std::string& path) {
+  try {
+    std::string text = io::readWholeFile(path);
+    if (text.empty()) throw inputError(path, 0, "empty file");
+    io::checkTextEncoding(path, text, false);
+    return latticeio::parsePrm(path, text);
+  } catch (const Error& e) {
+    throw Error(e.kind(), io::oneLine(e.what()));
+  }
+}
+
+void writePygemParameters(const std::string& path, const PygemParameters& parameters) {
+  latticeio::writePrmParameters(path, parameters);
+}
+
+Lattice pygemLattice(const PygemParameters& parameters) { return latticeio::latticeOfPrm(parameters, "PyGeM parameters"); }
+
 namespace latticeio {
 
 Lattice readLatticeBytes(const std::string& path, std::string text, const LatticeReadOptions& options) {

@@ -105,7 +105,7 @@ glm::dmat3 rotationZ(double a) {
 
 }  // namespace
 
-Lattice readPrm(const std::string& path, const std::string& text) {
+PygemParameters parsePrm(const std::string& path, const std::string& text) {
   auto sections = parseIni(path, text);
   auto section = [&](const char* name) -> IniSection& {
     auto it = sections.find(name);
@@ -144,13 +144,9 @@ Lattice readPrm(const std::string& path, const std::string& text) {
     angle[a] = scalar(std::string("rotation angle ") + xyz[a]);
   }
 
-  Lattice L;
-  L.counts = n;
-  for (int a = 0; a < 3; ++a) {
-    L.degree[a] = n[a] - 1;
-    L.knots[a] = clampedUniformKnots(n[a], n[a] - 1, 0.0, 1.0);
-  }
-  std::vector<glm::dvec3> mu(L.pointCount(), glm::dvec3(0.0));
+  PygemParameters P;
+  P.counts = n, P.length = length, P.origin = origin, P.angleDeg = angle;
+  P.mu.assign(size_t(n[0]) * n[1] * n[2], glm::dvec3(0.0));
   for (int a = 0; a < 3; ++a) {
     IniValue& v = get(weights, "Parameters weights", std::string("parameter ") + xyz[a]);
     std::vector<std::string_view> tok;
@@ -166,14 +162,36 @@ Lattice readPrm(const std::string& path, const std::string& text) {
       double d = 0;
       if (!io::parseDouble(tok[3], d)) throw inputError(path, line, "bad number " + io::quoted(tok[3]));
       if (!std::isfinite(d)) throw inputError(path, line, "non-finite value " + io::quoted(tok[3]));
-      mu[L.index(int(idx[0]), int(idx[1]), int(idx[2]))][a] = d;   // a repeated entry overrides, as in PyGeM
+      P.mu[(size_t(idx[0]) * n[1] + size_t(idx[1])) * n[2] + size_t(idx[2])][a] = d;   // a repeated entry overrides, as in PyGeM
     }
   }
 
+  return P;
+}
+
+Lattice latticeOfPrm(const PygemParameters& P, const std::string& source) {
+  const std::array<int, 3>& n = P.counts;
+  for (int a = 0; a < 3; ++a) {
+    if (n[a] < 2 || n[a] > 6)
+      throw inputError(source, 0, "n control points " + std::to_string(n[a]) + "; 2..6 are supported (degree = count - 1, 1..5)");
+    if (!(P.length[a] > 0) || !std::isfinite(P.length[a])) throw inputError(source, 0, "box length must be positive");
+    if (!std::isfinite(P.origin[a]) || !std::isfinite(P.angleDeg[a])) throw inputError(source, 0, "box origin or rotation angle not finite");
+  }
+  Lattice L;
+  L.counts = n;
+  for (int a = 0; a < 3; ++a) {
+    L.degree[a] = n[a] - 1;
+    L.knots[a] = clampedUniformKnots(n[a], n[a] - 1, 0.0, 1.0);
+  }
+  if (!P.mu.empty() && P.mu.size() != L.pointCount())
+    throw inputError(source, 0, "mu has " + std::to_string(P.mu.size()) + " entries; the counts need " + std::to_string(L.pointCount()));
+  for (const glm::dvec3& m : P.mu)
+    if (!std::isfinite(m.x) || !std::isfinite(m.y) || !std::isfinite(m.z)) throw inputError(source, 0, "non-finite mu");
+  const glm::dvec3 origin = P.origin;
   const double deg = std::numbers::pi / 180.0;
-  glm::dmat3 R = rotationX(angle.x * deg) * rotationY(angle.y * deg) * rotationZ(angle.z * deg);
+  glm::dmat3 R = rotationX(P.angleDeg.x * deg) * rotationY(P.angleDeg.y * deg) * rotationZ(P.angleDeg.z * deg);
   glm::dmat3 A = R;
-  for (int c = 0; c < 3; ++c) A[c] *= length[c];   // A = R diag(L): column c scaled by L_c
+  for (int c = 0; c < 3; ++c) A[c] *= P.length[c];   // A = R diag(L): column c scaled by L_c
   L.frameLinear = glm::inverse(A);
   L.frameOffset = -(L.frameLinear * origin);
   L.controlPoints.resize(L.pointCount());
@@ -182,12 +200,14 @@ Lattice readPrm(const std::string& path, const std::string& text) {
       for (int k = 0; k < n[2]; ++k) {
         size_t id = L.index(i, j, k);
         glm::dvec3 s(double(i) / (n[0] - 1), double(j) / (n[1] - 1), double(k) / (n[2] - 1));
-        L.controlPoints[id] = origin + A * (s + mu[id]);
+        L.controlPoints[id] = origin + A * (s + (P.mu.empty() ? glm::dvec3(0.0) : P.mu[id]));
       }
   L.outside = OutsideMode::Keep;
-  validateLattice(L, path);
+  validateLattice(L, source);
   return L;
 }
+
+Lattice readPrm(const std::string& path, const std::string& text) { return latticeOfPrm(parsePrm(path, text), path); }
 
 // ---------------------------------------------------------------------------------------------------
 // .npy (numpy format 1.0/2.0/3.0): a little-endian float32 or float64 array of shape (mu, mv, mw, 3) in
@@ -401,10 +421,23 @@ void writePrm(const std::string& path, const Lattice& L) {
   for (int c = 0; c < 3; ++c) off = std::max(off, glm::length(back[c] - R[c]));
   if (!(off < 1e-9))
     throw inputError(path, 0, "the lattice's box is not a rotated rectangular box, which is all a .prm file can hold: write .json");
-  if (L.outside != OutsideMode::Keep) {
-    // PyGeM leaves points outside the box unmoved; the lattice asked to extrapolate them. Said in the file.
-  }
   const double deg = 180.0 / std::numbers::pi;
+  PygemParameters P;
+  P.counts = L.counts, P.origin = origin, P.length = length, P.angleDeg = glm::dvec3(ax, ay, az) * deg;
+  // Displacements normalised by the box: mu = A^-1 (P - origin) - s.
+  const glm::dmat3 Ainv = glm::inverse(A);
+  P.mu.resize(L.pointCount());
+  for (int i = 0; i < L.counts[0]; ++i)
+    for (int j = 0; j < L.counts[1]; ++j)
+      for (int k = 0; k < L.counts[2]; ++k) {
+        const glm::dvec3 s(double(i) / (L.counts[0] - 1), double(j) / (L.counts[1] - 1), double(k) / (L.counts[2] - 1));
+        P.mu[L.index(i, j, k)] = Ainv * (L.controlPoints[L.index(i, j, k)] - origin) - s;
+      }
+  writePrmParameters(path, P);
+}
+
+void writePrmParameters(const std::string& path, const PygemParameters& P) {
+  latticeOfPrm(P, path);   // the same checks as reading
   auto num = [](double v) {
     std::string s;
     io::appendNumber(s, v, 0);
@@ -412,23 +445,20 @@ void writePrm(const std::string& path, const Lattice& L) {
   };
   static const char* xyz[3] = {"x", "y", "z"};
   std::string t = "[Box info]\n# Written by sffd: PyGeM's FFD parameters (points outside the box are left unmoved).\n";
-  for (int a = 0; a < 3; ++a) t += std::string("n control points ") + xyz[a] + ": " + std::to_string(L.counts[a]) + "\n";
-  for (int a = 0; a < 3; ++a) t += std::string("box length ") + xyz[a] + ": " + num(length[a]) + "\n";
-  for (int a = 0; a < 3; ++a) t += std::string("box origin ") + xyz[a] + ": " + num(origin[a]) + "\n";
-  const double angle[3] = {ax * deg, ay * deg, az * deg};
-  for (int a = 0; a < 3; ++a) t += std::string("rotation angle ") + xyz[a] + ": " + num(angle[a]) + "\n";
-  // Displacements normalised by the box: mu = A^-1 (P - origin) - s.
-  const glm::dmat3 Ainv = glm::inverse(A);
+  for (int a = 0; a < 3; ++a) t += std::string("n control points ") + xyz[a] + ": " + std::to_string(P.counts[a]) + "\n";
+  for (int a = 0; a < 3; ++a) t += std::string("box length ") + xyz[a] + ": " + num(P.length[a]) + "\n";
+  for (int a = 0; a < 3; ++a) t += std::string("box origin ") + xyz[a] + ": " + num(P.origin[a]) + "\n";
+  for (int a = 0; a < 3; ++a) t += std::string("rotation angle ") + xyz[a] + ": " + num(P.angleDeg[a]) + "\n";
   t += "\n[Parameters weights]\n";
   for (int a = 0; a < 3; ++a) {
     t += std::string("parameter ") + xyz[a] + ":";
     bool first = true;
-    for (int i = 0; i < L.counts[0]; ++i)
-      for (int j = 0; j < L.counts[1]; ++j)
-        for (int k = 0; k < L.counts[2]; ++k) {
-          const glm::dvec3 s(double(i) / (L.counts[0] - 1), double(j) / (L.counts[1] - 1), double(k) / (L.counts[2] - 1));
-          const glm::dvec3 mu = Ainv * (L.controlPoints[L.index(i, j, k)] - origin) - s;
-          t += (first ? " " : "    ") + std::to_string(i) + " " + std::to_string(j) + " " + std::to_string(k) + " " + num(mu[a]) + "\n";
+    for (int i = 0; i < P.counts[0]; ++i)
+      for (int j = 0; j < P.counts[1]; ++j)
+        for (int k = 0; k < P.counts[2]; ++k) {
+          const size_t id = (size_t(i) * P.counts[1] + j) * P.counts[2] + k;
+          const double mu = P.mu.empty() ? 0.0 : P.mu[id][a];
+          t += (first ? " " : "    ") + std::to_string(i) + " " + std::to_string(j) + " " + std::to_string(k) + " " + num(mu) + "\n";
           first = false;
         }
   }

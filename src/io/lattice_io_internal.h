@@ -11,11 +11,15 @@ Lattice readLatticeBytes(const std::string& path, std::string text, const Lattic
 
 Lattice readJson(const std::string& path, const std::string& text);
 Lattice readPrm(const std::string& path, const std::string& text);
+// readPrm in two steps (the PyGeM parameters of <sffd/lattice.h>): the file's values, then their lattice.
+PygemParameters parsePrm(const std::string& path, const std::string& text);
+Lattice latticeOfPrm(const PygemParameters& parameters, const std::string& source);
 Lattice readNpy(const std::string& path, const std::string& text, const LatticeReadOptions& options);
 
 // The .npy (control points only, float64) and .prm (PyGeM; one Bezier box, a rotated box) forms.
 void writeNpy(const std::string& path, const Lattice& lattice);
 void writePrm(const std::string& path, const Lattice& lattice);
+void writePrmParameters(const std::string& path, const PygemParameters& parameters);
 
 // Most control points a lattice file may ask for (checked before anything is allocated).
 constexpr size_t kMaxControlPoints = size_t(1) << 24;

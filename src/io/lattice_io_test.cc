@@ -136,6 +136,29 @@ TEST_F(LatticeIo, PrmIdentityIsUndeformed) {
   for (size_t i = 0; i < L.controlPoints.size(); ++i) EXPECT_LT(glm::length(I.controlPoints[i] - L.controlPoints[i]), 1e-12 * 100);
 }
 
+
+// The PyGeM parameters (what the Python package's sffd.FFD holds): the file's values exactly, the
+// same lattice as readLattice, written and read back to the same values.
+TEST_F(LatticeIo, PygemParametersRoundTrip) {
+  const std::string prm = kData + "/pygem/rotation_convention/parameters_sphere.prm";
+  PygemParameters P = readPygemParameters(prm);
+  EXPECT_EQ(P.counts, (std::array<int, 3>{3, 2, 2}));
+  EXPECT_EQ(P.angleDeg, glm::dvec3(20.3, 11.0, 0.0));
+  ASSERT_EQ(P.mu.size(), 12u);
+  EXPECT_EQ(P.mu[(0 * 2 + 1) * 2 + 1], glm::dvec3(0.0, 0.0, -0.456229852));
+  Lattice A = pygemLattice(P), B = readLattice(prm);
+  EXPECT_EQ(A.controlPoints, B.controlPoints);
+  EXPECT_TRUE(sameLatticeStructure(A, B));
+  writePygemParameters(path("again.prm"), P);
+  PygemParameters Q = readPygemParameters(path("again.prm"));
+  EXPECT_EQ(Q.mu, P.mu);
+  EXPECT_EQ(Q.origin, P.origin);
+  EXPECT_EQ(Q.length, P.length);
+  EXPECT_EQ(Q.angleDeg, P.angleDeg);
+  P.counts[0] = 7;
+  expectInputError([&] { pygemLattice(P); }, "PyGeM parameters", 0, "2..6 are supported");
+  expectInputError([&] { readPygemParameters(path("missing.prm")); }, path("missing.prm"), 0, "");
+}
 TEST_F(LatticeIo, PrmSyntax) {
   // "key = value", keys in any case, values on the key line, comments, a repeated entry overrides.
   std::string prm =

@@ -1,0 +1,153 @@
+// sffd.deform, sffd.Deformer and sffd.deform_points (<sffd/deformer.h>): the caller's arrays become a
+// MeshView, the result Mesh becomes fresh arrays.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <sffd/sffd.h>
+
+#include "arrays.h"
+
+namespace py = pybind11;
+using namespace py::literals;
+
+namespace sffd::python {
+namespace {
+
+using DeviceFor = std::shared_ptr<Device> (*)(py::handle);
+DeviceFor gDeviceFor = nullptr;
+
+Method methodOf(const std::string& name) {
+  if (name == "smooth") return Method::Smooth;
+  if (name == "classic") return Method::Classic;
+  if (name == "accurate") return Method::Accurate;
+  throw Error(ErrorKind::Input, "method must be 'smooth', 'classic' or 'accurate', not '" + name + "'");
+}
+
+Precision precisionOf(const std::string& name) {
+  if (name == "auto") return Precision::Auto;
+  if (name == "float") return Precision::Float;
+  if (name == "double") return Precision::Double;
+  throw Error(ErrorKind::Input, "precision must be 'auto', 'float' or 'double', not '" + name + "'");
+}
+
+py::tuple meshArrays(const Mesh& m) { return py::make_tuple(toArray(m.positions), toArray(m.triangles), toArray(m.normals)); }
+
+// A Deformer and the device it runs on, which must outlive it (members are destroyed in reverse order).
+struct PyDeformer {
+  std::shared_ptr<Device> device;
+  std::unique_ptr<Deformer> deformer;
+};
+
+struct Inputs {
+  std::vector<glm::dvec3> positions, normals;
+  std::vector<uint32_t> triangles;
+  MeshView view() const {
+    MeshView v;
+    v.positions = &positions[0].x, v.vertexCount = positions.size();
+    if (!normals.empty()) v.normals = &normals[0].x;
+    v.triangles = triangles.data(), v.triangleCount = triangles.size() / 3;
+    return v;
+  }
+};
+
+Inputs inputsOf(py::handle vertices, py::handle triangles, py::handle normals) {
+  Inputs in;
+  in.positions = points(vertices, "vertices");
+  if (in.positions.empty()) throw Error(ErrorKind::Input, "vertices: no vertices");
+  in.triangles = triangleIndices(triangles, in.positions.size());
+  if (!normals.is_none()) {
+    in.normals = points(normals, "normals");
+    if (in.normals.size() != in.positions.size())
+      throw Error(ErrorKind::Input, "normals: expected one per vertex (" + std::to_string(in.positions.size()) + "), got " +
+                                        std::to_string(in.normals.size()));
+  }
+  return in;
+}
+
+PyDeformer makeDeformer(py::handle vertices, py::handle triangles, const Lattice& lattice, const std::string& method,
+                        py::handle backend, py::object edgeLength, int tess, py::handle normals, bool strict,
+                        const std::string& precision) {
+  DeformOptions o;
+  o.method = methodOf(method);
+  o.edgeLength = edgeLength.is_none() ? 0.0 : edgeLength.cast<double>();
+  o.tess = tess;
+  o.strict = strict;
+  o.precision = precisionOf(precision);
+  Inputs in = inputsOf(vertices, triangles, normals);
+  PyDeformer d;
+  d.device = gDeviceFor(backend);
+  d.deformer = std::make_unique<Deformer>(*d.device, in.view(), lattice, o);
+  return d;
+}
+
+}  // namespace
+
+void bindDeform(py::module_& m, DeviceFor deviceFor) {
+  gDeviceFor = deviceFor;
+  py::class_<PyDeformer>(m, "Deformer",
+                         "A mesh prepared once on a device for lattices of one structure; deform(lattice) as often as asked.")
+      .def(py::init(&makeDeformer), "vertices"_a, "triangles"_a, "lattice"_a, py::kw_only(), "method"_a = "smooth",
+           "backend"_a = "auto", "edge_length"_a = py::none(), "tess"_a = 10, "normals"_a = py::none(), "strict"_a = false,
+           "precision"_a = "auto")
+      .def(
+          "deform",
+          [](PyDeformer& d, const Lattice& lattice) {
+            d.deformer->deform(lattice);
+            return meshArrays(d.deformer->result());
+          },
+          "lattice"_a, "(vertices, triangles, normals) for the lattice's current control points.")
+      .def_property_readonly("device", [](const PyDeformer& d) { return d.device; })
+      .def_property_readonly("sub_triangles", [](const PyDeformer& d) { return d.deformer->subTriangles(); })
+      .def_property_readonly("timings", [](const PyDeformer& d) {
+        const Timings& t = d.deformer->timings();
+        return py::dict("pn_ms"_a = t.pnMs, "clip_ms"_a = t.clipMs, "deform_ms"_a = t.deformMs, "wall_ms"_a = t.wallMs);
+      });
+
+  m.def(
+      "deform",
+      [](py::handle vertices, py::handle triangles, const Lattice& lattice, const std::string& method, py::handle backend,
+         py::object edgeLength, int tess, py::handle normals, bool strict, const std::string& precision) {
+        PyDeformer d = makeDeformer(vertices, triangles, lattice, method, backend, edgeLength, tess, normals, strict, precision);
+        d.deformer->deform(lattice);
+        return meshArrays(d.deformer->result());
+      },
+      "vertices"_a, "triangles"_a, "lattice"_a, "method"_a = "smooth", "backend"_a = "auto", "edge_length"_a = py::none(),
+      "tess"_a = 10, "normals"_a = py::none(), "strict"_a = false, "precision"_a = "auto",
+      "Deforms a triangle mesh: (vertices, triangles, normals) as float64, uint32, float64 arrays.");
+
+  m.def(
+      "read_mesh", [](const std::string& path) { return meshArrays(readMesh(path)); }, "path"_a,
+      "Reads .obj .off .ply .stl .om (.bpt): (vertices, triangles, normals); normals computed where the file has none.");
+  m.def(
+      "write_mesh",
+      [](const std::string& path, py::handle vertices, py::handle triangles, py::handle normals) {
+        Inputs in = inputsOf(vertices, triangles, normals);
+        writeMesh(path, meshFromView(in.view()));
+      },
+      "path"_a, "vertices"_a, "triangles"_a, "normals"_a = py::none(), "Writes by extension (.obj .ply .off .stl).");
+
+  // Classic FFD of bare points (sffd.FFD.__call__). A Mesh needs a triangle: one degenerate triangle
+  // over point 0 is handed over, and fixed normals, so that none is computed; the kernel moves each
+  // point on its own.
+  m.def(
+      "deform_points",
+      [](py::handle pts, const Lattice& lattice, py::handle backend, const std::string& precision) {
+        Inputs in;
+        in.positions = points(pts, "points");
+        if (in.positions.empty()) return toArray(in.positions);
+        in.normals.assign(in.positions.size(), glm::dvec3(0, 0, 1));
+        in.triangles = {0, 0, 0};
+        std::shared_ptr<Device> device = gDeviceFor(backend);
+        DeformOptions o;
+        o.method = Method::Classic;
+        o.precision = precisionOf(precision);
+        Deformer d(*device, in.view(), lattice, o);
+        d.deform(lattice);
+        return toArray(d.result().positions);
+      },
+      "points"_a, "lattice"_a, "backend"_a = "auto", "precision"_a = "auto",
+      "Classic FFD of an (n, 3) array of points: an (n, 3) float64 array, the same order.");
+}
+
+}  // namespace sffd::python

@@ -1,0 +1,173 @@
+"""sffd.deform, sffd.Deformer and sffd.Lattice: identity and affine lattices, the CLI's output, errors,
+dtypes and strides, re-deforming, and memory over repeated calls."""
+import resource
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import sffd
+from conftest import CLI, DATA
+
+
+def test_devices():
+    found = sffd.devices()
+    assert any(d.label == "cpu" for d in found)
+    for d in found:
+        assert d.name and d.api in ("vulkan", "gl", "cpu") and d.type and d.label
+    assert sffd.device("cpu").api == "cpu"
+    assert sffd.device("cpu") is sffd.device("cpu")   # opened once, shared
+
+
+def test_identity_and_affine_lattices(sphere):
+    v, t, n = sphere
+    lat = sffd.Lattice.fitted(v, counts=(4, 5, 6), degree=(2, 3, 2))
+    out_v, out_t, out_n = sffd.deform(v, t, lat, method="classic", backend="cpu")
+    assert out_v.dtype == np.float64 and out_t.dtype == np.uint32 and out_n.shape == v.shape
+    np.testing.assert_allclose(out_v, v, rtol=0, atol=1e-12)
+    np.testing.assert_array_equal(out_t, t)   # classic: the input's topology
+    # B-splines reproduce affine maps: control points mapped by A x + b map every vertex so.
+    a = np.array([[1.2, 0.3, 0.0], [-0.1, 0.9, 0.2], [0.05, 0.0, 1.1]])
+    b = np.array([0.5, -1.0, 2.0])
+    lat.control_points = lat.control_points @ a.T + b
+    out_v, _, _ = sffd.deform(v, t, lat, method="classic", backend="cpu")
+    np.testing.assert_allclose(out_v, v @ a.T + b, rtol=0, atol=1e-12)
+
+
+def test_control_points_edit_in_place(sphere):
+    lat = sffd.Lattice.fitted(sphere[0])
+    before = lat.control_points.copy()
+    lat.control_points[3] += 0.1
+    assert np.allclose(lat.control_points[3] - before[3], 0.1)
+    view = lat.control_points
+    del lat   # the view keeps the lattice's storage alive
+    assert np.allclose(view[3] - before[3], 0.1)
+    lat = sffd.Lattice.fitted(sphere[0])
+    with pytest.raises(sffd.InputError, match="expected 125 points"):
+        lat.control_points = np.zeros((4, 3))
+    twisted = lat.preset("twist", 0.5)
+    assert not np.array_equal(twisted.control_points, lat.control_points)   # a new lattice; this one unchanged
+    assert lat.counts == (5, 5, 5) and lat.degree == (2, 2, 2) and lat.outside == "extrapolate"
+
+
+def test_smooth_equals_the_cli(sphere, tmp_path):
+    if not CLI.exists():
+        pytest.skip(f"no command-line tool at {CLI}")
+    v, t, n = sphere
+    lat = sffd.Lattice.fitted(v).preset("twist", 0.5)
+    lat.save(str(tmp_path / "twist.json"))
+    out = tmp_path / "out.ply"
+    subprocess.run([str(CLI), "deform", str(DATA / "sphere.obj"), "-l", str(tmp_path / "twist.json"), "--backend", "cpu",
+                    "-o", str(out), "--quiet"], check=True)
+    cli_v, cli_t, cli_n = sffd.read_mesh(str(out))
+    py_v, py_t, py_n = sffd.deform(v, t, lat, backend="cpu", normals=n)
+    assert py_t.shape == cli_t.shape and len(py_t) > 720
+    np.testing.assert_array_equal(py_t, cli_t)
+    # Float results, written with 9 significant digits: the same float32 values.
+    np.testing.assert_array_equal(py_v.astype(np.float32), cli_v.astype(np.float32))
+    np.testing.assert_allclose(py_n, cli_n, rtol=0, atol=1e-6)
+
+
+def test_bad_input_raises_sffds_message(sphere, tmp_path):
+    v, t, n = sphere
+    lat = sffd.Lattice.fitted(v)
+    with pytest.raises(sffd.InputError, match=r"vertex index 362 out of range 0\.\.361"):
+        sffd.deform(v, t + 1, lat, backend="cpu")
+    with pytest.raises(ValueError, match=r"vertices: expected shape \(n, 3\), got \(362, 2\)"):
+        sffd.deform(v[:, :2], t, lat)
+    with pytest.raises(sffd.InputError, match="method must be"):
+        sffd.deform(v, t, lat, method="fancy", backend="cpu")
+    with pytest.raises(sffd.InputError, match="the tessellation level must be"):
+        sffd.deform(v, t, lat, tess=0, backend="cpu")
+    with pytest.raises(sffd.InputError, match="unknown"):
+        lat.preset("wobble", 1.0)
+    missing = str(tmp_path / "missing.json")
+    with pytest.raises(sffd.Error) as e:
+        sffd.Lattice.from_file(missing)
+    assert str(e.value).startswith(missing) and "\n" not in str(e.value)
+    with pytest.raises(sffd.InputError, match=r"lattice_degree_too_high\.json"):
+        sffd.Lattice.from_file(str(DATA / "bad" / "lattice_degree_too_high.json"))
+    with pytest.raises(sffd.Error):
+        sffd.deform(v, t, lat, backend="no-such-device")
+
+
+def test_float32_and_non_contiguous_input(sphere):
+    v, t, n = sphere
+    lat = sffd.Lattice.fitted(v).preset("bend", 0.3)
+    ref = sffd.deform(v.astype(np.float32).astype(np.float64), t, lat, method="classic", backend="cpu")
+    got = sffd.deform(v.astype(np.float32), t.astype(np.int32), lat, method="classic", backend="cpu")
+    for a, b in zip(ref, got):
+        np.testing.assert_array_equal(a, b)
+    wide = np.zeros((len(v), 6))
+    wide[:, 1::2] = v
+    ref = sffd.deform(v, t, lat, backend="cpu", tess=3)
+    got = sffd.deform(wide[:, 1::2], np.asfortranarray(t), lat, backend="cpu", tess=3)
+    for a, b in zip(ref, got):
+        np.testing.assert_array_equal(a, b)
+
+
+@pytest.mark.parametrize("method", ["smooth", "classic"])
+def test_deformer_redeform_equals_fresh(sphere, method):
+    v, t, n = sphere
+    base = sffd.Lattice.fitted(v)
+    d = sffd.Deformer(v, t, base, method=method, backend="cpu", tess=4)
+    for name, amount in (("twist", 0.7), ("taper", 0.4)):
+        lat = base.preset(name, amount)
+        again = d.deform(lat)
+        fresh = sffd.deform(v, t, lat, method=method, backend="cpu", tess=4)
+        for a, b in zip(again, fresh):
+            np.testing.assert_array_equal(a, b)
+    assert d.timings["wall_ms"] >= 0
+    with pytest.raises(sffd.InputError, match="differ from the Deformer's"):
+        d.deform(sffd.Lattice.fitted(v, counts=(4, 4, 4)))
+
+
+def test_repeated_calls_do_not_leak(sphere):
+    v, t, n = sphere
+    lat = sffd.Lattice.fitted(v).preset("twist", 0.5)
+    d = sffd.Deformer(v, t, lat, backend="cpu", tess=4)
+
+    def calls(k):
+        for _ in range(k):
+            out = d.deform(lat)   # about 1.2 MB of arrays each
+            for _ in range(5):
+                sffd.deform(v, t, lat, method="classic", backend="cpu")
+                sffd.deform_points(v, lat, backend="cpu")
+        return out
+
+    out = calls(10)   # warm up: allocator pools, the device's buffers
+    before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss   # KiB
+    calls(60)
+    grown = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before
+    leaked_if_kept = 60 * sum(a.nbytes for a in out) // 1024
+    assert grown < leaked_if_kept // 4, f"max RSS grew by {grown} KiB over 60 calls ({leaked_if_kept} KiB of results made)"
+    positions = out[0]
+    del out
+    assert sys.getrefcount(positions) == 2   # nothing but this name holds the result (and the call's argument)
+
+
+def test_lattice_files_round_trip(sphere, tmp_path):
+    lat = sffd.Lattice.fitted(sphere[0], counts=(4, 5, 6)).preset("bulge", 0.3)
+    lat.save(str(tmp_path / "l.json"))
+    again = sffd.Lattice.from_file(str(tmp_path / "l.json"))
+    assert again.same_structure(lat)
+    np.testing.assert_array_equal(again.control_points, lat.control_points)
+    # .npy holds the control points only: the box and degree come from the caller.
+    lat.save(str(tmp_path / "l.npy"))
+    lo = [k[d] for k, d in zip(lat.knots, lat.degree)]
+    hi = [k[-d - 1] for k, d in zip(lat.knots, lat.degree)]
+    again = sffd.Lattice.from_file(str(tmp_path / "l.npy"), box=(lo, hi), degree=lat.degree)
+    assert again.counts == (4, 5, 6)
+    np.testing.assert_array_equal(again.control_points, lat.control_points)
+    np.testing.assert_allclose(np.concatenate(again.knots), np.concatenate(lat.knots), rtol=0, atol=1e-15)
+
+
+@pytest.mark.parametrize("label", [d.label for d in sffd.devices()])
+def test_every_device_gives_the_cpu_bits_in_strict_mode(sphere, label):
+    v, t, n = sphere
+    lat = sffd.Lattice.fitted(v).preset("twist", 0.6)
+    ref = sffd.deform(v, t, lat, backend="cpu", tess=3, strict=True)
+    got = sffd.deform(v, t, lat, backend=label, tess=3, strict=True)
+    for a, b in zip(ref, got):
+        np.testing.assert_array_equal(a, b)
