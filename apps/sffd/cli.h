@@ -7,6 +7,7 @@
 #include <vector>
 
 #include <sffd/device.h>
+#include <sffd/error.h>
 
 #include "model/lattice.h"
 #include "model/mesh.h"
@@ -80,6 +81,14 @@ std::vector<std::string> takeWarnings();
 // Reads a mesh; what the reader repaired or skipped becomes warnings (warnOnSuccess).
 Mesh readMeshWarning(const std::string& path, const MeshReadOptions& options = {});
 
+// SFFD_MEMORY_LIMIT as bytes (0 when unset: physical memory); an input Error when it does not parse.
+uint64_t memoryLimitFromEnvironment();
+// Runs `f`, naming a memory limit the library reports as one of its options SFFD_MEMORY_LIMIT instead.
+template <class F>
+auto withToolLimitName(F&& f) -> decltype(f());
+// The message of `e` with the library's name of the limit replaced by SFFD_MEMORY_LIMIT.
+std::string toolLimitMessage(std::string what);
+
 // SFFD_MAX_CHUNK_* (elements per chunk, to test chunking): the value of the variable `name`, at
 // least 1; 0 when it is not set (no limit).
 size_t chunkFromEnvironment(const char* name);
@@ -103,5 +112,16 @@ CommandSpec errorCommand();
 CommandSpec renderCommand();
 CommandSpec benchCommand();
 CommandSpec viewCommand();   // cmd_view.cpp (src/view)
+
+template <class F>
+auto withToolLimitName(F&& f) -> decltype(f()) {
+  try {
+    return f();
+  } catch (const Error& e) {
+    std::string what = toolLimitMessage(e.what());
+    if (what == e.what()) throw;
+    throw Error(e.kind(), what);
+  }
+}
 
 }  // namespace sffd::cli

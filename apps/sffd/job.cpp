@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 
 #include "apps/sffd/cli.h"
@@ -86,7 +87,8 @@ Job loadJob(const ParsedArgs& args) {
     lo.meshBoxHi /= *job.normalizedTo;
   }
   lo.haveMeshBox = !job.mesh.positions.empty();
-  job.lattice = readLattice(job.latticePath, lo);
+  lo.memoryLimit = memoryLimitFromEnvironment();
+  job.lattice = withToolLimitName([&] { return readLattice(job.latticePath, lo); });
   return job;
 }
 
@@ -123,6 +125,20 @@ void checkEdgeLength(const Mesh& mesh, double l) {
                   estimate, kMaxSubTriangles);
     throw Error(ErrorKind::Input, buf);
   }
+}
+
+uint64_t memoryLimitFromEnvironment() {
+  const char* s = std::getenv("SFFD_MEMORY_LIMIT");
+  if (!s || !*s) return 0;
+  uint64_t v = parseByteSize(s);
+  if (v == 0) throw Error(ErrorKind::Input, std::string("SFFD_MEMORY_LIMIT must be a size like 4096, 512M or 2G, not '") + s + "'");
+  return v;
+}
+
+std::string toolLimitMessage(std::string what) {
+  for (const char* name : {"(DeformOptions::memoryLimit)", "(LatticeReadOptions::memoryLimit)"})
+    if (size_t at = what.find(name); at != std::string::npos) what.replace(at, std::strlen(name), "(SFFD_MEMORY_LIMIT)");
+  return what;
 }
 
 size_t chunkFromEnvironment(const char* name) {
