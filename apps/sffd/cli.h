@@ -59,6 +59,10 @@ struct Job {
 };
 Job loadJob(const ParsedArgs& args);
 
+// A warning when the file's normals contradict the winding for most triangles (each face's geometric
+// normal against the mean of its corners' file normals); empty otherwise or without file normals.
+std::string normalsAgainstWindingWarning(const Mesh& mesh, const std::string& path);
+
 // Centers the mesh on its bounding box and scales it so its largest half-extent is `scale`.
 void normalizeMesh(Mesh& mesh, double scale);
 void meshBounds(const Mesh& mesh, glm::dvec3& lo, glm::dvec3& hi);

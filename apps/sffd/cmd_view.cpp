@@ -119,7 +119,7 @@ CommandSpec viewCommand() {
       {"--width", "W", "window width in pixels (default 1200)"},
       {"--height", "H", "window height in pixels (default 900)"},
       {"--view", "AZ,EL", "view direction in degrees, as for render (default 30,20)"},
-      {"--up", "AXIS", "the model's up axis: x, y, z, -x, -y, -z (default z)"},
+      {"--up", "AXIS", "the model's up axis: x, y, z, -x, -y, -z (default z; y-up scans and exports: y)"},
       {"--wireframe", nullptr, "start with the triangle edges drawn"},
       {"--replay", "SCRIPT", "run the commands of SCRIPT (one a line, see docs/CLI.md), then exit"},
       {"--out-dir", "DIR", "where screenshots and saved files go, and relative script paths point (default .)"},
