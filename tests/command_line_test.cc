@@ -71,6 +71,7 @@ TEST_F(CommandLine, DeviceWaitTimesOutAsADeviceError) {
   EXPECT_EQ(r.status, 3) << r.err;
   EXPECT_NE(r.err.find("did not finish its work within 1e-06 s (SFFD_DEVICE_TIMEOUT); the driver or GPU may be hung"), std::string::npos)
       << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;   // nothing from the validation layer either
   EXPECT_FALSE(fs::exists(dir_ / "o.obj"));
   // The default (60 s) and a generous override let the same job finish.
   RunResult ok = runSffd("deform " + box_ + " -l " + lattice_ + " --backend vulkan --quiet -o " + out("o.obj"), "SFFD_DEVICE_TIMEOUT=600");

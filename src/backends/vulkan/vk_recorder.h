@@ -20,7 +20,7 @@ class Recorder {
   Recorder(const Recorder&) = delete;
   Recorder& operator=(const Recorder&) = delete;
 
-  // After a wait that timed out: waits once more (the timeout again); false when the device is still busy.
+  // After a wait that timed out: waits once more (10 s); false when the device is still busy.
   bool settled();
   // Forgets every handle without destroying it: what a device still using them needs (a hung driver).
   void abandon();
