@@ -1,4 +1,7 @@
+#include <algorithm>
+#include <cctype>
 #include <charconv>
+#include <cstring>
 #include <cmath>
 #include <sstream>
 
@@ -35,9 +38,27 @@ const OptionSpec* findOption(const CommandSpec& spec, const std::string& arg, st
 
 }  // namespace
 
+namespace {
+
+// What the user probably meant by an extra positional argument: a lattice or output given without its option.
+std::string positionalHint(const CommandSpec& spec, const std::string& arg, const std::string& after) {
+  std::string canonical;
+  auto has = [&](const char* name) { return findOption(spec, name, canonical) != nullptr; };
+  if (!after.empty()) return " (" + after + " takes one value)";
+  std::string ext = arg.size() > 4 ? arg.substr(arg.size() - 5) : arg;
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  auto endsWith = [&](const char* e) { return ext.size() >= std::strlen(e) && ext.compare(ext.size() - std::strlen(e), std::string::npos, e) == 0; };
+  if (has("--lattice") && (endsWith(".json") || endsWith(".prm") || endsWith(".npy"))) return " (the lattice is given with -l)";
+  if (has("--output")) return " (the output is given with -o)";
+  return "";
+}
+
+}  // namespace
+
 ParsedArgs parseArgs(const CommandSpec& spec, int argc, char** argv) {
   ParsedArgs a;
   a.command = &spec;
+  std::string lastValued;   // the option whose value the previous argument was, for hints
   for (int i = 0; i < argc; ++i) {
     std::string arg = argv[i];
     if (arg.size() > 1 && arg[0] == '-' && !(arg.size() > 1 && (std::isdigit(arg[1]) || arg[1] == '.'))) {
@@ -48,26 +69,44 @@ ParsedArgs parseArgs(const CommandSpec& spec, int argc, char** argv) {
         value = arg.substr(eq + 1);
         arg = arg.substr(0, eq);
       }
-      std::string canonical;
+      std::string canonical, other;
       const OptionSpec* o = findOption(spec, arg, canonical);
       if (!o) throw usage("unknown option '" + arg + "' for 'sffd " + spec.name + "' (see sffd " + spec.name + " --help)");
+      lastValued.clear();
       if (o->value) {
         if (!inlineValue) {
           if (i + 1 >= argc) throw usage("option " + canonical + " needs a value (" + o->value + ")");
+          // "-l -o x": the next argument is an option of this command, not a value.
+          if (argv[i + 1][0] == '-' && findOption(spec, argv[i + 1], other))
+            throw usage("option " + canonical + " needs a value (" + o->value + "), not the option '" + argv[i + 1] + "'");
           value = argv[++i];
         }
+        // One value per option: "-l a -l b" would silently keep b.
+        if (auto it = a.values.find(canonical); it != a.values.end())
+          throw usage("option " + canonical + " is given twice ('" + it->second + "' and '" + value + "'); give it once");
         a.values[canonical] = value;
+        lastValued = canonical;
       } else {
         if (inlineValue) throw usage("option " + canonical + " takes no value");
         a.values[canonical] = "1";
       }
     } else {
+      if (a.positional.size() >= spec.maxPositional && !a.has("--help"))
+        throw usage("unexpected argument '" + arg + "'" + positionalHint(spec, arg, lastValued) + " (usage: sffd " + spec.name +
+                    " " + spec.usage + ")");
       a.positional.push_back(arg);
+      lastValued.clear();
     }
   }
   if (a.has("--help")) return a;
-  if (a.positional.size() < spec.minPositional || a.positional.size() > spec.maxPositional)
-    throw usage(std::string("usage: sffd ") + spec.name + " " + spec.usage);
+  if (a.positional.size() < spec.minPositional)
+  {
+    // The first placeholder of the usage line ("MESH") names what is missing.
+    std::string first = std::string(spec.usage).substr(0, std::string(spec.usage).find(' '));
+    bool placeholder = !first.empty() && std::all_of(first.begin(), first.end(), [](char c) { return std::isupper(static_cast<unsigned char>(c)) || c == '_'; });
+    throw usage("missing " + (placeholder && a.positional.empty() ? first : std::string("an argument")) + " (usage: sffd " + spec.name +
+                " " + spec.usage + ")");
+  }
   return a;
 }
 
@@ -113,12 +152,14 @@ std::array<int, 3> ParsedArgs::getTriple(const std::string& name, std::array<int
   while (std::getline(ss, part, ',')) {
     int v = 0;
     auto [p, ec] = std::from_chars(part.data(), part.data() + part.size(), v);
-    if (n >= 3 || ec != std::errc() || p != part.data() + part.size())
-      throw usage("option " + name + " needs three integers like 5,5,5, not '" + it->second + "'");
+    if (n >= 3 || ec != std::errc() || p != part.data() + part.size()) n = 4;
+    if (n >= 3) break;
     r[n++] = v;
   }
+  // The one rule of list options (docs/CLI.md): one value for every axis, or exactly three.
   if (n == 1) r = {r[0], r[0], r[0]};
-  else if (n != 3) throw usage("option " + name + " needs three integers like 5,5,5, not '" + it->second + "'");
+  else if (n != 3)
+    throw usage("option " + name + " needs one integer for all axes or three (U,V,W) like 5 or 5,6,7, not '" + it->second + "'");
   return r;
 }
 

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include <sffd/device.h>
+#include <sffd/error.h>
 
 #include "model/lattice.h"
 #include "model/mesh.h"
@@ -58,6 +59,10 @@ struct Job {
 };
 Job loadJob(const ParsedArgs& args);
 
+// A warning when the file's normals contradict the winding for most triangles (each face's geometric
+// normal against the mean of its corners' file normals); empty otherwise or without file normals.
+std::string normalsAgainstWindingWarning(const Mesh& mesh, const std::string& path);
+
 // Centers the mesh on its bounding box and scales it so its largest half-extent is `scale`.
 void normalizeMesh(Mesh& mesh, double scale);
 void meshBounds(const Mesh& mesh, glm::dvec3& lo, glm::dvec3& hi);
@@ -79,6 +84,14 @@ void warnOnSuccess(const std::string& line);
 std::vector<std::string> takeWarnings();
 // Reads a mesh; what the reader repaired or skipped becomes warnings (warnOnSuccess).
 Mesh readMeshWarning(const std::string& path, const MeshReadOptions& options = {});
+
+// SFFD_MEMORY_LIMIT as bytes (0 when unset: physical memory); an input Error when it does not parse.
+uint64_t memoryLimitFromEnvironment();
+// Runs `f`, naming a memory limit the library reports as one of its options SFFD_MEMORY_LIMIT instead.
+template <class F>
+auto withToolLimitName(F&& f) -> decltype(f());
+// The message of `e` with the library's name of the limit replaced by SFFD_MEMORY_LIMIT.
+std::string toolLimitMessage(std::string what);
 
 // SFFD_MAX_CHUNK_* (elements per chunk, to test chunking): the value of the variable `name`, at
 // least 1; 0 when it is not set (no limit).
@@ -103,5 +116,16 @@ CommandSpec errorCommand();
 CommandSpec renderCommand();
 CommandSpec benchCommand();
 CommandSpec viewCommand();   // cmd_view.cpp (src/view)
+
+template <class F>
+auto withToolLimitName(F&& f) -> decltype(f()) {
+  try {
+    return f();
+  } catch (const Error& e) {
+    std::string what = toolLimitMessage(e.what());
+    if (what == e.what()) throw;
+    throw Error(e.kind(), what);
+  }
+}
 
 }  // namespace sffd::cli

@@ -75,6 +75,8 @@ int run(const ParsedArgs& args) {
         {"output", {{"vertices", deformed.positions.size()}, {"triangles", deformed.triangles.size()}}},
         {"timings_ms", {{"pn", t.pnMs}, {"clip", t.clipMs}, {"deform", t.deformMs}, {"total", totalMs}}},
     };
+    // Smooth: the target edge length used (given, or a tenth of the mesh's largest extent); others: null.
+    j["edge_length"] = run.method == "smooth" ? nlohmann::ordered_json(edgeLengthOf(args, job.mesh)) : nlohmann::ordered_json();
     // --split: the deform steps (deform.sample, ...), which the fused kernel does not have.
     if (args.has("--split"))
       for (const auto& [step, ms] : t.steps)

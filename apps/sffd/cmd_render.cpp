@@ -153,7 +153,7 @@ CommandSpec renderCommand() {
       {"--width", "W", "picture width in pixels (default 1200)"},
       {"--height", "H", "picture height in pixels (default 900)"},
       {"--view", "AZ,EL", "view direction in degrees: azimuth around the up axis, elevation (default 30,20)"},
-      {"--up", "AXIS", "the model's up axis: x, y, z, -x, -y, -z (default z)"},
+      {"--up", "AXIS", "the model's up axis: x, y, z, -x, -y, -z (default z; y-up scans and exports: y)"},
       {"--wireframe", nullptr, "draw the triangle edges over the shading"},
       {"--compare", "WHAT", "classic|input: draw it on the left, the --method result on the right"},
       {"--color-by", "WHAT", "geometry|normal: colour the result by its error against the exact FFD (sffd error's metrics)"},

@@ -102,6 +102,7 @@ int run(const ParsedArgs& args) {
   o.samples = args.getInt("--samples", 0);
   o.split = args.has("--split");
   o.creaseAngleDeg = args.getDouble("--crease-angle", 40.0);
+  o.memoryLimit = memoryLimitFromEnvironment();   // each Deformer the viewer makes is checked against it
   const std::string precision = args.get("--precision", "auto");
   if (precision != "auto" && precision != "float" && precision != "double")
     throw usageError("--precision must be auto, float or double");
@@ -119,7 +120,7 @@ CommandSpec viewCommand() {
       {"--width", "W", "window width in pixels (default 1200)"},
       {"--height", "H", "window height in pixels (default 900)"},
       {"--view", "AZ,EL", "view direction in degrees, as for render (default 30,20)"},
-      {"--up", "AXIS", "the model's up axis: x, y, z, -x, -y, -z (default z)"},
+      {"--up", "AXIS", "the model's up axis: x, y, z, -x, -y, -z (default z; y-up scans and exports: y)"},
       {"--wireframe", nullptr, "start with the triangle edges drawn"},
       {"--replay", "SCRIPT", "run the commands of SCRIPT (one a line, see docs/CLI.md), then exit"},
       {"--out-dir", "DIR", "where screenshots and saved files go, and relative script paths point (default .)"},

@@ -14,13 +14,6 @@
 #include "pipelines/deformer_internal.h"
 
 namespace sffd::cli {
-namespace {
-
-// The library's name for a limit the tool took from SFFD_MEMORY_LIMIT, in its messages.
-constexpr const char* kLibraryLimitName = "(DeformOptions::memoryLimit)";
-
-}  // namespace
-
 Method methodOf(const std::string& name) {
   if (name == "smooth") return Method::Smooth;
   if (name == "accurate") return Method::Accurate;
@@ -38,6 +31,7 @@ double edgeLengthOf(const ParsedArgs& args, const Mesh& mesh) {
 DeformOptions deformOptionsOf(const ParsedArgs& args, const Job& job, Device& device, Method method) {
   DeformOptions o;
   o.method = method;
+  o.memoryLimit = memoryLimitFromEnvironment();
   o.precision = wantDouble(args, device.info(), method != Method::Smooth) ? Precision::Double : Precision::Float;
   o.strict = args.has("--strict");
   o.clip = args.get("--clip", "regular") == "knot-box" ? Clip::KnotBox : Clip::Regular;
@@ -51,11 +45,6 @@ DeformOptions deformOptionsOf(const ParsedArgs& args, const Job& job, Device& de
     checkEdgeLength(job.mesh, o.edgeLength);
     o.maxChunkElements = chunkFromEnvironment("SFFD_MAX_CHUNK_SUBTRIANGLES");
   } else {
-    if (const char* s = std::getenv("SFFD_MEMORY_LIMIT"); s && *s) {
-      o.memoryLimit = parseByteSize(s);
-      if (o.memoryLimit == 0)
-        throw Error(ErrorKind::Input, std::string("SFFD_MEMORY_LIMIT must be a size like 4096, 512M or 2G, not '") + s + "'");
-    }
     o.maxChunkElements = chunkFromEnvironment(method == Method::Classic ? "SFFD_MAX_CHUNK_VERTICES" : "SFFD_MAX_CHUNK_PATCHES");
   }
   return o;
@@ -71,16 +60,7 @@ DeformRun runMethod(const ParsedArgs& args, Job& job, Device& device, Method met
   DeformOptions o = deformOptionsOf(args, job, device, method);
   auto line = std::make_shared<ProgressLine>(progressWanted(args));   // cleared also when a call throws
   o.progress = line->callback();
-  auto make = [&] {
-    try {
-      return Deformer(device, job.mesh, job.lattice, o);
-    } catch (const Error& e) {
-      std::string what = e.what();
-      size_t at = what.find(kLibraryLimitName);
-      if (at == std::string::npos) throw;
-      throw Error(e.kind(), what.replace(at, std::string(kLibraryLimitName).size(), "(SFFD_MEMORY_LIMIT)"));
-    }
-  };
+  auto make = [&] { return withToolLimitName([&] { return Deformer(device, job.mesh, job.lattice, o); }); };
   const char* name = method == Method::Smooth ? "smooth" : method == Method::Accurate ? "accurate" : "classic";
   DeformRun run{name, method == Method::Accurate ? "knot-box" : args.get("--clip", "regular"), line, make(), {}};
   run.deformer.deform(job.lattice);

@@ -17,8 +17,7 @@ Method methodOf(const std::string& name);
 
 // The job options (--clip, --edge-length, --tess, --samples, --split, --precision, --strict,
 // --crease-angle) for `method` on `device`, and what the library takes as options but the tool reads
-// from the environment: SFFD_MEMORY_LIMIT (classic and accurate, the methods with a host-memory
-// estimate) and SFFD_MAX_CHUNK_VERTICES, _PATCHES, _SUBTRIANGLES (classic, accurate, smooth).
+// from the environment: SFFD_MEMORY_LIMIT (every method) and SFFD_MAX_CHUNK_VERTICES, _PATCHES, _SUBTRIANGLES (classic, accurate, smooth).
 DeformOptions deformOptionsOf(const ParsedArgs& args, const Job& job, Device& device, Method method);
 
 class ProgressLine;

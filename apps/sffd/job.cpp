@@ -1,12 +1,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 
 #include "apps/sffd/cli.h"
 #include <sffd/error.h>
 #include "core/job_budget.h"
 #include "io/lattice_io.h"
+#include "model/mesh.h"
 
 namespace sffd::cli {
 namespace fs = std::filesystem;
@@ -18,11 +20,12 @@ std::vector<OptionSpec> jobOptions() {
       {"--device", "SUBSTRING", "use the first device whose name contains SUBSTRING"},
       {"--method", "NAME", "smooth|accurate|classic (default smooth)"},
       {"--clip", "NAME", "regular|knot-box sub-triangle clipping (default regular)"},
-      {"--edge-length", "L", "target sub-triangle edge length l, in model units"},
+      {"--edge-length", "L", "target sub-triangle edge length l, in model units (default a tenth of the mesh's largest extent)"},
       {"--tess", "N", "tessellation level of each patch (default 10)"},
       {"--split", nullptr, "smooth: run the deform steps as separate dispatches (per-step timings in --stats)"},
       {"--samples", "S", "smooth: sampling density s of the fit (default nu+nv+nw; 6 is the reference implementation's)"},
       {"--crease-angle", "DEG", "crease threshold for meshes without normals (default 40)"},
+      {"--ignore-normals", nullptr, "recompute the normals from the winding instead of reading them from the file"},
       {"--bpt-resolution", "N", ".bpt input: grid segments per patch side (default 10: 200 triangles a patch)"},
       {"--normalize", "S", "center the mesh on its box and scale its largest half-extent to S (.npy: 0.99)"},
       {"--degree", "U,V,W", ".npy lattices: B-spline degree per axis (default 2,2,2)"},
@@ -32,6 +35,24 @@ std::vector<OptionSpec> jobOptions() {
       {"--quiet", nullptr, "no notes on stderr"},
       {"--help|-h", nullptr, "show this help"},
   };
+}
+
+std::string normalsAgainstWindingWarning(const Mesh& mesh, const std::string& path) {
+  if (!mesh.normalsFromFile) return {};
+  size_t against = 0, judged = 0;
+  for (const auto& t : mesh.triangles) {
+    const glm::dvec3 &a = mesh.positions[t[0]], &b = mesh.positions[t[1]], &c = mesh.positions[t[2]];
+    const glm::dvec3 face = glm::cross(b - a, c - a);
+    const glm::dvec3 mean = mesh.normals[t[0]] + mesh.normals[t[1]] + mesh.normals[t[2]];
+    const double d = glm::dot(face, mean);
+    if (d == 0 || !std::isfinite(d)) continue;   // no area, or normals that cancel: no say
+    ++judged;
+    against += d < 0;
+  }
+  if (judged == 0 || 2 * against <= judged) return {};
+  const int percent = int(std::lround(100.0 * double(against) / double(judged)));
+  return path + ": the file's normals point against the winding for " + std::to_string(percent) +
+         "% of the triangles; the result follows the normals (--ignore-normals recomputes them from the winding)";
 }
 
 void meshBounds(const Mesh& mesh, glm::dvec3& lo, glm::dvec3& hi) {
@@ -65,6 +86,12 @@ Job loadJob(const ParsedArgs& args) {
     if (read.bptResolution < 1 || read.bptResolution > 1000) throw Error(ErrorKind::Input, "--bpt-resolution must be 1..1000");
   }
   job.mesh = readMeshWarning(job.meshPath, read);
+  if (args.has("--ignore-normals") && job.mesh.normalsFromFile) {
+    computeVertexNormals(job.mesh);
+    job.mesh.normalsFromFile = false;
+  } else if (std::string w = normalsAgainstWindingWarning(job.mesh, job.meshPath); !w.empty()) {
+    warnOnSuccess(w);
+  }
   std::string ext = fs::path(job.latticePath).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
   if (args.has("--normalize")) {
@@ -86,7 +113,8 @@ Job loadJob(const ParsedArgs& args) {
     lo.meshBoxHi /= *job.normalizedTo;
   }
   lo.haveMeshBox = !job.mesh.positions.empty();
-  job.lattice = readLattice(job.latticePath, lo);
+  lo.memoryLimit = memoryLimitFromEnvironment();
+  job.lattice = withToolLimitName([&] { return readLattice(job.latticePath, lo); });
   return job;
 }
 
@@ -123,6 +151,20 @@ void checkEdgeLength(const Mesh& mesh, double l) {
                   estimate, kMaxSubTriangles);
     throw Error(ErrorKind::Input, buf);
   }
+}
+
+uint64_t memoryLimitFromEnvironment() {
+  const char* s = std::getenv("SFFD_MEMORY_LIMIT");
+  if (!s || !*s) return 0;
+  uint64_t v = parseByteSize(s);
+  if (v == 0) throw Error(ErrorKind::Input, std::string("SFFD_MEMORY_LIMIT must be a size like 4096, 512M or 2G, not '") + s + "'");
+  return v;
+}
+
+std::string toolLimitMessage(std::string what) {
+  for (const char* name : {"(DeformOptions::memoryLimit)", "(LatticeReadOptions::memoryLimit)"})
+    if (size_t at = what.find(name); at != std::string::npos) what.replace(at, std::strlen(name), "(SFFD_MEMORY_LIMIT)");
+  return what;
 }
 
 size_t chunkFromEnvironment(const char* name) {

@@ -73,6 +73,10 @@ struct LatticeReadOptions {
   // (--normalize, 0.99 by default). Required for .npy.
   bool haveMeshBox = false;
   glm::dvec3 meshBoxLo{0.0}, meshBoxHi{0.0};
+  // Bytes of host memory the lattice may need to be evaluated (control points, per-knot-box Bezier
+  // form, kernel form); a larger one is refused before anything is allocated. 0: physical memory
+  // (or the container's limit when lower).
+  uint64_t memoryLimit = 0;
 };
 
 // Reads by extension: .json (native), .prm (PyGeM), .npy (an array of control points). Throws an

@@ -265,6 +265,16 @@ TEST(Deformer, OptionsAreCheckedAndDefaulted) {
     EXPECT_EQ(e.kind(), ErrorKind::Input);
     EXPECT_NE(std::string(e.what()).find("memoryLimit"), std::string::npos) << e.what();
   }
+  // Smooth too, before anything is allocated (issue 12: smooth jobs ignored the limit).
+  DeformOptions smooth;
+  smooth.memoryLimit = 64 << 10;
+  try {
+    Deformer(device, mesh, lattice, smooth);
+    ADD_FAILURE() << "the memory limit was not applied to smooth";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Input);
+    EXPECT_NE(std::string(e.what()).find("(DeformOptions::memoryLimit)"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

@@ -123,6 +123,77 @@ uint64_t hostMemoryLimit(uint64_t requested) {
   return limit;
 }
 
+uint64_t estimateLatticeBytes(const Lattice& L) {
+  double boxes = 1, perBox = 1, points = 1;
+  for (int a = 0; a < 3; ++a) {
+    // Knot boxes: the distinct knot values in the domain, less one (counts - degree when uniform).
+    double distinct = 0, last = 0;
+    const auto& k = L.knots[a];
+    for (size_t i = size_t(L.degree[a]); i <= size_t(L.counts[a]) && i < k.size(); ++i)
+      if (distinct == 0 || k[i] != last) ++distinct, last = k[i];
+    boxes *= k.empty() ? double(L.counts[a] - L.degree[a]) : std::max(1.0, distinct - 1);
+    perBox *= L.degree[a] + 1;
+    points *= L.counts[a];
+  }
+  const double coeffs = boxes * perBox;
+  // Points (dvec3), the box form (dvec3), the packed form (4 doubles) and its kernel copy (4 doubles at
+  // most): all alive at once while a method uploads the lattice.
+  const double bytes = points * 24 + coeffs * (24 + 32 + 32);
+  return bytes >= 1.8e19 ? UINT64_MAX : uint64_t(bytes);
+}
+
+namespace {
+
+std::string limitText(uint64_t limit, uint64_t memoryLimit, const char* limitName) {
+  return formatBytes(limit) + (memoryLimit ? " (" + std::string(limitName) + ")" : std::string(" (physical memory)"));
+}
+
+}  // namespace
+
+std::string latticeTooLarge(const Lattice& L, uint64_t memoryLimit, const char* limitName) {
+  const uint64_t limit = hostMemoryLimit(memoryLimit), need = estimateLatticeBytes(L);
+  if (limit == 0 || need <= limit) return {};
+  uint64_t boxes = 1;
+  for (int a = 0; a < 3; ++a) boxes *= uint64_t(std::max(1, L.counts[a] - L.degree[a]));
+  const std::string dims = std::to_string(L.counts[0]) + "x" + std::to_string(L.counts[1]) + "x" + std::to_string(L.counts[2]);
+  const std::string deg = std::to_string(L.degree[0]) + "," + std::to_string(L.degree[1]) + "," + std::to_string(L.degree[2]);
+  return "the " + dims + " lattice (up to " + std::to_string(boxes) + " knot boxes of degree " + deg + ") needs about " +
+         formatBytes(need) + " of host memory to evaluate, more than the limit of " + limitText(limit, memoryLimit, limitName) +
+         "; use fewer control points";
+}
+
+JobEstimate estimateSmoothJob(const Mesh& mesh, double S, int level, size_t realBytes, bool deviceIsHost) {
+  const double nv = double((level + 1) * (level + 2) / 2), tris = double(level) * level, nt = double(mesh.triangles.size());
+  const double r4 = 4.0 * double(realBytes);   // one real4
+  // Device, per sub-triangle: header, record, patch and tessellation (positions and normals); per
+  // input triangle its PN record and about one clip triangle of 3 real4 corners and a header.
+  const double device = S * (16 + SFFD_SUB_STRIDE * r4 + SFFD_PATCH_STRIDE * r4 + 2 * nv * r4) +
+                        nt * (SFFD_PN_STRIDE * r4 + 3 * r4 + 16) + double(meshBytes(mesh, false));
+  // Host, per sub-triangle, at the peak (the weld, smooth's result()): the downloaded records (4
+  // doubles a real4), the pre-images and positions and normals of the patch vertices (9 doubles), the
+  // weld's two hash entries and the welded vertex with push_back's slack (about 256 bytes), the
+  // triangles; then the writer's position index (76 bytes a vertex, as for classic).
+  const double perSub = (16 + SFFD_SUB_STRIDE * 32.0) + 4 + nv * 72 + nv * 256 + tris * 24 + nv * 76;
+  // The input held by the Deformer, the session's copy and the prepared mesh, and per triangle the
+  // topology and clip triangles (about 256 bytes).
+  const double input = 3.0 * double(meshBytes(mesh, true)) + nt * 256;
+  JobEstimate e;
+  const double host = input + S * perSub + (deviceIsHost ? device : 0) + (1 << 20);
+  e.hostBytes = host >= 1.8e19 ? UINT64_MAX : uint64_t(host);
+  e.deviceBytes = device >= 1.8e19 ? UINT64_MAX : uint64_t(device);
+  e.chunkVertices = uint64_t(S * nv);
+  e.chunks = 1;
+  return e;
+}
+
+void checkHostFits(const JobEstimate& e, uint64_t memoryLimit, const char* limitName, const char* what) {
+  const uint64_t limit = hostMemoryLimit(memoryLimit);
+  if (limit > 0 && e.hostBytes > limit)
+    throw Error(ErrorKind::Input, std::string("the ") + what + " needs about " + formatBytes(e.hostBytes) +
+                                      " of host memory, more than the limit of " + limitText(limit, memoryLimit, limitName) +
+                                      "; use a smaller mesh, a longer --edge-length or a lower --tess");
+}
+
 void checkJobFits(const JobEstimate& e, const PackedLattice& P, size_t realBytes, const DeviceLimits* limits,
                   uint64_t memoryLimit, const char* limitName) {
   const uint64_t limit = hostMemoryLimit(memoryLimit);

@@ -52,6 +52,26 @@ uint64_t hostMemoryLimit(uint64_t requested);
 void checkJobFits(const JobEstimate& estimate, const PackedLattice& lattice, size_t realBytes, const DeviceLimits* limits,
                   uint64_t memoryLimit, const char* limitName = "memoryLimit");
 
+// The host memory a lattice needs to be evaluated, from its counts, degrees and knots alone (the
+// control points need not be there yet): the control points, the per-knot-box Bezier form (boxes x
+// (n+1)^3 points, extractBoxForm), the packed kernel form (4 doubles a coefficient, packLattice) and
+// its copy in the kernel's reals. What a reader checks before it allocates anything.
+uint64_t estimateLatticeBytes(const Lattice& lattice);
+
+// "the NxNxN lattice (up to B knot boxes of degree D) needs about X of host memory to evaluate, more
+// than the limit of Y (LIMITNAME); ..." when estimateLatticeBytes exceeds hostMemoryLimit(memoryLimit),
+// else empty.
+std::string latticeTooLarge(const Lattice& lattice, uint64_t memoryLimit, const char* limitName);
+
+// Estimate for `deform --method smooth` with about `subTriangles` sub-triangles at tessellation `level`
+// (docs/ROBUSTNESS.md "Limits"): the copies of the input, PN and clip records, the sub-triangle records,
+// patches and tessellation on the device and downloaded, the pre-images, the weld's index and the welded
+// result. `deviceIsHost`: the device's buffers are host memory (the CPU reference, software drivers).
+JobEstimate estimateSmoothJob(const Mesh& mesh, double subTriangles, int level, size_t realBytes, bool deviceIsHost);
+
+// Throws the input Error of checkJobFits for host bytes above the limit (no device-range check).
+void checkHostFits(const JobEstimate& estimate, uint64_t memoryLimit, const char* limitName, const char* what);
+
 // "1.50 GiB" style.
 std::string formatBytes(uint64_t bytes);
 

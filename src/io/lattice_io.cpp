@@ -30,9 +30,14 @@
 #include <sffd/error.h>
 #include "io/io_util.h"
 #include "io/lattice_io_internal.h"
+#include "core/job_budget.h"
 
 namespace sffd {
 namespace latticeio {
+
+// How a memory limit given is named in messages (the tool renames it SFFD_MEMORY_LIMIT).
+constexpr const char* kLimitName = "LatticeReadOptions::memoryLimit";
+
 namespace {
 
 using json = nlohmann::json;
@@ -149,7 +154,7 @@ std::string stripNlohmannPrefix(const std::string& what) {
 
 }  // namespace
 
-Lattice readJson(const std::string& path, const std::string& text) {
+Lattice readJson(const std::string& path, const std::string& text, uint64_t memoryLimit) {
   LineMap lines(text);
   json j;
   try {
@@ -280,6 +285,8 @@ Lattice readJson(const std::string& path, const std::string& text) {
   if (j.contains("control_points") && j.contains("displacements"))
     throw fail("/displacements", "give either control_points or displacements, not both");
   const char* pointsKey = j.contains("control_points") ? "control_points" : j.contains("displacements") ? "displacements" : nullptr;
+  // A few bytes of counts can ask for gigabytes: refused before the points are made.
+  if (std::string big = latticeTooLarge(L, memoryLimit, kLimitName); !big.empty()) throw fail("/counts", big);
   setIdentityControlPoints(L);
   if (pointsKey) {
     const json& pts = j[pointsKey];
@@ -338,9 +345,13 @@ Lattice readLatticeBytes(const std::string& path, std::string text, const Lattic
     std::string ext = io::lowerExtension(path);
     if (text.empty()) throw inputError(path, 0, "empty file");
     if (ext != ".npy") io::checkTextEncoding(path, text, false);   // no UTF-16, no binary; a UTF-8 BOM skipped
-    if (ext == ".json") return readJson(path, text);
-    if (ext == ".prm") return readPrm(path, text);
-    if (ext == ".npy") return readNpy(path, text, options);
+    if (ext == ".json") return readJson(path, text, options.memoryLimit);
+    if (ext == ".prm" || ext == ".npy") {
+      Lattice L = ext == ".prm" ? readPrm(path, text) : readNpy(path, text, options);
+      // The points are in the file; the box form, up to (n+1)^3 times more, is not.
+      if (std::string big = latticeTooLarge(L, options.memoryLimit, kLimitName); !big.empty()) throw inputError(path, 0, big);
+      return L;
+    }
     throw inputError(path, 0, "unknown lattice format " + io::quoted(ext));
   } catch (const Error& e) {
     throw Error(e.kind(), io::oneLine(e.what()));   // a message is one line, whatever the file held

@@ -9,7 +9,8 @@ namespace sffd::latticeio {
 // What readLattice does once the file is read: dispatch by the extension of `path` (used by the fuzz targets).
 Lattice readLatticeBytes(const std::string& path, std::string text, const LatticeReadOptions& options = {});
 
-Lattice readJson(const std::string& path, const std::string& text);
+// `memoryLimit`: as LatticeReadOptions::memoryLimit, checked before the control points are allocated.
+Lattice readJson(const std::string& path, const std::string& text, uint64_t memoryLimit = 0);
 Lattice readPrm(const std::string& path, const std::string& text);
 // readPrm in two steps (the PyGeM parameters of <sffd/lattice.h>): the file's values, then their lattice.
 PygemParameters parsePrm(const std::string& path, const std::string& text);

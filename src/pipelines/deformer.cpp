@@ -56,6 +56,8 @@ double stageMs(const std::vector<DispatchTiming>& dispatches, double wallMs) {
 
 namespace {
 
+constexpr const char* kLimitName = "DeformOptions::memoryLimit";
+
 ResolvedOptions resolve(const DeformOptions& o, const DeviceInfo& info, const Mesh& mesh, const Lattice& lattice) {
   ResolvedOptions r;
   r.method = o.method;
@@ -113,6 +115,8 @@ Deformer::Deformer(Device& device, const Mesh& mesh, const Lattice& lattice, con
   I.options = options;
   validateLattice(lattice, "lattice");
   I.resolved = resolve(options, device.info(), mesh, lattice);
+  if (std::string big = latticeTooLarge(lattice, options.memoryLimit, kLimitName); !big.empty())
+    throw Error(ErrorKind::Input, big);
   I.structure = lattice;
   I.input = mesh;
   const ResolvedOptions& r = I.resolved;
@@ -123,6 +127,12 @@ Deformer::Deformer(Device& device, const Mesh& mesh, const Lattice& lattice, con
     // Smooth FFD's pre-images index the mesh with its creases split (the error analysis needs it).
     if (!I.input.normalsFromFile) applyCreaseAngle(I.input, r.creaseAngleDeg);
     checkSmoothSize(I.input, r.edgeLength);
+    // Host and device memory before anything is allocated (docs/ROBUSTNESS.md "Limits").
+    const DeviceInfo& info = device.info();
+    const bool deviceIsHost = info.api == "cpu" || info.type == "cpu";
+    JobEstimate e = estimateSmoothJob(I.input, estimateSubTriangles(I.input, r.edgeLength), r.tess, r.variant.f64 ? 8 : 4, deviceIsHost);
+    e.hostBytes += estimateLatticeBytes(lattice);
+    checkHostFits(e, options.memoryLimit, kLimitName, "smooth job");
   }
   if (r.method == Method::Smooth) I.run = makeSmoothRun(backend, I.input, lattice, r, I.timings, progress);
   else if (r.method == Method::Classic) I.run = makeClassicRun(backend, I.input, lattice, r, I.timings, progress);

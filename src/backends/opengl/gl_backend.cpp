@@ -18,6 +18,7 @@
 
 #include <sffd/error.h>
 #include "backends/opengl/gl_state.h"
+#include "core/device_timeout.h"
 #include "core/kernel_registry.h"
 #include "kernels/common/shader_layout.h"
 
@@ -123,6 +124,7 @@ class GlBackend final : public Backend {
   }
 
   ~GlBackend() override {
+    if (hung_) return;   // the device may still use everything: leave it to the context's end
     try {
       ctx_->activate();
       glFinish();
@@ -203,7 +205,7 @@ class GlBackend final : public Backend {
     StateGuard state;
     state.buffer(GL_COPY_READ_BUFFER);
     glBindBuffer(GL_COPY_READ_BUFFER, b.name);
-    // Synchronous: waits for the dispatches that write the buffer.
+    waitIdle("download");   // bounded: glGetBufferSubData alone would wait forever on a hung driver
     glGetBufferSubData(GL_COPY_READ_BUFFER, static_cast<GLintptr>(offset), static_cast<GLsizeiptr>(bytes), data);
     checkGl("download");
   }
@@ -299,13 +301,27 @@ class GlBackend final : public Backend {
 
   void finish() override {
     ctx_->activate();
-    glFinish();
+    waitIdle("finish");
     checkGl("finish");
+  }
+
+  // Waits for every command issued so far, at most the device timeout (core/device_timeout.h).
+  void waitIdle(const char* what) {
+    GLsync sync = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+    if (!sync) return checkGl(what);
+    const GLenum r = glClientWaitSync(sync, GL_SYNC_FLUSH_COMMANDS_BIT, deviceTimeoutNs());
+    glDeleteSync(sync);
+    if (r == GL_TIMEOUT_EXPIRED) {
+      hung_ = true;
+      throw deviceError(deviceTimeoutMessage(info_.name));
+    }
+    checkGl(what);
   }
 
   std::vector<DispatchTiming> takeTimings() override {
     ctx_->activate();
     std::vector<DispatchTiming> out;
+    if (!pending_.empty()) waitIdle("timings");   // the query results below are then ready
     out.reserve(pending_.size());
     for (Pending& p : pending_) {
       DispatchTiming t;
@@ -433,6 +449,7 @@ class GlBackend final : public Backend {
   std::vector<Pending> pending_;
   std::vector<GLuint> freeQueries_;
   bool dirty_ = false;   // dispatches since the last barrier
+  bool hung_ = false;    // a wait timed out: the device may still use our objects
 };
 
 // A backend of one explicit provider, refused when its renderer does not match the device substring.

@@ -92,6 +92,12 @@ class VulkanBackend final : public Backend {
         recorder_(device_, kernels_.setLayout()) {}
 
   ~VulkanBackend() override {
+    // A device that timed out and still has not finished: nothing it may still use is freed.
+    if (!recorder_.settled()) {
+      recorder_.abandon();
+      device_.abandon();
+      return;
+    }
     // Submissions are waited for, so nothing should be in flight (unless a wait failed);
     // unsubmitted work is dropped with the command pool. A borrowed device's other queues are the
     // application's: only our queue is waited for.

@@ -43,6 +43,8 @@ class Device {
   const VkPhysicalDeviceProperties& properties() const { return props_; }
   const DeviceInfo& info() const { return info_; }
   bool owned() const { return owned_; }
+  // Leaves the VkDevice alive at destruction: a hung device may still run our work.
+  void abandon() { owned_ = false; }
 
   // Throws a device Error when memory runs out.
   Allocation allocate(uint64_t bytes, VkBufferUsageFlags usage, MemoryUse use);

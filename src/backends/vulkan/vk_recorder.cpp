@@ -1,4 +1,5 @@
 #include "backends/vulkan/vk_recorder.h"
+#include "core/device_timeout.h"
 
 #include <algorithm>
 #include <cstring>
@@ -40,6 +41,24 @@ Recorder::Recorder(Device& device, VkDescriptorSetLayout setLayout) : device_(de
 }
 
 Recorder::~Recorder() { destroy(); }
+
+bool Recorder::settled() {
+  if (!hung_) return true;
+  // A grace period of its own (not the timeout, which tests make tiny): a slow device finishes and is
+  // cleaned up as usual; a hung one costs 10 s more at exit.
+  const VkResult waited = device_.api().vkWaitForFences(device_.handle(), 1, &fence_, VK_TRUE, 10'000'000'000ull);
+  hung_ = waited != VK_SUCCESS;
+  return !hung_;
+}
+
+void Recorder::abandon() {
+  releases_.clear();
+  paramChunks_.clear();
+  descriptorPools_.clear();
+  queryPools_.clear();
+  fence_ = VK_NULL_HANDLE;
+  commandPool_ = VK_NULL_HANDLE;
+}
 
 void Recorder::destroy() {
   const Api& api = device_.api();
@@ -173,7 +192,13 @@ std::vector<DispatchTiming> Recorder::submitAndWait() {
   si.commandBufferCount = 1;
   si.pCommandBuffers = &commands_;
   check(api.vkQueueSubmit(device_.queue(), 1, &si, fence_), "vkQueueSubmit");
-  check(api.vkWaitForFences(dev, 1, &fence_, VK_TRUE, UINT64_MAX), "vkWaitForFences");
+  // A finite wait: a hung driver is a device error, not a hang (core/device_timeout.h).
+  const VkResult waited = api.vkWaitForFences(dev, 1, &fence_, VK_TRUE, deviceTimeoutNs());
+  if (waited == VK_TIMEOUT) {
+    hung_ = true;
+    throw deviceError(deviceTimeoutMessage(device_.info().name));
+  }
+  check(waited, "vkWaitForFences");
 
   std::vector<uint64_t> ticks(labels_.size() * 2);
   if (timestamps_) {

@@ -20,6 +20,10 @@ class Recorder {
   Recorder(const Recorder&) = delete;
   Recorder& operator=(const Recorder&) = delete;
 
+  // After a wait that timed out: waits once more (10 s); false when the device is still busy.
+  bool settled();
+  // Forgets every handle without destroying it: what a device still using them needs (a hung driver).
+  void abandon();
   // Whether commands were recorded since the last submission.
   bool active() const { return active_; }
   // The command buffer, begun on first use after a submission.
@@ -56,6 +60,7 @@ class Recorder {
   VkCommandPool commandPool_ = VK_NULL_HANDLE;
   VkCommandBuffer commands_ = VK_NULL_HANDLE;
   VkFence fence_ = VK_NULL_HANDLE;
+  bool hung_ = false;   // the last wait timed out
   bool active_ = false;
 
   std::vector<VkDescriptorPool> descriptorPools_;

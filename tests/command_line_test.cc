@@ -1,0 +1,82 @@
+// The command line says which argument is wrong (issue 12, item 10): unexpected positional arguments,
+// missing values, repeated options, the one rule of list options; and a device wait that times out is
+// a device error (exit 3), not a hang.
+#include <gtest/gtest.h>
+
+#include "tests/support/cli_runner.h"
+
+namespace sffd::test {
+namespace {
+
+void expectUsageError(const RunResult& r, const std::string& message) {
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("sffd: error: " + message), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+}
+
+class CommandLine : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = tempDir("command_line");
+    writeBoxObj(dir_ / "box.obj", 0, 0, 0, 0.5);
+    box_ = (dir_ / "box.obj").string();
+    lattice_ = (dir_ / "l.json").string();
+    ASSERT_EQ(runSffd("lattice " + box_ + " -o " + lattice_ + " --quiet").status, 0);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string out(const char* name) const { return (dir_ / name).string(); }
+  fs::path dir_;
+  std::string box_, lattice_;
+};
+
+TEST_F(CommandLine, UnexpectedAndMissingArgumentsAreNamed) {
+  expectUsageError(runSffd("deform " + box_ + " " + lattice_ + " " + out("o.obj")),
+                   "unexpected argument '" + lattice_ + "' (the lattice is given with -l)");
+  expectUsageError(runSffd("lattice " + box_ + " -o " + out("x.json") + " --preset twist 0.5"),
+                   "unexpected argument '0.5' (--preset takes one value)");
+  expectUsageError(runSffd("deform " + box_ + " -l " + lattice_ + " " + out("o.obj")), "unexpected argument '" + out("o.obj") + "'");
+  expectUsageError(runSffd("deform -l " + lattice_ + " -o " + out("o.obj")), "missing MESH (usage: sffd deform MESH");
+  expectUsageError(runSffd("deform " + box_ + " -l -o " + out("o.obj")), "option --lattice needs a value (FILE), not the option '-o'");
+  expectUsageError(runSffd("deform " + box_ + " -o " + out("o.obj") + " -l"), "option --lattice needs a value (FILE)");
+  // A negative number is a value, not an option.
+  EXPECT_EQ(runSffd("lattice " + box_ + " -o " + out("x.json") + " --preset twist:-0.5 --margin 0.1 --quiet").status, 0);
+  EXPECT_FALSE(fs::exists(dir_ / "o.obj"));
+}
+
+TEST_F(CommandLine, RepeatedSingleValuedOptionsAreRefused) {
+  expectUsageError(runSffd("deform " + box_ + " -l " + lattice_ + " -l " + lattice_ + " -o " + out("o.obj")),
+                   "option --lattice is given twice");
+  expectUsageError(runSffd("lattice " + box_ + " -o " + out("x.json") + " --preset twist --preset bend"),
+                   "option --preset is given twice ('twist' and 'bend'); give it once");
+  expectUsageError(runSffd("deform " + box_ + " -l " + lattice_ + " -o " + out("o.obj") + " --output=" + out("p.obj")),
+                   "option --output is given twice");
+  EXPECT_FALSE(fs::exists(dir_ / "o.obj"));
+}
+
+TEST_F(CommandLine, ListOptionsTakeOneValueOrThree) {
+  for (const char* counts : {"7", "5,6,7"})
+    EXPECT_EQ(runSffd("lattice " + box_ + " -o " + out("x.json") + " --counts " + counts + " --quiet").status, 0) << counts;
+  for (const char* bad : {"5,5", "5,5,5,5", "a", "5,,5"})
+    expectUsageError(runSffd("lattice " + box_ + " -o " + out("x.json") + " --counts " + bad),
+                     "option --counts needs one integer for all axes or three (U,V,W) like 5 or 5,6,7, not '" + std::string(bad) + "'");
+  expectUsageError(runSffd("lattice " + box_ + " -o " + out("x.json") + " --degree 2,3"), "option --degree needs one integer for all axes or three");
+  EXPECT_EQ(runSffd("lattice " + box_ + " -o " + out("x.json") + " --degree 3 --counts 6 --quiet").status, 0);
+}
+
+// lavapipe cannot finish a smooth job in a microsecond: the wait gives up with a device error.
+TEST_F(CommandLine, DeviceWaitTimesOutAsADeviceError) {
+  RunResult r = runSffd("deform " + box_ + " -l " + lattice_ + " --backend vulkan --tess 32 --edge-length 0.05 -o " + out("o.obj"),
+                        "SFFD_DEVICE_TIMEOUT=0.000001");
+  if (r.status == 3 && r.err.find("no Vulkan") != std::string::npos) GTEST_SKIP() << r.err;
+  EXPECT_EQ(r.status, 3) << r.err;
+  EXPECT_NE(r.err.find("did not finish its work within 1e-06 s (SFFD_DEVICE_TIMEOUT); the driver or GPU may be hung"), std::string::npos)
+      << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;   // nothing from the validation layer either
+  EXPECT_FALSE(fs::exists(dir_ / "o.obj"));
+  // The default (60 s) and a generous override let the same job finish.
+  RunResult ok = runSffd("deform " + box_ + " -l " + lattice_ + " --backend vulkan --quiet -o " + out("o.obj"), "SFFD_DEVICE_TIMEOUT=600");
+  EXPECT_EQ(ok.status, 0) << ok.err;
+}
+
+}  // namespace
+}  // namespace sffd::test
