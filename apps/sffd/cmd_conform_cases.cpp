@@ -124,6 +124,12 @@ std::map<std::string, std::string> inputHashes(const Case& c) {
   return {{"mesh", fnv1a(c.args.positional.at(0))}, {"lattice", fnv1a(c.args.get("--lattice"))}};
 }
 
+std::vector<std::string> bufferNames(const Case& c) {
+  if (c.method() == "classic") return {"classic.positions", "classic.normals"};
+  if (c.method() == "accurate") return {"accurate.patches", "accurate.tess.positions", "accurate.tess.normals"};
+  return {"pn.records", "clip.headers", "clip.records", "deform.patches", "deform.tess.positions", "deform.tess.normals"};
+}
+
 CaseOutput runCase(Device& device, const Case& c) {
   Backend& backend = device.backend();
   const ParsedArgs& args = c.args;

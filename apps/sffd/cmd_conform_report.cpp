@@ -75,14 +75,9 @@ std::vector<Result> compareRuns(const std::vector<Case>& cases, const std::vecto
   for (size_t ci = 0; ci < cases.size(); ++ci) {
     const Case& c = cases[ci];
     std::vector<std::optional<CaseOutput>> outputs(runs.size());
-    std::vector<std::string> names;   // the buffers, in the order the first backend that ran wrote them
+    const std::vector<std::string> names = bufferNames(c);
     for (size_t r = 0; r < runs.size(); ++r)
-      if (runs[r].cases[ci].status == Status::Pass) {
-        outputs[r] = readCaseOutput(runs[r].dir / c.name);
-        if (names.empty())
-          for (const Buffer& b : outputs[r]->buffers) names.push_back(b.name);
-      }
-    if (names.empty()) names.push_back("*");   // nothing ran: one result per pair says why
+      if (runs[r].cases[ci].status == Status::Pass) outputs[r] = readCaseOutput(runs[r].dir / c.name);
     for (auto [ia, ib] : pairs) {
       const BackendRun &A = runs[ia], &B = runs[ib];
       for (const std::string& name : names) {

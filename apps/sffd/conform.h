@@ -50,6 +50,8 @@ struct CaseOutput {
   std::vector<uint32_t> parents;   // per sub-triangle or patch: its input triangle (empty for classic)
 };
 
+// The buffers runCase writes for the case's method, in its order.
+std::vector<std::string> bufferNames(const Case& c);
 // Runs every kernel of the case's method on `device` and downloads every output.
 CaseOutput runCase(Device& device, const Case& c);
 
