@@ -4,6 +4,7 @@
 // a backend named by --require cannot be opened (docs/CONFORMANCE.md).
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>

@@ -1,6 +1,7 @@
 #include "backends/vulkan/vk_recorder.h"
 
 #include <algorithm>
+#include <cstdlib>
 #include <cstring>
 
 #include <sffd/error.h>
@@ -173,7 +174,12 @@ std::vector<DispatchTiming> Recorder::submitAndWait() {
   si.commandBufferCount = 1;
   si.pCommandBuffers = &commands_;
   check(api.vkQueueSubmit(device_.queue(), 1, &si, fence_), "vkQueueSubmit");
-  check(api.vkWaitForFences(dev, 1, &fence_, VK_TRUE, UINT64_MAX), "vkWaitForFences");
+  // A finite wait: a hung device is a device error, not a hung process (SFFD_VK_FENCE_TIMEOUT seconds, default 600).
+  const char* limit = std::getenv("SFFD_VK_FENCE_TIMEOUT");
+  const double seconds = limit && std::atof(limit) > 0 ? std::atof(limit) : 600.0;
+  const VkResult waited = api.vkWaitForFences(dev, 1, &fence_, VK_TRUE, uint64_t(seconds * 1e9));
+  if (waited == VK_TIMEOUT) throw deviceError("Vulkan: the device did not finish its work in " + std::to_string(int(seconds)) + " s");
+  check(waited, "vkWaitForFences");
 
   std::vector<uint64_t> ticks(labels_.size() * 2);
   if (timestamps_) {
