@@ -207,7 +207,7 @@ CommandSpec conformCommand() {
       {"--quiet", nullptr, "no notes on stderr"},
       {"--help|-h", nullptr, "show this help"},
   };
-  c.options.insert(c.options.begin() + 1, own.begin(), own.end());
+  c.options.insert(c.options.end(), own.begin(), own.end());
   return c;
 }
 

@@ -29,7 +29,10 @@ const CommandSpec& caseSpec() {
     CommandSpec c{"conform", "MESH -l LATTICE [options]", "", {}, nullptr, 1, 1};
     for (const OptionSpec& o : jobOptions()) {
       std::string n = o.name;
-      if (n != "--backend" && n != "--device" && n != "--stats" && n != "--quiet" && n != "--help|-h") c.options.push_back(o);
+      if (n == "--backend" || n == "--device" || n == "--stats" || n == "--quiet" || n == "--help|-h") continue;
+      if (n == "--precision") c.options.push_back({o.name, o.value, "float|double kernel arithmetic (default float)"});
+      else if (n == "--split") c.options.push_back({o.name, o.value, "smooth: the deform steps' kernels (deform_step_*) instead of the fused one"});
+      else c.options.push_back(o);
     }
     return c;
   }();
