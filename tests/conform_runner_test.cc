@@ -117,6 +117,7 @@ TEST(ConformRunner, ChangedDumpFailsNamingTheFirstMismatchingElement) {
   EXPECT_EQ(manifest["cases"][0]["variant"], "strict float");
   r = runSffd(args + " --backends cpu,vulkan --against " + (dir / "d").string());
   EXPECT_EQ(r.status, 0) << r.out << r.err;
+  EXPECT_EQ(runSffd(args + " --split --backends cpu --against " + (dir / "d").string()).status, 2);   // other options
   EXPECT_TRUE(has(r.out, "deform.tess.positions dump:cpu vs cpu: max_abs=0 max_ulp=0 mismatched=0/")) << r.out;
   EXPECT_TRUE(has(r.out, "deform.tess.positions dump:vulkan vs vulkan: max_abs=0 max_ulp=0")) << r.out;
   // One value changed: at level 3 a sub-triangle has 10 vertices (40 values), so element 85 is sub-triangle 2, value 1 (y).

@@ -37,6 +37,15 @@ std::string dataDir() {
   return SFFD_SOURCE_DATA;
 }
 
+// A case's options without its input paths (those are checked by hash): what a dump must share.
+json optionsOf(const Case& c) {
+  json args = json::array();
+  for (size_t i = 1; i < c.argv.size(); ++i)
+    if (c.argv[i] != "--lattice" && c.argv[i] != "-l" && c.argv[i - 1] != "--lattice" && c.argv[i - 1] != "-l")
+      args.push_back(c.argv[i]);
+  return args;
+}
+
 void writeManifest(const fs::path& dir, const std::vector<Case>& cases, const std::vector<BackendRun>& runs) {
   json m{{"format", "sffd-conform-dump"}, {"version", 1},
          {"sffd", std::to_string(SFFD_VERSION_MAJOR) + "." + std::to_string(SFFD_VERSION_MINOR) + "." +
@@ -53,10 +62,7 @@ void writeManifest(const fs::path& dir, const std::vector<Case>& cases, const st
   }
   m["cases"] = json::array();
   for (const Case& c : cases) {
-    json args = json::array();
-    for (size_t i = 1; i < c.argv.size(); ++i)
-      if (i < 2 || (c.argv[i - 1] != "--lattice" && c.argv[i - 1] != "-l")) args.push_back(c.argv[i]);
-    m["cases"].push_back({{"name", c.name}, {"method", c.method()}, {"variant", c.variant()}, {"options", args},
+    m["cases"].push_back({{"name", c.name}, {"method", c.method()}, {"variant", c.variant()}, {"options", optionsOf(c)},
                           {"input_hashes", inputHashes(c)}});
   }
   std::ofstream(dir / "manifest.json") << m.dump(1) << "\n";
@@ -74,9 +80,9 @@ std::vector<BackendRun> readDump(const fs::path& dir, const std::vector<Case>& c
     if (it == dumped.end()) continue;
     if (it->second.at("input_hashes") != json(inputHashes(c)))
       throw Error(ErrorKind::Input, "case " + c.name + ": its mesh or lattice differs from the one dumped in " + dir.string());
-    if (it->second.at("variant") != c.variant() || it->second.at("method") != c.method())
-      throw Error(ErrorKind::Input, "case " + c.name + ": dumped as " + it->second.at("method").get<std::string>() + " " +
-                                        it->second.at("variant").get<std::string>() + ", run as " + c.method() + " " + c.variant());
+    if (it->second.at("options") != optionsOf(c))
+      throw Error(ErrorKind::Input, "case " + c.name + ": dumped with the options " + it->second.at("options").dump() +
+                                        ", run with " + optionsOf(c).dump());
   }
   std::vector<BackendRun> runs;
   for (const json& b : m.at("backends")) {
