@@ -1,115 +1,219 @@
-// sffd conform MESH -l LATTICE: runs the same job on several backends and compares every output
-// buffer pairwise; exit 1 past tolerance (tolerances: docs/CONFORMANCE.md).
+// sffd conform: runs cases (one from the command line, or a case set) on several backends, each in
+// its own child process, and compares every output buffer pairwise or against a dump of another run.
+// Exit 0 when nothing failed, 1 on a Fail, Crash, Timeout or UnexpectedPass, 2 for bad usage, 3 when
+// a backend named by --require cannot be opened (docs/CONFORMANCE.md).
+#include <unistd.h>
+
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <set>
 #include <sstream>
 
-#include "analysis/buffer_compare.h"
-#include "kernels/classic/classic_ffd.h"
-#include "kernels/pn/pn_triangles.h"
-#include "kernels/clip/regular_clip.h"
-#include "kernels/clip/split_pattern_table.h"
-#include "apps/sffd/cli.h"
+#include <nlohmann/json.hpp>
 #include <sffd/error.h>
-#include "model/mesh_topology.h"
+#include <sffd/sffd.h>
+
+#include "apps/sffd/conform.h"
 
 namespace sffd::cli {
 namespace {
 
-struct BackendRun {
-  std::string label;
-  bool isCpu = false;
-  std::vector<std::pair<std::string, std::vector<double>>> buffers;
-};
+using namespace conform;
+using json = nlohmann::ordered_json;
 
-// Tolerance for a pair of backends (documented in docs/CONFORMANCE.md; measured figures there).
-CompareTolerance toleranceFor(bool strict, bool f64, bool withCpu) {
-  CompareTolerance t;
-  if (strict) {
-    t.bitExact = true;
-  } else if (withCpu) {
-    // GPU arithmetic against the double reference: a few float roundings per coefficient.
-    t.maxUlp = f64 ? 1e6 : 64;
-    t.absOfScale = f64 ? 1e-12 : 2e-6;
-  } else {
-    // GPU against GPU: the front ends reassociate differently (PLATFORM.md).
-    t.maxUlp = f64 ? 1e6 : 64;
-    t.absOfScale = f64 ? 1e-12 : 1e-6;
+std::vector<std::string> listOf(const std::string& text) {
+  std::vector<std::string> out;
+  std::stringstream ss(text);
+  for (std::string n; std::getline(ss, n, ',');)
+    if (!n.empty()) out.push_back(n);
+  return out;
+}
+
+// Where `--cases default` finds tests/data/conform/default.cases.
+std::string dataDir() {
+  if (const char* d = std::getenv("SFFD_CONFORM_DATA"); d && *d) return d;
+  return SFFD_SOURCE_DATA;
+}
+
+// A case's options without its input paths (those are checked by hash): what a dump must share.
+json optionsOf(const Case& c) {
+  json args = json::array();
+  for (size_t i = 1; i < c.argv.size(); ++i)
+    if (c.argv[i] != "--lattice" && c.argv[i] != "-l" && c.argv[i - 1] != "--lattice" && c.argv[i - 1] != "-l")
+      args.push_back(c.argv[i]);
+  return args;
+}
+
+void writeManifest(const fs::path& dir, const std::vector<Case>& cases, const std::vector<BackendRun>& runs) {
+  json m{{"format", "sffd-conform-dump"}, {"version", 1},
+         {"sffd", std::to_string(SFFD_VERSION_MAJOR) + "." + std::to_string(SFFD_VERSION_MINOR) + "." +
+                      std::to_string(SFFD_VERSION_PATCH)}};
+  m["backends"] = json::array();
+  for (const BackendRun& b : runs) {
+    json d = b.opened ? json::parse(deviceJson(b.label, b.info)) : json{{"backend", b.label}};
+    d["dir"] = fs::relative(b.dir, dir).string();
+    d["opened"] = b.opened;
+    d["cases"] = json::object();
+    for (size_t i = 0; i < cases.size(); ++i)
+      d["cases"][cases[i].name] = {{"status", statusName(b.cases[i].status)}, {"detail", b.cases[i].detail}};
+    m["backends"].push_back(d);
   }
-  return t;
+  m["cases"] = json::array();
+  for (const Case& c : cases) {
+    m["cases"].push_back({{"name", c.name}, {"method", c.method()}, {"variant", c.variant()}, {"options", optionsOf(c)},
+                          {"input_hashes", inputHashes(c)}});
+  }
+  std::ofstream(dir / "manifest.json") << m.dump(1) << "\n";
+}
+
+// The dumped backends as runs: the same cases (by name), their inputs checked against the dump's hashes.
+std::vector<BackendRun> readDump(const fs::path& dir, const std::vector<Case>& cases) {
+  std::ifstream in(dir / "manifest.json");
+  if (!in) throw Error(ErrorKind::Input, (dir / "manifest.json").string() + ": cannot read (is it a --dump folder?)");
+  json m = json::parse(in);
+  std::map<std::string, json> dumped;
+  for (const json& c : m.at("cases")) dumped[c.at("name")] = c;
+  for (const Case& c : cases) {
+    auto it = dumped.find(c.name);
+    if (it == dumped.end()) continue;
+    if (it->second.at("input_hashes") != json(inputHashes(c)))
+      throw Error(ErrorKind::Input, "case " + c.name + ": its mesh or lattice differs from the one dumped in " + dir.string());
+    if (it->second.at("options") != optionsOf(c))
+      throw Error(ErrorKind::Input, "case " + c.name + ": dumped with the options " + it->second.at("options").dump() +
+                                        ", run with " + optionsOf(c).dump());
+  }
+  std::vector<BackendRun> runs;
+  for (const json& b : m.at("backends")) {
+    if (!b.value("opened", false)) continue;
+    BackendRun r;
+    r.label = r.name = "dump:" + b.at("backend").get<std::string>();
+    r.opened = true;
+    r.info.api = b.value("api", "");
+    r.info.name = b.value("device", "");
+    r.info.driver = b.value("driver", "");
+    if (b["driver_version"].is_string()) r.info.driverVersion = b["driver_version"];
+    r.dir = dir / b.at("dir").get<std::string>();
+    for (const Case& c : cases) {
+      const json& st = b.at("cases").contains(c.name) ? b["cases"][c.name] : json{{"status", "Skip"}, {"detail", "not in the dump"}};
+      const bool ran = st.at("status") == "Pass";
+      r.cases.push_back({ran ? Status::Pass : Status::Skip, ran ? "" : "dumped as " + st.at("status").get<std::string>() + ": " +
+                                                                           st.value("detail", "")});
+    }
+    runs.push_back(std::move(r));
+  }
+  if (runs.empty()) throw Error(ErrorKind::Input, dir.string() + ": the dump holds no backend");
+  return runs;
 }
 
 int run(const ParsedArgs& args) {
-  std::vector<std::string> names;
-  std::stringstream ss(args.get("--backends", "vulkan,gl-egl,gl-osmesa,cpu"));
-  for (std::string n; std::getline(ss, n, ',');)
-    if (!n.empty()) names.push_back(n);
-  if (names.size() < 2) throw Error(ErrorKind::Input, "--backends needs at least two backends to compare");
-  Job job = loadJob(args);
-  PackedLattice packed = packLattice(job.lattice);
-  if (!job.mesh.normalsFromFile) applyCreaseAngle(job.mesh, args.getDouble("--crease-angle", 40.0));
-  PreparedMesh prepared = prepareMesh(job.mesh);
-  glm::dvec3 lo, hi;
-  meshBounds(job.mesh, lo, hi);
-  double l = args.has("--edge-length") ? args.getDouble("--edge-length", 0) : 0.1 * std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
-  checkEdgeLength(job.mesh, l);
-  ClipTriangles clip = buildClipTriangles(job.mesh, l, splitPatternTable().nmax());
-  KernelVariant variant;
-  variant.strict = args.has("--strict");
-  std::string precision = args.get("--precision", "float");
-  if (precision != "float" && precision != "double") throw Error(ErrorKind::Input, "--precision must be float or double");
-  variant.f64 = precision == "double";
+  static const std::set<std::string> known{"vulkan", "gl", "gl-egl", "gl-osmesa", "gl-glfw", "cpu"};
+  const std::vector<std::string> names = listOf(args.get("--backends", "vulkan,gl-egl,gl-osmesa,cpu"));
+  for (const std::string& n : names)
+    if (!known.count(n)) throw Error(ErrorKind::Input, "--backends: unknown backend '" + n + "' (vulkan, gl, gl-egl, gl-osmesa, gl-glfw, cpu)");
+  const std::vector<std::string> required = listOf(args.get("--require"));
+  for (const std::string& n : required)
+    if (std::find(names.begin(), names.end(), n) == names.end())
+      throw Error(ErrorKind::Input, "--require: '" + n + "' is not one of --backends");
+  const bool against = args.has("--against");
+  if (names.size() < (against ? 1u : 2u))
+    throw Error(ErrorKind::Input, against ? "--backends needs a backend" : "--backends needs at least two backends to compare");
+  const bool fromFile = args.has("--cases");
+  if (fromFile == !args.positional.empty())
+    throw Error(ErrorKind::Input, "give MESH -l LATTICE or --cases default|FILE, not both (usage: sffd conform " +
+                                      std::string(args.command->usage) + ")");
+  RunnerOptions options;
+  options.timeoutSeconds = args.getDouble("--timeout", 60);
+  if (!(options.timeoutSeconds > 0)) throw Error(ErrorKind::Input, "--timeout must be a number of seconds > 0");
+  options.deviceSubstring = args.get("--device");
+  const std::vector<Case> cases = fromFile ? readCases(args.get("--cases"), dataDir()) : std::vector<Case>{caseFromArgs(args)};
+  for (const char* opt : {"--junit", "--json"})
+    if (args.has(opt)) checkOutputPath(args.get(opt), {});
+
+  // The children write the buffers under the dump folder, or a temporary one removed at the end.
+  fs::path root;
+  if (args.has("--dump")) {
+    root = args.get("--dump");
+    std::error_code ec;
+    if (fs::exists(root) && !fs::is_empty(root, ec))
+      throw Error(ErrorKind::Input, root.string() + ": the dump folder exists and is not empty");
+    fs::create_directories(root);
+  } else {
+    std::string tmpl = (fs::temp_directory_path() / "sffd_conform_XXXXXX").string();
+    if (!::mkdtemp(tmpl.data())) throw Error(ErrorKind::Internal, "cannot create a temporary folder");
+    root = tmpl;
+  }
+  struct Cleanup {
+    fs::path dir;
+    ~Cleanup() { if (!dir.empty()) fs::remove_all(dir); }
+  } cleanup{args.has("--dump") ? fs::path() : root};
 
   std::vector<BackendRun> runs;
-  for (const std::string& name : names) {
-    DeviceRequest req;
-    req.name = name;
-    req.deviceSubstring = args.get("--device");
-    Device device = Device::open(req);
-    Backend& backend = device.backend();
-    BackendRun r;
-    r.label = device.label();
-    r.isCpu = device.info().api == "cpu";
-    // The CPU backend runs in the kernels' precision (in float, in the strict kernels' operation
-    // order): conformance compares the same arithmetic on the same inputs. Accuracy against the
-    // double reference is a separate matter (docs/CONFORMANCE.md).
-    ClassicOutput classic = classicFfd(backend, job.mesh, packed, variant, chunkFromEnvironment("SFFD_MAX_CHUNK_VERTICES"));
-    r.buffers.push_back({"classic.positions", std::move(classic.positions)});
-    r.buffers.push_back({"classic.normals", std::move(classic.normals)});
-    PnOutput pn = pnTriangles(backend, prepared, variant, chunkFromEnvironment("SFFD_MAX_CHUNK_TRIANGLES"));
-    // Each backend clips from its own PN records: the whole pre-compute stage is compared.
-    SubTriangleRecords subs =
-        regularClip(backend, prepared, pn, clip, l, variant, chunkFromEnvironment("SFFD_MAX_CHUNK_SUBTRIANGLES"));
-    r.buffers.push_back({"pn.records", std::move(pn.records)});
-    r.buffers.push_back({"clip.headers", std::vector<double>(subs.headers.begin(), subs.headers.end())});
-    r.buffers.push_back({"clip.records", std::move(subs.records)});
-    runs.push_back(std::move(r));
+  for (const std::string& n : names) {
+    runs.push_back(runBackend(n, cases, root / n, options));
+    const BackendRun& r = runs.back();
+    if (!r.opened && r.cases.size() && r.cases[0].status == Status::Skip)
+      std::fprintf(stderr, "sffd: conform: %s: Skip: %s\n", n.c_str(), r.skipReason.c_str());
+    for (size_t i = 0; i < cases.size(); ++i)
+      if (r.cases[i].status != Status::Pass && (r.opened || r.cases[i].status != Status::Skip))
+        std::fprintf(stderr, "sffd: conform: %s %s: %s: %s\n", r.label.c_str(), cases[i].name.c_str(),
+                     statusName(r.cases[i].status), r.cases[i].detail.c_str());
   }
+  if (args.has("--dump")) writeManifest(root, cases, runs);
 
+  std::vector<std::pair<size_t, size_t>> pairs;
+  const size_t live = runs.size();
+  if (against) {
+    for (BackendRun& d : readDump(args.get("--against"), cases)) runs.push_back(std::move(d));
+    for (size_t i = 0; i < live; ++i) {
+      size_t before = pairs.size();
+      for (size_t j = live; j < runs.size(); ++j)
+        if (runs[j].label == "dump:" + runs[i].label) pairs.push_back({j, i});
+      if (pairs.size() == before)   // no dump of the same backend: compare with every dumped one
+        for (size_t j = live; j < runs.size(); ++j) pairs.push_back({j, i});
+    }
+  } else {
+    for (size_t i = 0; i < live; ++i)
+      for (size_t j = i + 1; j < live; ++j) pairs.push_back({i, j});
+  }
+  std::vector<Result> results = compareRuns(cases, runs, pairs);
+  if (args.has("--baseline")) applyBaseline(results, args.get("--baseline"));
+  printText(results, fromFile);
+  if (args.has("--junit")) writeJunit(args.get("--junit"), results);
+  if (args.has("--json")) writeJson(args.get("--json"), cases, runs, results);
   bool pass = true;
-  for (size_t i = 0; i < runs.size(); ++i)
-    for (size_t j = i + 1; j < runs.size(); ++j)
-      for (size_t k = 0; k < runs[i].buffers.size(); ++k) {
-        bool withCpu = runs[i].isCpu || runs[j].isCpu;
-        CompareResult c = compareBuffers(runs[i].buffers[k].second, runs[j].buffers[k].second, !variant.f64,
-                                         toleranceFor(variant.strict, variant.f64, withCpu));
-        std::printf("%s %s vs %s: max_abs=%.3g max_ulp=%llu mismatched=%zu/%zu\n", runs[i].buffers[k].first.c_str(),
-                    runs[i].label.c_str(), runs[j].label.c_str(), c.maxAbs, (unsigned long long)c.maxUlp, c.mismatched,
-                    c.total);
-        if (c.mismatched) pass = false;
-      }
+  for (const Result& r : results) pass = pass && !isFailure(r.status);
   std::printf("conform: %s\n", pass ? "PASS" : "FAIL");
+  std::fflush(stdout);
+  for (size_t i = 0; i < live; ++i)
+    if (!runs[i].opened && std::find(required.begin(), required.end(), runs[i].name) != required.end())
+      throw deviceError("required backend " + runs[i].name + " could not be opened: " +
+                        (runs[i].skipReason.empty() ? runs[i].cases[0].detail : runs[i].skipReason));
   return pass ? 0 : 1;
 }
 
 }  // namespace
 
 CommandSpec conformCommand() {
-  CommandSpec c{"conform", "MESH -l LATTICE [--backends vulkan,gl,cpu] [--strict]",
-                "Runs the same job on several backends and compares every output buffer; exit 1 past tolerance.",
-                jobOptions(), run, 1, 1};
-  c.options.insert(c.options.begin() + 1,
-                   {"--backends", "LIST", "comma-separated backends to compare (default vulkan,gl-egl,gl-osmesa,cpu)"});
+  CommandSpec c{"conform", "MESH -l LATTICE [options] | --cases default|FILE [options]",
+                "Runs the same jobs on several backends and compares every output buffer; exit 1 on a failure.",
+                caseSpec().options, run, 0, 1};
+  const std::vector<OptionSpec> own = {
+      {"--backends", "LIST", "comma-separated backends to compare (default vulkan,gl-egl,gl-osmesa,cpu)"},
+      {"--device", "SUBSTRING", "on each backend, the first device whose name contains SUBSTRING"},
+      {"--cases", "default|FILE", "run a case set: the default one (every kernel) or a case file"},
+      {"--require", "LIST", "backends that must open (exit 3 otherwise); others that cannot are skipped"},
+      {"--timeout", "SECONDS", "a backend child without progress for this long is killed: Timeout (default 60)"},
+      {"--junit", "FILE", "write JUnit XML: one testcase per case, buffer and pair of backends"},
+      {"--json", "FILE", "write the backends, cases and results as JSON"},
+      {"--baseline", "FILE", "expected failures, TEST,STATUS lines (deqp-runner's failures.csv)"},
+      {"--dump", "DIR", "write every compared buffer and a manifest to DIR (a new or empty folder)"},
+      {"--against", "DIR", "compare the backends with the buffers of a --dump folder instead of each other"},
+      {"--quiet", nullptr, "no notes on stderr"},
+      {"--help|-h", nullptr, "show this help"},
+  };
+  c.options.insert(c.options.end(), own.begin(), own.end());
   return c;
 }
 

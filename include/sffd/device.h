@@ -29,6 +29,11 @@ struct DeviceInfo {
   std::string name;      // device name as the driver reports it
   std::string driver;    // driver / API version string
   std::string type;      // "discrete", "integrated", "virtual", "cpu", "other"
+  // Where the API gives them (Vulkan; 0 / empty otherwise): PCI-style ids, the driver's own version
+  // and the device UUID (32 hex digits), so conformance results name the exact driver.
+  uint32_t vendorId = 0, deviceId = 0;
+  std::string driverVersion;
+  std::string uuid;
   DeviceLimits limits;
 };
 

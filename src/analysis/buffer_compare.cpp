@@ -40,6 +40,7 @@ CompareResult compareBuffers(const std::vector<double>& a, const std::vector<dou
     r.mismatched = r.total;
     r.maxAbs = INFINITY;
     r.maxUlp = UINT64_MAX;
+    r.firstMismatch = std::min(a.size(), b.size());
     return r;
   }
   double scale = 0;
@@ -61,7 +62,7 @@ CompareResult compareBuffers(const std::vector<double>& a, const std::vector<dou
     r.maxAbs = std::max(r.maxAbs, d);
     r.maxUlp = std::max(r.maxUlp, ulp);
     bool ok = tol.bitExact ? same : (same || double(ulp) <= tol.maxUlp || d <= tol.absOfScale * scale);
-    if (!ok) ++r.mismatched;
+    if (!ok && !r.mismatched++) r.firstMismatch = i;
   }
   return r;
 }

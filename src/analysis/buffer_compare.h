@@ -18,6 +18,7 @@ struct CompareResult {
   double maxAbs = 0;
   uint64_t maxUlp = 0;
   size_t mismatched = 0, total = 0;
+  size_t firstMismatch = SIZE_MAX;   // index of the first element outside the tolerance (sffd conform names it)
 };
 
 // Values are compared in the precision the kernel wrote (float32 when `float32`, else double); the

@@ -82,6 +82,9 @@ class GlBackend final : public Backend {
     info_.provider = ctx_->name();
     info_.name = glString(GL_RENDERER);
     info_.driver = glString(GL_VERSION);
+    // "4.5 (Core Profile) Mesa 22.3.6": the driver's own version where it names one.
+    size_t mesa = info_.driver.find("Mesa ");
+    info_.driverVersion = mesa == std::string::npos ? info_.driver : info_.driver.substr(mesa);
     if (major * 10 + minor < 43 || !(profile & GL_CONTEXT_CORE_PROFILE_BIT))
       throw deviceError("gl/" + info_.provider + ": compute needs OpenGL 4.3 core, the context is " +
                         std::to_string(major) + "." + std::to_string(minor) +

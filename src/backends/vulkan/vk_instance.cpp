@@ -97,6 +97,17 @@ PhysicalDevice describe(const Api& api, VkPhysicalDevice handle) {
   info.name = props.deviceName;
   info.type = kTypeNames[typeRank(props.deviceType)];
   info.driver = "Vulkan " + versionString(props.apiVersion) + ", driver version " + std::to_string(props.driverVersion);
+  info.vendorId = props.vendorID;
+  info.deviceId = props.deviceID;
+  info.driverVersion = std::to_string(props.driverVersion);
+  if (props.apiVersion >= VK_API_VERSION_1_1) {   // VkPhysicalDeviceIDProperties is core in 1.1
+    auto ids = vkStruct<VkPhysicalDeviceIDProperties>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ID_PROPERTIES);
+    auto props2 = vkStruct<VkPhysicalDeviceProperties2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2);
+    props2.pNext = &ids;
+    api.vkGetPhysicalDeviceProperties2(handle, &props2);
+    static const char* hex = "0123456789abcdef";
+    for (uint8_t b : ids.deviceUUID) info.uuid += hex[b >> 4], info.uuid += hex[b & 15];
+  }
   // Driver name and info are core in 1.2 and VK_KHR_driver_properties before.
   if (props.apiVersion >= VK_API_VERSION_1_2 || hasDeviceExtension(api, handle, "VK_KHR_driver_properties")) {
     auto driver = vkStruct<VkPhysicalDeviceDriverProperties>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES);
@@ -104,6 +115,7 @@ PhysicalDevice describe(const Api& api, VkPhysicalDevice handle) {
     props2.pNext = &driver;
     api.vkGetPhysicalDeviceProperties2(handle, &props2);
     info.driver = std::string(driver.driverName) + " " + driver.driverInfo + ", Vulkan " + versionString(props.apiVersion);
+    if (driver.driverInfo[0]) info.driverVersion = driver.driverInfo;   // "Mesa 22.3.6" rather than an encoded number
   }
 
   uint32_t familyCount = 0;

@@ -1,0 +1,220 @@
+// sffd conform: each backend runs in a forked child process, so that a driver that crashes or hangs
+// ends one case, not the run. The parent opens no device itself; the child reports on a pipe (one
+// line an event) and writes each case's buffers to files. Test hook (docs/CONFORMANCE.md):
+// SFFD_CONFORM_FAULT=crash|hang:BACKEND[:CASE] makes that child crash or hang at that case.
+#include <poll.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <cerrno>
+#include <cstring>
+#include <optional>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+#include <sffd/error.h>
+
+#include "apps/sffd/conform.h"
+
+namespace sffd::cli::conform {
+
+using json = nlohmann::ordered_json;
+
+void writeCaseOutput(const fs::path& dir, const CaseOutput& out) {
+  fs::create_directories(dir);
+  json index = json::array();
+  for (const Buffer& b : out.buffers) {
+    std::ofstream f(dir / (b.name + ".f64"), std::ios::binary);
+    f.write(reinterpret_cast<const char*>(b.values.data()), std::streamsize(b.values.size() * sizeof(double)));
+    index.push_back({{"name", b.name}, {"unit", b.unit}, {"per_unit", b.perUnit}, {"count", b.values.size()},
+                     {"file", b.name + ".f64"}});
+  }
+  std::ofstream(dir / "parents.u32", std::ios::binary)
+      .write(reinterpret_cast<const char*>(out.parents.data()), std::streamsize(out.parents.size() * 4));
+  std::ofstream(dir / "buffers.json") << json{{"format", "sffd-conform-buffers"}, {"version", 1},
+                                              {"values", "little-endian float64, as the kernel wrote them"},
+                                              {"buffers", index}, {"parents", "parents.u32"}}.dump(1) << "\n";
+}
+
+CaseOutput readCaseOutput(const fs::path& dir) {
+  std::ifstream in(dir / "buffers.json");
+  if (!in) throw Error(ErrorKind::Input, (dir / "buffers.json").string() + ": cannot read");
+  json index = json::parse(in);
+  CaseOutput out;
+  auto readRaw = [](const fs::path& p, void* data, size_t bytes) {
+    std::ifstream f(p, std::ios::binary);
+    if (!f.read(static_cast<char*>(data), std::streamsize(bytes)) && bytes)
+      throw Error(ErrorKind::Input, p.string() + ": shorter than its buffers.json says");
+  };
+  for (const json& b : index.at("buffers")) {
+    Buffer buf{b.at("name"), b.at("unit"), b.at("per_unit"), std::vector<double>(b.at("count").get<size_t>())};
+    readRaw(dir / b.at("file").get<std::string>(), buf.values.data(), buf.values.size() * 8);
+    out.buffers.push_back(std::move(buf));
+  }
+  out.parents.resize(fs::file_size(dir / "parents.u32") / 4);
+  readRaw(dir / "parents.u32", out.parents.data(), out.parents.size() * 4);
+  return out;
+}
+
+namespace {
+
+void say(int fd, const std::string& line) {
+  std::string l = line;
+  for (char& c : l)
+    if (c == '\n') c = ' ';
+  l += '\n';
+  for (size_t at = 0; at < l.size();) {
+    ssize_t n = ::write(fd, l.data() + at, l.size() - at);
+    if (n <= 0) return;
+    at += size_t(n);
+  }
+}
+
+// The test hook: "crash:vulkan" or "hang:gl-egl:CASE".
+void injectFault(const std::string& backend, const std::string& caseName) {
+  const char* v = std::getenv("SFFD_CONFORM_FAULT");
+  if (!v) return;
+  std::string s = v, kind = s.substr(0, s.find(':')), rest = s.find(':') == std::string::npos ? "" : s.substr(s.find(':') + 1);
+  std::string b = rest.substr(0, rest.find(':')), c = rest.find(':') == std::string::npos ? "" : rest.substr(rest.find(':') + 1);
+  if (b != backend || (!c.empty() && c != caseName)) return;
+  if (kind == "crash") ::raise(SIGSEGV);
+  if (kind == "hang")
+    for (;;) ::pause();
+}
+
+// The child: opens the device, then runs cases[first..] and reports each on `fd`.
+void childMain(const std::string& name, const std::vector<Case>& cases, size_t first, const fs::path& dir,
+               const RunnerOptions& options, int fd) {
+  std::optional<Device> device;
+  try {
+    DeviceRequest req;
+    req.name = name;
+    req.deviceSubstring = options.deviceSubstring;
+    device.emplace(Device::open(req));
+  } catch (const std::exception& e) {
+    say(fd, std::string("skip-backend ") + e.what());
+    return;
+  }
+  say(fd, "open " + deviceJson(device->label(), device->info()));
+  for (size_t i = first; i < cases.size(); ++i) {
+    say(fd, "start " + std::to_string(i));
+    injectFault(name, cases[i].name);
+    try {
+      writeCaseOutput(dir / cases[i].name, runCase(*device, cases[i]));
+      say(fd, "done " + std::to_string(i));
+    } catch (const Error& e) {
+      say(fd, (e.kind() == ErrorKind::Device ? "skip " : "fail ") + std::to_string(i) + " " + e.what());
+    } catch (const std::exception& e) {
+      say(fd, "fail " + std::to_string(i) + " " + e.what());
+    }
+  }
+}
+
+DeviceInfo infoFromJson(const json& j) {
+  auto str = [&](const char* k) { return j.contains(k) && j[k].is_string() ? j[k].get<std::string>() : std::string(); };
+  auto num = [&](const char* k) { return j.contains(k) && j[k].is_number() ? j[k].get<uint32_t>() : 0u; };
+  DeviceInfo d;
+  d.api = str("api"), d.provider = str("provider"), d.name = str("device"), d.driver = str("driver"), d.type = str("type");
+  d.driverVersion = str("driver_version"), d.uuid = str("uuid");
+  d.vendorId = num("vendor_id"), d.deviceId = num("device_id");
+  d.limits.float64 = j.value("float64", false);
+  return d;
+}
+
+std::string signalText(int status) {
+  if (WIFSIGNALED(status)) return "killed by signal " + std::to_string(WTERMSIG(status)) + " (" + strsignal(WTERMSIG(status)) + ")";
+  return "exited with status " + std::to_string(WEXITSTATUS(status)) + " before finishing";
+}
+
+}  // namespace
+
+BackendRun runBackend(const std::string& name, const std::vector<Case>& cases, const fs::path& dir,
+                      const RunnerOptions& options) {
+  using Clock = std::chrono::steady_clock;
+  BackendRun run;
+  run.name = run.label = name;
+  run.dir = dir;
+  run.cases.assign(cases.size(), CaseRun{Status::Skip, "not run"});
+  size_t next = 0;
+  while (next < cases.size()) {
+    int fds[2];
+    if (::pipe(fds) != 0) throw Error(ErrorKind::Internal, "conform: cannot create a pipe");
+    std::fflush(stdout);
+    std::fflush(stderr);
+    const pid_t pid = ::fork();
+    if (pid < 0) throw Error(ErrorKind::Internal, "conform: cannot fork");
+    if (pid == 0) {
+      ::close(fds[0]);
+      childMain(name, cases, next, dir, options, fds[1]);
+      std::fflush(nullptr);
+      ::_exit(0);
+    }
+    ::close(fds[1]);
+    long current = -1;   // the case the child is in
+    bool timedOut = false, backendSkipped = false;
+    auto deadline = Clock::now() + std::chrono::duration<double>(options.timeoutSeconds);
+    std::string pending;
+    for (;;) {
+      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now()).count();
+      pollfd p{fds[0], POLLIN, 0};
+      if (left <= 0 || ::poll(&p, 1, int(std::max<long long>(left, 0))) == 0) {
+        ::kill(pid, SIGKILL);
+        timedOut = true;
+        break;
+      }
+      char buf[4096];
+      const ssize_t n = ::read(fds[0], buf, sizeof buf);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) break;
+      pending.append(buf, size_t(n));
+      for (size_t eol; (eol = pending.find('\n')) != std::string::npos; pending.erase(0, eol + 1)) {
+        const std::string line = pending.substr(0, eol), word = line.substr(0, line.find(' '));
+        const std::string rest = line.find(' ') == std::string::npos ? "" : line.substr(line.find(' ') + 1);
+        deadline = Clock::now() + std::chrono::duration<double>(options.timeoutSeconds);
+        if (word == "open") {
+          json j = json::parse(rest);
+          run.opened = true;
+          run.label = j.value("backend", name);
+          run.info = infoFromJson(j);
+        } else if (word == "skip-backend") {
+          run.skipReason = rest;
+          backendSkipped = true;
+        } else if (word == "start") {
+          current = std::stol(rest);
+        } else {
+          // done|skip|fail I [why]
+          const size_t i = std::stoul(rest.substr(0, rest.find(' ')));
+          const std::string why = rest.find(' ') == std::string::npos ? "" : rest.substr(rest.find(' ') + 1);
+          run.cases[i] = {word == "done" ? Status::Pass : word == "skip" ? Status::Skip : Status::Fail, why};
+          current = -1;
+          next = i + 1;
+        }
+      }
+    }
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    ::close(fds[0]);
+    if (backendSkipped) {
+      for (CaseRun& c : run.cases) c = {Status::Skip, run.skipReason};
+      break;
+    }
+    const bool clean = !timedOut && WIFEXITED(status) && WEXITSTATUS(status) == 0;
+    if (clean && next >= cases.size()) break;
+    const Status s = timedOut ? Status::Timeout : Status::Crash;
+    char t[64];
+    std::snprintf(t, sizeof t, "no progress for %g s", options.timeoutSeconds);
+    const std::string why = timedOut ? std::string(t) : signalText(status);
+    if (current < 0) {   // died opening the device or between cases: nothing more can be trusted
+      for (size_t i = next; i < cases.size(); ++i) run.cases[i] = {s, why + (run.opened ? "" : " while opening the device")};
+      break;
+    }
+    run.cases[size_t(current)] = {s, why};
+    next = size_t(current) + 1;
+  }
+  return run;
+}
+
+}  // namespace sffd::cli::conform

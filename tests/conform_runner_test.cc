@@ -1,0 +1,229 @@
+// sffd conform as a conformance runner (docs/CONFORMANCE.md): every kernel's buffers per method, the
+// options honoured, skips, crashes and hangs as results, JUnit and JSON, baselines, dumps.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <regex>
+
+#include <nlohmann/json.hpp>
+
+#include "support/cli_runner.h"
+
+namespace {
+
+using namespace sffd::test;
+using json = nlohmann::json;
+
+const std::string kData = SFFD_TEST_DATA;
+const std::string kCube2 = kData + "/cube2.obj -l " + kData + "/lattices/cube2_twist.npy";
+
+// The backends every test machine has (SFFD_REQUIRE_BACKENDS, as the backend tests read it).
+std::string requiredBackends() {
+  const char* env = std::getenv("SFFD_REQUIRE_BACKENDS");
+  return env ? env : "vulkan,gl-egl,gl-osmesa,cpu";
+}
+
+bool has(const std::string& text, const std::string& what) { return text.find(what) != std::string::npos; }
+
+// The mismatched count of `buffer`'s line for a pair: "-1" when there is no such line.
+std::string totalOf(const std::string& out, const std::string& buffer, const std::string& pair) {
+  std::smatch m;
+  std::regex re("(^|\\n)" + std::regex_replace(buffer, std::regex("\\."), "\\.") + " " + pair +
+                ": max_abs=\\S+ max_ulp=\\d+ mismatched=\\d+/(\\d+)");
+  return std::regex_search(out, m, re) ? m[2].str() : "-1";
+}
+
+void expectStrictPassEverywhere(const std::string& args, const std::vector<std::string>& buffers) {
+  const std::string backends = requiredBackends();
+  RunResult r = runSffd("conform " + args + " --strict --tess 3 --backends " + backends + " --require " + backends);
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  EXPECT_TRUE(has(r.out, "\nconform: PASS\n")) << r.out;
+  for (const std::string& b : buffers) {
+    EXPECT_NE(totalOf(r.out, b, "vulkan vs cpu"), "-1") << b << "\n" << r.out;
+    EXPECT_TRUE(has(r.out, b + " vulkan vs gl-egl: max_abs=0 max_ulp=0 mismatched=0/")) << b << "\n" << r.out;
+  }
+  EXPECT_FALSE(has(r.out, "max_ulp=1")) << r.out;
+}
+
+TEST(ConformRunner, StrictSmoothComparesEveryStageOnEveryBackend) {
+  expectStrictPassEverywhere(kCube2 + " --method smooth --edge-length 0.5",
+                             {"pn.records", "clip.headers", "clip.records", "deform.patches", "deform.tess.positions",
+                              "deform.tess.normals"});
+}
+
+TEST(ConformRunner, StrictAccurateComparesPatchesAndTessellation) {
+  expectStrictPassEverywhere(kCube2 + " --method accurate",
+                             {"accurate.patches", "accurate.tess.positions", "accurate.tess.normals"});
+}
+
+TEST(ConformRunner, OptionsChangeWhatIsCompared) {
+  const std::string base = "conform " + kCube2 + " --strict --backends vulkan,cpu --edge-length 0.5";
+  RunResult t3 = runSffd(base + " --tess 3"), t5 = runSffd(base + " --tess 5"), classic = runSffd(base + " --method classic");
+  RunResult knot = runSffd(base + " --tess 3 --clip knot-box"), split = runSffd(base + " --tess 3 --split --samples 6");
+  for (const RunResult* r : {&t3, &t5, &classic, &knot, &split}) ASSERT_EQ(r->status, 0) << r->out << r->err;
+  const std::string pair = "vulkan vs cpu";
+  EXPECT_NE(totalOf(t3.out, "deform.tess.positions", pair), totalOf(t5.out, "deform.tess.positions", pair));
+  EXPECT_EQ(totalOf(t3.out, "deform.patches", pair), totalOf(t5.out, "deform.patches", pair));
+  EXPECT_NE(totalOf(t3.out, "clip.records", pair), totalOf(knot.out, "clip.records", pair));
+  EXPECT_EQ(totalOf(t3.out, "deform.tess.positions", pair), totalOf(split.out, "deform.tess.positions", pair));
+  EXPECT_NE(totalOf(classic.out, "classic.positions", pair), "-1");
+  EXPECT_FALSE(has(classic.out, "pn.records")) << classic.out;
+  EXPECT_FALSE(has(classic.out, "deform.")) << classic.out;
+}
+
+TEST(ConformRunner, BackendWithoutADisplayIsSkippedUnlessRequired) {
+  const std::string args = "conform " + kCube2 + " --method classic --backends vulkan,gl-glfw,cpu";
+  RunResult r = runSffd(args, "env -u DISPLAY -u WAYLAND_DISPLAY");
+  EXPECT_EQ(r.status, 0) << r.out << r.err;
+  EXPECT_TRUE(has(r.out, "classic.positions vulkan vs cpu: max_abs=")) << r.out;
+  EXPECT_TRUE(has(r.out, "conform: PASS")) << r.out;
+  EXPECT_TRUE(has(r.err, "gl-glfw: Skip")) << r.err;
+  r = runSffd(args + " --require gl-glfw", "env -u DISPLAY -u WAYLAND_DISPLAY");
+  EXPECT_EQ(r.status, 3) << r.out << r.err;
+  EXPECT_TRUE(has(r.err, "required backend gl-glfw")) << r.err;
+}
+
+TEST(ConformRunner, JunitIsWellFormedAndJsonHasTheFields) {
+  fs::path dir = tempDir("conform_reports");
+  RunResult r = runSffd("conform " + kCube2 + " --method accurate --tess 2 --backends vulkan,gl-egl,cpu --junit " +
+                        (dir / "r.xml").string() + " --json " + (dir / "r.json").string());
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  // 3 buffers x 3 pairs; parsed by Python's XML parser as a CI would.
+  const std::string check = "python3 -c \"import sys, xml.etree.ElementTree as E; r = E.parse(sys.argv[1]).getroot(); "
+                            "c = r.findall('testsuite/testcase'); assert r.tag == 'testsuites' and len(c) == 9, len(c); "
+                            "assert all(t.get('classname') and t.get('name') for t in c)\" " + (dir / "r.xml").string();
+  EXPECT_EQ(std::system(check.c_str()), 0) << slurp(dir / "r.xml");
+  json j = json::parse(slurp(dir / "r.json"));
+  EXPECT_EQ(j["status"], "PASS");
+  ASSERT_EQ(j["backends"].size(), 3u);
+  for (const char* k : {"backend", "device", "driver", "driver_version", "vendor_id", "device_id", "uuid"})
+    EXPECT_TRUE(j["backends"][0].contains(k)) << k;
+  EXPECT_EQ(j["backends"][0]["driver_version"].is_string(), true) << j["backends"][0];
+  ASSERT_EQ(j["results"].size(), 9u);
+  for (const char* k : {"case", "buffer", "pair", "status", "max_abs", "max_ulp", "mismatched", "total", "tolerance",
+                        "first_mismatch"})
+    EXPECT_TRUE(j["results"][0].contains(k)) << k;
+  EXPECT_EQ(j["results"][0]["status"], "Pass");
+  fs::remove_all(dir);
+}
+
+TEST(ConformRunner, ChangedDumpFailsNamingTheFirstMismatchingElement) {
+  fs::path dir = tempDir("conform_dump");
+  const std::string args = "conform " + kCube2 + " --strict --tess 3 --edge-length 0.5";
+  RunResult r = runSffd(args + " --backends vulkan,cpu --dump " + (dir / "d").string());
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  json manifest = json::parse(slurp(dir / "d/manifest.json"));
+  EXPECT_TRUE(manifest["cases"][0]["input_hashes"].contains("mesh"));
+  EXPECT_EQ(manifest["cases"][0]["variant"], "strict float");
+  r = runSffd(args + " --backends cpu,vulkan --against " + (dir / "d").string());
+  EXPECT_EQ(r.status, 0) << r.out << r.err;
+  EXPECT_EQ(runSffd(args + " --split --backends cpu --against " + (dir / "d").string()).status, 2);   // other options
+  EXPECT_TRUE(has(r.out, "deform.tess.positions dump:cpu vs cpu: max_abs=0 max_ulp=0 mismatched=0/")) << r.out;
+  EXPECT_TRUE(has(r.out, "deform.tess.positions dump:vulkan vs vulkan: max_abs=0 max_ulp=0")) << r.out;
+  // One value changed: at level 3 a sub-triangle has 10 vertices (40 values), so element 85 is sub-triangle 2, value 1 (y).
+  const size_t element = 4 * 10 * 2 + 5;
+  {
+    std::fstream f(dir / "d/cpu/cube2/deform.tess.positions.f64", std::ios::in | std::ios::out | std::ios::binary);
+    double v = 0;
+    f.seekg(std::streamoff(element * 8));
+    f.read(reinterpret_cast<char*>(&v), 8);
+    v += 0.25;
+    f.seekp(std::streamoff(element * 8));
+    f.write(reinterpret_cast<const char*>(&v), 8);
+  }
+  r = runSffd(args + " --backends cpu --against " + (dir / "d").string() + " --json " + (dir / "r.json").string());
+  EXPECT_EQ(r.status, 1) << r.out << r.err;
+  EXPECT_TRUE(has(r.out, "deform.tess.positions dump:cpu vs cpu: max_abs=0.25 max_ulp=")) << r.out;
+  EXPECT_TRUE(has(r.out, "mismatched=1/")) << r.out;
+  EXPECT_TRUE(has(r.err, "first mismatch deform.tess.positions[" + std::to_string(element) +
+                             "]: sub-triangle 2 (input triangle ")) << r.err;
+  EXPECT_TRUE(has(r.out, "conform: FAIL")) << r.out;
+  json j = json::parse(slurp(dir / "r.json"));
+  bool found = false;
+  for (const json& res : j["results"])
+    if (res["buffer"] == "deform.tess.positions") {
+      found = true;
+      EXPECT_EQ(res["status"], "Fail");
+      EXPECT_EQ(res["first_mismatch"]["element"], element);
+    }
+  EXPECT_TRUE(found);
+  fs::remove_all(dir);
+}
+
+// Two cases, so a crash or a hang in the first shows that the run goes on with the second.
+fs::path twoCases(const fs::path& dir) {
+  std::ofstream(dir / "two.cases") << "first " << kData << "/cube2.obj -l " << kData
+                                   << "/lattices/cube2_twist.npy --method classic --strict\n"
+                                   << "second " << kData << "/cube.obj -l " << kData
+                                   << "/lattices/cube_bend.npy --method classic --strict\n";
+  return dir / "two.cases";
+}
+
+TEST(ConformRunner, InjectedCrashAndHangAreResultsAndTheRunGoesOn) {
+  fs::path dir = tempDir("conform_faults");
+  const std::string args = "conform --cases " + twoCases(dir).string() + " --backends vulkan,cpu --timeout 2 --json " +
+                           (dir / "r.json").string();
+  RunResult r = runSffd(args, "SFFD_CONFORM_FAULT=crash:vulkan:first");
+  EXPECT_EQ(r.status, 1) << r.out << r.err;
+  EXPECT_TRUE(has(r.err, "vulkan first: Crash: killed by signal 11")) << r.err;
+  EXPECT_TRUE(has(r.out, "second/classic.positions vulkan vs cpu: max_abs=0 max_ulp=0 mismatched=0/")) << r.out;
+  json j = json::parse(slurp(dir / "r.json"));
+  EXPECT_EQ(j["results"][0]["test"], "first/classic.positions/vulkan-vs-cpu");
+  EXPECT_EQ(j["results"][0]["status"], "Crash");
+
+  r = runSffd(args, "SFFD_CONFORM_FAULT=hang:vulkan:first");
+  EXPECT_EQ(r.status, 1) << r.out << r.err;
+  EXPECT_TRUE(has(r.err, "vulkan first: Timeout: no progress for 2 s")) << r.err;
+  EXPECT_TRUE(has(r.out, "second/classic.normals vulkan vs cpu: max_abs=0")) << r.out;
+
+  // The crash listed in a baseline is an expected failure (exit 0); a listed test that passes is not.
+  std::ofstream(dir / "failures.csv") << "# test,status\nfirst/classic.positions/vulkan-vs-cpu,Crash\n"
+                                      << "first/classic.normals/vulkan-vs-cpu,Crash\n";
+  r = runSffd(args + " --baseline " + (dir / "failures.csv").string(), "SFFD_CONFORM_FAULT=crash:vulkan:first");
+  EXPECT_EQ(r.status, 0) << r.out << r.err;
+  EXPECT_TRUE(has(r.out, "conform: PASS")) << r.out;
+  r = runSffd(args + " --baseline " + (dir / "failures.csv").string());
+  EXPECT_EQ(r.status, 1) << r.out << r.err;
+  EXPECT_TRUE(has(r.err, "UnexpectedPass first/classic.normals/vulkan-vs-cpu")) << r.err;
+  fs::remove_all(dir);
+}
+
+TEST(ConformRunner, DefaultCasesCoverEveryKernel) {
+  RunResult r = runSffd("conform --cases default --backends vulkan,cpu");
+  EXPECT_EQ(r.status, 0) << r.out << r.err;
+  for (const char* b : {"classic.positions", "classic.normals", "pn.records", "clip.headers", "clip.records",
+                        "deform.patches", "deform.tess.positions", "deform.tess.normals", "accurate.patches",
+                        "accurate.tess.positions", "accurate.tess.normals"})
+    EXPECT_TRUE(has(r.out, std::string("/") + b + " vulkan vs cpu: ")) << b;
+  for (const char* c : {"smooth-cube-split/", "smooth-cube2-knot-box/", "classic-sphere-double/", "accurate-cube-fast/"})
+    EXPECT_TRUE(has(r.out, c)) << c;
+}
+
+TEST(ConformRunner, BadUsageIsExit2) {
+  EXPECT_EQ(runSffd("conform").status, 2);
+  EXPECT_EQ(runSffd("conform " + kCube2 + " --backends vulkan,metal").status, 2);
+  EXPECT_EQ(runSffd("conform " + kCube2 + " --method nope").status, 2);
+  EXPECT_EQ(runSffd("conform " + kCube2 + " --cases default").status, 2);
+  EXPECT_EQ(runSffd("conform " + kCube2 + " --timeout 0").status, 2);
+  EXPECT_EQ(runSffd("conform " + kCube2 + " --backends cpu,vulkan --require gl-egl").status, 2);
+}
+
+TEST(ConformRunner, DevicesJsonHasIdsAndDriverVersion) {
+  RunResult r = runSffd("devices --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  json j = json::parse(r.out);
+  ASSERT_FALSE(j["devices"].empty());
+  bool vulkan = false;
+  for (const json& d : j["devices"]) {
+    for (const char* k : {"backend", "device", "driver", "driver_version", "vendor_id", "device_id", "uuid"})
+      EXPECT_TRUE(d.contains(k)) << k;
+    if (d["backend"] == "vulkan") {
+      vulkan = true;
+      EXPECT_TRUE(d["vendor_id"].is_number()) << d;
+      EXPECT_EQ(d["uuid"].get<std::string>().size(), 32u) << d;
+    }
+  }
+  EXPECT_TRUE(vulkan) << r.out;
+}
+
+}  // namespace
