@@ -8,7 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "io/atomic_file.h"
-#include "apps/sffd/cli.h"
+#include "apps/sffd/deform_job.h"
 #include <sffd/error.h>
 #include "kernels/clip/knot_box_clip.h"
 #include "model/mesh_topology.h"
@@ -59,11 +59,6 @@ nlohmann::ordered_json statsJson(const QualityStats& q) {
           {"quality_histogram", q.histogram}};
 }
 
-double defaultEdgeLength(const Mesh& mesh) {
-  glm::dvec3 lo, hi;
-  meshBounds(mesh, lo, hi);
-  return 0.1 * std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
-}
 
 int run(const ParsedArgs& args) {
   std::string out = args.requireValue("--output");
@@ -76,7 +71,7 @@ int run(const ParsedArgs& args) {
   auto t0 = std::chrono::steady_clock::now();
   Job job = loadJob(args);
   if (!job.mesh.normalsFromFile) applyCreaseAngle(job.mesh, args.getDouble("--crease-angle", 40.0));
-  double l = args.has("--edge-length") ? args.getDouble("--edge-length", 0) : defaultEdgeLength(job.mesh);
+  double l = edgeLengthOf(args, job.mesh);
   checkEdgeLength(job.mesh, l);
   Device device = openDeviceFromArgs(args);
   KernelVariant variant;

@@ -22,10 +22,7 @@ Method methodOf(const std::string& name) {
 }
 
 double edgeLengthOf(const ParsedArgs& args, const Mesh& mesh) {
-  if (args.has("--edge-length")) return args.getDouble("--edge-length", 0);
-  glm::dvec3 lo, hi;
-  meshBounds(mesh, lo, hi);
-  return 0.1 * std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
+  return args.has("--edge-length") ? args.getDouble("--edge-length", 0) : defaultEdgeLength(mesh);
 }
 
 DeformOptions deformOptionsOf(const ParsedArgs& args, const Job& job, Device& device, Method method) {

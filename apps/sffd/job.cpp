@@ -142,16 +142,7 @@ Device openDeviceFromArgs(const ParsedArgs& args) {
   return d;
 }
 
-void checkEdgeLength(const Mesh& mesh, double l) {
-  if (!(l > 0) || !std::isfinite(l)) throw Error(ErrorKind::Input, "--edge-length must be a positive number");
-  double estimate = estimateSubTriangles(mesh, l);
-  if (estimate > kMaxSubTriangles) {
-    char buf[200];
-    std::snprintf(buf, sizeof buf, "--edge-length %g would make about %.3g sub-triangles, above the limit of %.3g", l,
-                  estimate, kMaxSubTriangles);
-    throw Error(ErrorKind::Input, buf);
-  }
-}
+void checkEdgeLength(const Mesh& mesh, double l) { checkSubTriangleCount(mesh, l, "--edge-length"); }
 
 uint64_t memoryLimitFromEnvironment() {
   const char* s = std::getenv("SFFD_MEMORY_LIMIT");

@@ -4,6 +4,7 @@
 #include <charconv>
 #include <cctype>
 #include <cmath>
+#include <limits>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -68,6 +69,23 @@ double estimateSubTriangles(const Mesh& mesh, double l) {
   for (const auto& t : mesh.triangles)
     area += 0.5 * glm::length(glm::cross(mesh.positions[t[1]] - mesh.positions[t[0]], mesh.positions[t[2]] - mesh.positions[t[0]]));
   return area / (std::sqrt(3.0) / 4 * l * l) + double(mesh.triangles.size());
+}
+
+double defaultEdgeLength(const Mesh& mesh) {
+  glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (const glm::dvec3& p : mesh.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
+  return mesh.positions.empty() ? 0 : 0.1 * std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
+}
+
+void checkSubTriangleCount(const Mesh& mesh, double l, const std::string& name) {
+  if (!(l > 0) || !std::isfinite(l)) throw Error(ErrorKind::Input, name + " must be a positive number");
+  const double estimate = estimateSubTriangles(mesh, l);
+  if (estimate > kMaxSubTriangles) {
+    char buf[160];
+    std::snprintf(buf, sizeof buf, " %g would make about %.3g sub-triangles, above the limit of %.3g", l, estimate,
+                  kMaxSubTriangles);
+    throw Error(ErrorKind::Input, name + buf);
+  }
 }
 
 std::string formatBytes(uint64_t bytes) {

@@ -32,6 +32,12 @@ struct JobEstimate {
 // and at least one a triangle; jobs above kMaxSubTriangles are refused.
 constexpr double kMaxSubTriangles = 50e6;
 double estimateSubTriangles(const Mesh& mesh, double l);
+// The edge length smooth FFD uses when none is given: a tenth of the mesh's largest extent (the
+// reference implementation's l = 0.2 for models in [-1, 1]).
+double defaultEdgeLength(const Mesh& mesh);
+// Refuses (input Error) an edge length that is not a positive number or whose estimate exceeds
+// kMaxSubTriangles, before any work; `name` is how the message calls it ("--edge-length" in the tool).
+void checkSubTriangleCount(const Mesh& mesh, double l, const std::string& name);
 
 // Estimate for `deform --method classic`: the input mesh, the kernel outputs widened to double, the
 // deformed copy, the writer's position index; on a GPU the lattice buffers and, kept on the device by

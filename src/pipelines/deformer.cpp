@@ -74,12 +74,7 @@ ResolvedOptions resolve(const DeformOptions& o, const DeviceInfo& info, const Me
   if (!std::isfinite(o.edgeLength) || o.edgeLength < 0)
     throw Error(ErrorKind::Input, "the edge length must be a finite number > 0 (or 0: a tenth of the mesh's size)");
   r.edgeLength = o.edgeLength;
-  if (r.edgeLength == 0) {
-    // The reference implementation's l = 0.2 for models in [-1,1]: a tenth of the largest extent.
-    glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi = -lo;
-    for (const auto& p : mesh.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
-    r.edgeLength = 0.1 * std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
-  }
+  if (r.edgeLength == 0) r.edgeLength = defaultEdgeLength(mesh);
   const int degrees = lattice.degree[0] + lattice.degree[1] + lattice.degree[2];
   r.samples = std::max(3, o.samples > 0 ? o.samples : degrees);
   r.knotBoxClip = o.clip == Clip::KnotBox;
@@ -90,17 +85,6 @@ ResolvedOptions resolve(const DeformOptions& o, const DeviceInfo& info, const Me
   return r;
 }
 
-// Smooth FFD's size limit, before any work: the number of sub-triangles the edge length makes.
-void checkSmoothSize(const Mesh& mesh, double l) {
-  if (!(l > 0) || !std::isfinite(l)) throw Error(ErrorKind::Input, "the edge length must be a positive number");
-  double estimate = estimateSubTriangles(mesh, l);
-  if (estimate > kMaxSubTriangles) {
-    char buf[200];
-    std::snprintf(buf, sizeof buf, "the edge length %g would make about %.3g sub-triangles, above the limit of %.3g", l,
-                  estimate, kMaxSubTriangles);
-    throw Error(ErrorKind::Input, buf);
-  }
-}
 
 }  // namespace
 
@@ -126,7 +110,7 @@ Deformer::Deformer(Device& device, const Mesh& mesh, const Lattice& lattice, con
   if (r.method == Method::Smooth) {
     // Smooth FFD's pre-images index the mesh with its creases split (the error analysis needs it).
     if (!I.input.normalsFromFile) applyCreaseAngle(I.input, r.creaseAngleDeg);
-    checkSmoothSize(I.input, r.edgeLength);
+    checkSubTriangleCount(I.input, r.edgeLength, "the edge length");
     // Host and device memory before anything is allocated (docs/ROBUSTNESS.md "Limits").
     const DeviceInfo& info = device.info();
     const bool deviceIsHost = info.api == "cpu" || info.type == "cpu";
