@@ -36,13 +36,7 @@ void writePatchFile(const std::string& path, DeformRun& run, const std::vector<d
 
 int run(const ParsedArgs& args) {
   std::string out = args.requireValue("--output");
-  args.requireValue("--lattice");
-  std::string method = args.get("--method", "smooth");
-  methodOf(method);   // an input Error for another name, before any work
-  std::string clip = args.get("--clip", "regular");
-  if (clip != "regular" && clip != "knot-box") throw Error(ErrorKind::Input, "--clip must be regular or knot-box");
-  auto opt = [&](const char* o) { return args.has(o) ? std::optional<std::string>(args.get(o)) : std::nullopt; };
-  checkSizeOptions(opt("--edge-length"), opt("--tess"));   // docs/ROBUSTNESS.md "Limits"
+  checkJobOptions(args);
   checkOutputPath(out, {args.positional[0], args.get("--lattice")});
   if (args.has("--stats")) checkOutputPath(args.get("--stats"), {args.positional[0], args.get("--lattice"), out});
   if (args.has("--patches")) checkOutputPath(args.get("--patches"), {args.positional[0], args.get("--lattice"), out});

@@ -17,13 +17,7 @@ namespace {
 nlohmann::ordered_json statsJson(const ErrorStats& s) { return {{"avg", s.avg}, {"max", s.max}, {"std", s.std}}; }
 
 int run(const ParsedArgs& args) {
-  args.requireValue("--lattice");
-  std::string method = args.get("--method", "smooth");
-  methodOf(method);   // an input Error for another name, before any work
-  std::string clip = args.get("--clip", "regular");
-  if (clip != "regular" && clip != "knot-box") throw Error(ErrorKind::Input, "--clip must be regular or knot-box");
-  auto opt = [&](const char* o) { return args.has(o) ? std::optional<std::string>(args.get(o)) : std::nullopt; };
-  checkSizeOptions(opt("--edge-length"), opt("--tess"));
+  checkJobOptions(args);
 
   Job job = loadJob(args);
   Device device = openDeviceFromArgs(args);

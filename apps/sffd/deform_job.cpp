@@ -21,6 +21,15 @@ Method methodOf(const std::string& name) {
   throw Error(ErrorKind::Input, "--method must be smooth, accurate or classic, not '" + name + "'");
 }
 
+void checkJobOptions(const ParsedArgs& args) {
+  args.requireValue("--lattice");
+  methodOf(args.get("--method", "smooth"));
+  const std::string clip = args.get("--clip", "regular");
+  if (clip != "regular" && clip != "knot-box") throw Error(ErrorKind::Input, "--clip must be regular or knot-box");
+  auto opt = [&](const char* o) { return args.has(o) ? std::optional<std::string>(args.get(o)) : std::nullopt; };
+  checkSizeOptions(opt("--edge-length"), opt("--tess"));   // docs/ROBUSTNESS.md "Limits"
+}
+
 double edgeLengthOf(const ParsedArgs& args, const Mesh& mesh) {
   return args.has("--edge-length") ? args.getDouble("--edge-length", 0) : defaultEdgeLength(mesh);
 }

@@ -43,4 +43,8 @@ DeformRun runDeformJob(const ParsedArgs& args, Job& job, Device& device);
 // models in [-1, 1]).
 double edgeLengthOf(const ParsedArgs& args, const Mesh& mesh);
 
+// The options of a deformation checked before any work (an input Error naming the first bad one):
+// --lattice given, --method and --clip known, --edge-length and --tess in range.
+void checkJobOptions(const ParsedArgs& args);
+
 }  // namespace sffd::cli
