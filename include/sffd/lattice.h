@@ -67,6 +67,17 @@ Lattice fitLattice(const Mesh& mesh, std::array<int, 3> counts = {5, 5, 5}, std:
 // control points, relative to the lattice box. Throws an input Error for an unknown name.
 void applyLatticePreset(Lattice& lattice, const std::string& name, double amount);
 
+// Knot insertion (Boehm): every knot span of axis a split into parts[a] equal spans (1: unchanged,
+// up to 64). The volume is the same to rounding (about 1e-15 of the control net's size), with more
+// control points to move. Throws an input Error naming `source` for a bad lattice or part count.
+Lattice refineLattice(const Lattice& lattice, std::array<int, 3> parts, const std::string& source = "refine");
+
+// Degree elevation: degree[a] raised by by[a] (the result stays <= 5), every interior knot's
+// multiplicity raised as much, so the continuity and the volume are unchanged (to rounding); the knot
+// vectors come back clamped over the same domain. A discontinuous lattice (an interior knot of
+// multiplicity above the degree) is refused with an input Error naming `source`.
+Lattice elevateLattice(const Lattice& lattice, std::array<int, 3> by, const std::string& source = "elevate");
+
 struct LatticeReadOptions {
   std::array<int, 3> npyDegree{2, 2, 2};   // .npy files carry no degree
   // .npy files carry no box: the box is the bounding box of the mesh normalised by the caller
@@ -85,7 +96,9 @@ Lattice readLattice(const std::string& path, const LatticeReadOptions& options =
 
 // Writes the format the extension names: .json (native, everything), .npy (the control points only, an
 // array (mu, mv, mw, 3) of float64, read back with the .npy conventions) or .prm (PyGeM's: only a
-// lattice of one Bezier box on a rotated rectangular box; points outside are then left unmoved).
+// lattice of one Bezier box on a rotated rectangular box; points outside are then left unmoved) or .vtk
+// (the control net as a legacy VTK structured grid for ParaView, with each point's displacement from the
+// identity; written only, not read).
 // Throws an input Error for another extension or a lattice the format cannot hold.
 void writeLattice(const std::string& path, const Lattice& lattice);
 

@@ -10,7 +10,7 @@
 // The headers, each a page:
 //   <sffd/error.h>     sffd::Error and its kinds: every failure is one of them, what() is one line.
 //   <sffd/mesh.h>      sffd::Mesh, MeshView (the caller's arrays), readMesh, writeMesh.
-//   <sffd/lattice.h>   sffd::Lattice, fitLattice, presets, lattice files.
+//   <sffd/lattice.h>   sffd::Lattice, fitLattice, presets, refineLattice/elevateLattice, lattice files.
 //   <sffd/device.h>    sffd::Device: open by name with fallback, or adopt (below); listDevices.
 //   <sffd/deformer.h>  sffd::Deformer: prepare once, deform for each new lattice, results on the host
 //                      or in device buffers; options, timings, progress and cancel.

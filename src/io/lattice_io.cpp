@@ -371,8 +371,9 @@ void writeLattice(const std::string& path, const Lattice& lattice) {
   if (ext == ".json") return writeLatticeJson(path, lattice);
   if (ext == ".npy") return latticeio::writeNpy(path, lattice);
   if (ext == ".prm") return latticeio::writePrm(path, lattice);
+  if (ext == ".vtk") return latticeio::writeVtk(path, lattice);
   throw inputError(path, 0, "cannot write lattice format " + (ext.empty() ? std::string("(no extension)") : io::quoted(ext)) +
-                                "; expected .json, .npy or .prm");
+                                "; expected .json, .npy, .prm or .vtk");
 }
 
 void writeLatticeJson(const std::string& path, const Lattice& L) {

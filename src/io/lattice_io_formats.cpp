@@ -436,6 +436,35 @@ void writePrm(const std::string& path, const Lattice& L) {
   writePrmParameters(path, P);
 }
 
+// Legacy VTK (ASCII, version 3.0): the control net as a structured grid, which ParaView and VisIt open
+// as they are; x (the lattice's i) varies fastest in VTK's point order, the reverse of ours. Each point
+// also carries its displacement from the identity lattice's point, to colour or glyph by.
+void writeVtk(const std::string& path, const Lattice& L) {
+  validateLattice(L, path);
+  Lattice identity = L;
+  setIdentityControlPoints(identity);
+  std::string s = "# vtk DataFile Version 3.0\nsffd lattice: degree " + std::to_string(L.degree[0]) + "," +
+                  std::to_string(L.degree[1]) + "," + std::to_string(L.degree[2]) + "\nASCII\nDATASET STRUCTURED_GRID\n";
+  s += "DIMENSIONS " + std::to_string(L.counts[0]) + " " + std::to_string(L.counts[1]) + " " + std::to_string(L.counts[2]) + "\n";
+  auto points = [&](const std::vector<glm::dvec3>& values, const std::vector<glm::dvec3>* minus) {
+    for (int k = 0; k < L.counts[2]; ++k)
+      for (int j = 0; j < L.counts[1]; ++j)
+        for (int i = 0; i < L.counts[0]; ++i) {
+          glm::dvec3 v = values[L.index(i, j, k)];
+          if (minus) v -= (*minus)[L.index(i, j, k)];
+          for (int c = 0; c < 3; ++c) {
+            io::appendNumber(s, v[c], 0);
+            s += c < 2 ? ' ' : '\n';
+          }
+        }
+  };
+  s += "POINTS " + std::to_string(L.pointCount()) + " double\n";
+  points(L.controlPoints, nullptr);
+  s += "POINT_DATA " + std::to_string(L.pointCount()) + "\nVECTORS displacement double\n";
+  points(L.controlPoints, &identity.controlPoints);
+  writeFileAtomically(path, [&](std::ostream& os) { os.write(s.data(), std::streamsize(s.size())); });
+}
+
 void writePrmParameters(const std::string& path, const PygemParameters& P) {
   latticeOfPrm(P, path);   // the same checks as reading
   auto num = [](double v) {

@@ -21,6 +21,8 @@ Lattice readNpy(const std::string& path, const std::string& text, const LatticeR
 void writeNpy(const std::string& path, const Lattice& lattice);
 void writePrm(const std::string& path, const Lattice& lattice);
 void writePrmParameters(const std::string& path, const PygemParameters& parameters);
+// The control net as a legacy VTK structured grid (ParaView), with displacements from the identity.
+void writeVtk(const std::string& path, const Lattice& lattice);
 
 // Most control points a lattice file may ask for (checked before anything is allocated).
 constexpr size_t kMaxControlPoints = size_t(1) << 24;

@@ -54,13 +54,13 @@ TEST(LatticeWrite, NpyHoldsTheControlPoints) {
 TEST(LatticeWrite, RefusesWhatTheFormatCannotHold) {
   fs::path dir = test::tempDir("lattice_write_refused");
   Lattice L = makeIdentityLattice({0, 0, 0}, {1, 1, 1}, {5, 5, 5}, {2, 2, 2});   // 3 knot boxes an axis
-  for (const char* name : {"l.txt", "l", "l.vtk.gz"}) {
+  for (const char* name : {"l.txt", "l", "l.vtk.gz", "l.vtu"}) {
     try {
       writeLattice((dir / name).string(), L);
       ADD_FAILURE() << name << " was written";
     } catch (const Error& e) {
       EXPECT_EQ(e.kind(), ErrorKind::Input);
-      EXPECT_NE(std::string(e.what()).find("expected .json, .npy or .prm"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("expected .json, .npy, .prm or .vtk"), std::string::npos) << e.what();
     }
   }
   try {

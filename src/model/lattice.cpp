@@ -102,10 +102,6 @@ void validateLattice(const Lattice& L, const std::string& source) {
   if (!std::isfinite(det) || std::abs(det) < 1e-300) throw inputError(source, 0, "lattice frame is singular");
 }
 
-namespace {
-
-// Knot insertion on a scalar control polygon (the extraction is linear, so extracting unit vectors
-// gives the extraction matrix). Inserts t once into (U, P) of degree p.
 void insertKnot(std::vector<double>& U, std::vector<std::vector<double>>& P, int p, double t) {
   int k = int(std::upper_bound(U.begin(), U.end(), t) - U.begin()) - 1;   // last U[k] <= t
   int s = int(std::count(U.begin(), U.end(), t));
@@ -123,6 +119,8 @@ void insertKnot(std::vector<double>& U, std::vector<std::vector<double>>& P, int
   U.insert(U.begin() + k + 1, t);
   P = std::move(Q);
 }
+
+namespace {
 
 struct AxisExtraction {
   std::vector<double> breaks;

@@ -18,6 +18,11 @@ struct LatticeBoxForm {
 };
 LatticeBoxForm extractBoxForm(const Lattice& lattice);
 
+// Knot insertion (Boehm) on a control polygon of vectors of any length (a lattice's control points
+// along one axis, or unit vectors, whose result is the insertion's matrix): inserts t once into the
+// knot vector U of degree p and updates P.
+void insertKnot(std::vector<double>& U, std::vector<std::vector<double>>& P, int p, double t);
+
 // cof(M) = det(M) M^{-T}: maps normals through a linear map keeping orientation.
 glm::dmat3 cofactor(const glm::dmat3& m);
 

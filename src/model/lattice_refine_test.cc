@@ -1,0 +1,118 @@
+// refineLattice and elevateLattice change the basis, never the volume: random lattices of every degree,
+// uniform and non-uniform knots, evaluated inside and outside the box (extrapolation) before and after.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include <sffd/error.h>
+
+#include "kernels/common/lattice_eval.h"
+#include "model/lattice.h"
+#include "model/lattice_pack.h"
+
+namespace sffd {
+namespace {
+
+struct Evaluated {
+  PackedLattice packed;
+  std::vector<double> frame, coeffs;
+  LatticeEvaluator<double> eval;
+  explicit Evaluated(const Lattice& L)
+      : packed(packLattice(L)), frame(packed.frame), coeffs(packed.coeffs), eval(packed.params, frame, coeffs) {}
+  glm::dvec3 at(glm::dvec3 x) const {
+    auto v = eval.evaluate(RVec3<double>{x.x, x.y, x.z}).value;
+    return {v.x, v.y, v.z};
+  }
+};
+
+Lattice randomLattice(std::mt19937& rng, std::array<int, 3> degree, std::array<int, 3> counts, bool nonUniform) {
+  Lattice L = makeIdentityLattice({-1, -2, -0.5}, {1.5, 1, 0.5}, counts, degree);
+  std::uniform_real_distribution<double> u(-0.3, 0.3);
+  if (nonUniform)
+    for (int a = 0; a < 3; ++a) {
+      auto& k = L.knots[a];
+      for (int i = degree[a] + 1; i < counts[a]; ++i) k[i] = k[i] + 0.4 * (k[i + 1] - k[i]) * (u(rng) + 0.3);
+    }
+  for (auto& p : L.controlPoints) p += glm::dvec3(u(rng), u(rng), u(rng));
+  return L;
+}
+
+// Largest distance between the two volumes at points inside the box (outside: up to a quarter of it
+// beyond, where extrapolating a smaller knot box's polynomial further out magnifies rounding, so the
+// tests allow more there).
+double largestDifference(const Lattice& a, const Lattice& b, std::mt19937& rng, bool outside = false) {
+  Evaluated ea(a), eb(b);
+  const double m = outside ? 0.25 : 0.0;
+  std::uniform_real_distribution<double> x(-1 - 2.5 * m, 1.5 + 2.5 * m), y(-2 - 3 * m, 1 + 3 * m), z(-0.5 - m, 0.5 + m);
+  double worst = 0;
+  for (int n = 0; n < 400; ++n) {
+    glm::dvec3 p(x(rng), y(rng), z(rng));
+    if (n < 8) p = {n & 1 ? 1.5 : -1.0, n & 2 ? 1.0 : -2.0, n & 4 ? 0.5 : -0.5};   // the box's corners
+    worst = std::max(worst, glm::length(ea.at(p) - eb.at(p)));
+  }
+  return worst;
+}
+
+TEST(LatticeRefine, KnotInsertionKeepsTheVolume) {
+  std::mt19937 rng(7);
+  for (int p = 1; p <= 5; ++p)
+    for (bool nonUniform : {false, true}) {
+      Lattice L = randomLattice(rng, {p, p == 5 ? 1 : p + 1, 2}, {p + 3, p + 4, 4}, nonUniform);
+      Lattice R = refineLattice(L, {2, 3, 1});
+      const int spans0 = L.counts[0] - L.degree[0], spans1 = L.counts[1] - L.degree[1];
+      EXPECT_EQ(R.counts[0], L.counts[0] + spans0);
+      EXPECT_EQ(R.counts[1], L.counts[1] + 2 * spans1);
+      EXPECT_EQ(R.counts[2], L.counts[2]);
+      EXPECT_EQ(R.degree, L.degree);
+      EXPECT_LT(largestDifference(L, R, rng), 1e-12) << "degree " << p << (nonUniform ? " non-uniform" : "");
+      EXPECT_LT(largestDifference(L, R, rng, true), 1e-9) << "degree " << p << (nonUniform ? " non-uniform" : "");
+    }
+}
+
+TEST(LatticeRefine, DegreeElevationKeepsTheVolume) {
+  std::mt19937 rng(11);
+  for (int p = 1; p <= 4; ++p)
+    for (bool nonUniform : {false, true}) {
+      Lattice L = randomLattice(rng, {p, 1, 2}, {p + 3, 3, 5}, nonUniform);
+      Lattice E = elevateLattice(L, {1, 5 - 1, 0});
+      EXPECT_EQ(E.degree, (std::array<int, 3>{p + 1, 5, 2}));
+      // Each of the spans adds one control point a degree raised.
+      EXPECT_EQ(E.counts[0], L.counts[0] + (L.counts[0] - L.degree[0]));
+      EXPECT_EQ(E.counts[1], L.counts[1] + 4 * (L.counts[1] - L.degree[1]));
+      EXPECT_EQ(E.counts[2], L.counts[2]);
+      EXPECT_LT(largestDifference(L, E, rng), 1e-12) << "degree " << p << (nonUniform ? " non-uniform" : "");
+      EXPECT_LT(largestDifference(L, E, rng, true), 1e-9) << "degree " << p << (nonUniform ? " non-uniform" : "");
+    }
+}
+
+TEST(LatticeRefine, RepeatedKnotsKeepTheirContinuity) {
+  std::mt19937 rng(3);
+  Lattice L = randomLattice(rng, {3, 2, 2}, {7, 4, 4}, false);
+  L.knots[0][5] = L.knots[0][4];   // a double interior knot: C1 there
+  Lattice E = elevateLattice(L, {2, 0, 0});
+  EXPECT_EQ(std::count(E.knots[0].begin(), E.knots[0].end(), L.knots[0][4]), 4);
+  EXPECT_LT(largestDifference(L, E, rng), 1e-12);
+  EXPECT_LT(largestDifference(L, refineLattice(E, {3, 2, 2}), rng), 1e-12);
+}
+
+TEST(LatticeRefine, RefusesWhatItCannotDoExactly) {
+  std::mt19937 rng(5);
+  Lattice L = randomLattice(rng, {2, 2, 2}, {5, 5, 5}, false);
+  EXPECT_THROW(elevateLattice(L, {4, 0, 0}), Error);   // degree 6
+  EXPECT_THROW(refineLattice(L, {0, 1, 1}), Error);
+  EXPECT_THROW(refineLattice(L, {65, 1, 1}), Error);
+  Lattice D = randomLattice(rng, {2, 2, 2}, {7, 5, 5}, false);
+  D.knots[0][3] = D.knots[0][5] = D.knots[0][4];   // multiplicity 3 > degree 2: discontinuous
+  try {
+    elevateLattice(D, {1, 0, 0}, "d.json");
+    ADD_FAILURE() << "a discontinuous lattice was elevated";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Input);
+    EXPECT_NE(std::string(e.what()).find("d.json: knot u"), std::string::npos) << e.what();
+  }
+  // Knot insertion stays exact there.
+  EXPECT_LT(largestDifference(D, refineLattice(D, {2, 1, 1}), rng), 1e-12);
+}
+
+}  // namespace
+}  // namespace sffd
