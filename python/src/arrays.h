@@ -73,13 +73,18 @@ inline py::array_t<uint32_t> toArray(const std::vector<std::array<uint32_t, 3>>&
   return a;
 }
 
+// Three integers, or one for every axis (the command line's rule for U,V,W options).
 inline std::array<int, 3> triple(py::handle obj, const char* what) {
+  if (py::isinstance<py::int_>(obj)) {
+    const int v = obj.cast<int>();
+    return {v, v, v};
+  }
   try {
     auto v = obj.cast<std::vector<int>>();
     if (v.size() == 3) return {v[0], v[1], v[2]};
   } catch (const py::cast_error&) {
   }
-  throw Error(ErrorKind::Input, std::string(what) + ": expected three integers");
+  throw Error(ErrorKind::Input, std::string(what) + ": expected an integer or three");
 }
 
 }  // namespace sffd::python

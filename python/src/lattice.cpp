@@ -100,11 +100,17 @@ void bindLattice(py::module_& m) {
             return out;
           },
           "name"_a, "amount"_a, "A new lattice: this one with a preset (twist, bend, taper, bulge, noise) applied.")
+      .def(
+          "refined", [](const Lattice& L, py::handle parts) { return refineLattice(L, triple(parts, "parts"), "Lattice.refined"); },
+          "parts"_a, "A new lattice: every knot span of each axis split into parts (int or 3 ints) equal spans; the same volume.")
+      .def(
+          "elevated", [](const Lattice& L, py::handle by) { return elevateLattice(L, triple(by, "by"), "Lattice.elevated"); },
+          "by"_a, "A new lattice: the degrees raised by `by` (int or 3 ints; at most 5); the same volume.")
       .def("copy", [](const Lattice& L) { return L; })
       .def("__copy__", [](const Lattice& L) { return L; })
       .def("__deepcopy__", [](const Lattice& L, py::dict) { return L; }, "memo"_a)
       .def("save", [](const Lattice& L, const std::string& path) { writeLattice(path, L); }, "path"_a,
-           "Writes the format the extension names: .json (everything), .npy (control points), .prm (PyGeM's box).")
+           "Writes the format the extension names: .json (everything), .npy (control points), .prm (PyGeM's box), .vtk (control net).")
       .def("same_structure", [](const Lattice& a, const Lattice& b) { return sameLatticeStructure(a, b); }, "other"_a)
       .def_property("control_points", &controlPointView, &setControlPoints,
                     "(n, 3) float64 view on the control points, index (i*ny + j)*nz + k; edit in place or assign.")

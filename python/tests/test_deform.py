@@ -49,6 +49,14 @@ def test_control_points_edit_in_place(sphere):
     twisted = lat.preset("twist", 0.5)
     assert not np.array_equal(twisted.control_points, lat.control_points)   # a new lattice; this one unchanged
     assert lat.counts == (5, 5, 5) and lat.degree == (2, 2, 2) and lat.outside == "extrapolate"
+    v, t, _ = sphere
+    finer = twisted.refined((2, 1, 3)).elevated(1)
+    assert finer.counts == (14, 8, 20) and finer.degree == (3, 3, 3)
+    a = sffd.deform(v, t, twisted, method="classic", backend="cpu", precision="double")[0]
+    b = sffd.deform(v, t, finer, method="classic", backend="cpu", precision="double")[0]
+    assert np.abs(a - b).max() < 1e-12   # the same volume
+    with pytest.raises(sffd.InputError, match="degrees stay within"):
+        lat.elevated(4)
 
 
 def test_smooth_equals_the_cli(sphere, tmp_path):
