@@ -6,36 +6,13 @@
 
 #include <sffd/error.h>
 
-#include "kernels/common/lattice_eval.h"
-#include "model/lattice.h"
-#include "model/lattice_pack.h"
+#include "model/lattice_test_support.h"
 
 namespace sffd {
 namespace {
 
-struct Evaluated {
-  PackedLattice packed;
-  std::vector<double> frame, coeffs;
-  LatticeEvaluator<double> eval;
-  explicit Evaluated(const Lattice& L)
-      : packed(packLattice(L)), frame(packed.frame), coeffs(packed.coeffs), eval(packed.params, frame, coeffs) {}
-  glm::dvec3 at(glm::dvec3 x) const {
-    auto v = eval.evaluate(RVec3<double>{x.x, x.y, x.z}).value;
-    return {v.x, v.y, v.z};
-  }
-};
-
-Lattice randomLattice(std::mt19937& rng, std::array<int, 3> degree, std::array<int, 3> counts, bool nonUniform) {
-  Lattice L = makeIdentityLattice({-1, -2, -0.5}, {1.5, 1, 0.5}, counts, degree);
-  std::uniform_real_distribution<double> u(-0.3, 0.3);
-  if (nonUniform)
-    for (int a = 0; a < 3; ++a) {
-      auto& k = L.knots[a];
-      for (int i = degree[a] + 1; i < counts[a]; ++i) k[i] = k[i] + 0.4 * (k[i + 1] - k[i]) * (u(rng) + 0.3);
-    }
-  for (auto& p : L.controlPoints) p += glm::dvec3(u(rng), u(rng), u(rng));
-  return L;
-}
+using test::Evaluated;
+using test::randomLattice;
 
 // Largest distance between the two volumes at points inside the box (outside: up to a quarter of it
 // beyond, where extrapolating a smaller knot box's polynomial further out magnifies rounding, so the

@@ -7,6 +7,7 @@
 #include "model/lattice.h"
 #include "kernels/common/lattice_eval.h"
 #include "model/lattice_pack.h"
+#include "model/lattice_test_support.h"
 
 using namespace sffd;
 
@@ -42,28 +43,11 @@ glm::dvec3 deBoor(const Lattice& L, glm::dvec3 x) {
   return r;
 }
 
-struct Evaluated {
-  PackedLattice packed;
-  std::vector<double> frame, coeffs;
-  LatticeEvaluator<double> eval;
-  explicit Evaluated(const Lattice& L)
-      : packed(packLattice(L)), frame(packed.frame), coeffs(packed.coeffs), eval(packed.params, frame, coeffs) {}
-};
-
 glm::dvec3 toGlm(RVec3<double> v) { return {v.x, v.y, v.z}; }
 RVec3<double> fromGlm(glm::dvec3 v) { return {v.x, v.y, v.z}; }
 
-Lattice randomLattice(std::mt19937& rng, std::array<int, 3> degree, std::array<int, 3> counts, bool nonUniform) {
-  Lattice L = makeIdentityLattice({-1, -2, -0.5}, {1.5, 1, 0.5}, counts, degree);
-  std::uniform_real_distribution<double> u(-0.2, 0.2);
-  if (nonUniform)
-    for (int a = 0; a < 3; ++a) {
-      auto& k = L.knots[a];
-      for (int i = degree[a] + 1; i < counts[a]; ++i) k[i] = k[i] + 0.3 * (k[i + 1] - k[i]) * (u(rng) + 0.2);
-    }
-  for (auto& p : L.controlPoints) p += glm::dvec3(u(rng), u(rng), u(rng));
-  return L;
-}
+using test::Evaluated;
+using test::randomLattice;
 
 }  // namespace
 
