@@ -9,6 +9,8 @@
 #include "apps/render/render_programs.h"   // generated from apps/render/programs/ at configure time
 
 #include <algorithm>
+#include <cctype>
+#include <filesystem>
 #include <cerrno>
 #include <cmath>
 #include <csetjmp>
@@ -137,6 +139,13 @@ UpAxis parseUpAxis(const std::string& text) {
   if (t == "-y") return UpAxis::NegY;
   if (t == "-z") return UpAxis::NegZ;
   throw Error(ErrorKind::Input, "up axis must be x, y, z, -x, -y or -z, not '" + text + "'");
+}
+
+UpAxis upAxisFor(const std::string& option, const std::string& meshPath) {
+  if (option != "auto") return parseUpAxis(option);
+  std::string ext = std::filesystem::path(meshPath).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return ext == ".gltf" || ext == ".glb" ? UpAxis::PosY : UpAxis::PosZ;
 }
 
 glm::vec3 viridis(float t) {

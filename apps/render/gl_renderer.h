@@ -37,6 +37,10 @@ struct RenderItem {
 enum class UpAxis { PosX, PosY, PosZ, NegX, NegY, NegZ };
 // "x", "y", "z", "-x", "-y", "-z" (also "+x"...); throws an input Error otherwise.
 UpAxis parseUpAxis(const std::string& text);
+// The --up option of render and view: an axis as parseUpAxis reads it, or "auto": +y for glTF files
+// (.gltf, .glb: the format defines +Y as up), +z otherwise (CAD's and the teapot's convention; files
+// of the other formats carry no up axis, so y-up scans still need --up y).
+UpAxis upAxisFor(const std::string& option, const std::string& meshPath);
 
 struct RenderOptions {
   int width = 1200, height = 900;

@@ -406,5 +406,15 @@ TEST(RendererProviders, SharesTheProcessWithOtherContexts) {
   EXPECT_EQ(again.rgba, ia.rgba);
 }
 
+TEST(UpAxis, AutoIsYForGltfAndZOtherwise) {
+  EXPECT_EQ(upAxisFor("auto", "a/scene.GLB"), UpAxis::PosY);
+  EXPECT_EQ(upAxisFor("auto", "scene.gltf"), UpAxis::PosY);
+  EXPECT_EQ(upAxisFor("auto", "part.stl"), UpAxis::PosZ);
+  EXPECT_EQ(upAxisFor("auto", "teapot.bpt"), UpAxis::PosZ);
+  EXPECT_EQ(upAxisFor("-x", "scene.glb"), UpAxis::NegX);
+  EXPECT_EQ(upAxisFor("+y", "part.stl"), UpAxis::PosY);
+  EXPECT_THROW(upAxisFor("up", "part.stl"), sffd::Error);
+}
+
 }  // namespace
 }  // namespace sffd::gl

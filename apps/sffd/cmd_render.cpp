@@ -57,7 +57,7 @@ int run(const ParsedArgs& args) {
   ro.width = sizeOption(args, "--width", 1200);
   ro.height = sizeOption(args, "--height", 900);
   if (args.has("--view")) parseView(args.get("--view"), ro.azimuthDeg, ro.elevationDeg);
-  if (args.has("--up")) ro.up = gl::parseUpAxis(args.get("--up"));
+  ro.up = gl::upAxisFor(args.get("--up", "auto"), args.positional.at(0));
   ro.wireframe = args.has("--wireframe");
   const bool deform = args.has("--lattice");
   const std::string method = args.get("--method", "smooth");
@@ -153,7 +153,7 @@ CommandSpec renderCommand() {
       {"--width", "W", "picture width in pixels (default 1200)"},
       {"--height", "H", "picture height in pixels (default 900)"},
       {"--view", "AZ,EL", "view direction in degrees: azimuth around the up axis, elevation (default 30,20)"},
-      {"--up", "AXIS", "the model's up axis: x, y, z, -x, -y, -z (default z; y-up scans and exports: y)"},
+      {"--up", "AXIS", "the model's up axis: x, y, z, -x, -y, -z or auto (default: y for glTF, z otherwise; y-up scans: y)"},
       {"--wireframe", nullptr, "draw the triangle edges over the shading"},
       {"--compare", "WHAT", "classic|input: draw it on the left, the --method result on the right"},
       {"--color-by", "WHAT", "geometry|normal: colour the result by its error against the exact FFD (sffd error's metrics)"},

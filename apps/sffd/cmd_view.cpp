@@ -33,7 +33,7 @@ int run(const ParsedArgs& args) {
   ro.width = sizeOption(args, "--width", 1200);
   ro.height = sizeOption(args, "--height", 900);
   if (args.has("--view")) parseView(args.get("--view"), ro.azimuthDeg, ro.elevationDeg);
-  if (args.has("--up")) ro.up = gl::parseUpAxis(args.get("--up"));
+  ro.up = gl::upAxisFor(args.get("--up", "auto"), args.positional.at(0));
   ro.wireframe = args.has("--wireframe");
   cfg.settings.method = args.get("--method", "smooth");
   if (cfg.settings.method != "smooth" && cfg.settings.method != "accurate" && cfg.settings.method != "classic")
@@ -120,7 +120,7 @@ CommandSpec viewCommand() {
       {"--width", "W", "window width in pixels (default 1200)"},
       {"--height", "H", "window height in pixels (default 900)"},
       {"--view", "AZ,EL", "view direction in degrees, as for render (default 30,20)"},
-      {"--up", "AXIS", "the model's up axis: x, y, z, -x, -y, -z (default z; y-up scans and exports: y)"},
+      {"--up", "AXIS", "the model's up axis: x, y, z, -x, -y, -z or auto (default: y for glTF, z otherwise; y-up scans: y)"},
       {"--wireframe", nullptr, "start with the triangle edges drawn"},
       {"--replay", "SCRIPT", "run the commands of SCRIPT (one a line, see docs/CLI.md), then exit"},
       {"--out-dir", "DIR", "where screenshots and saved files go, and relative script paths point (default .)"},
