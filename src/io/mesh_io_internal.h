@@ -36,6 +36,9 @@ void addPolygon(Mesh& mesh, const uint32_t* corners, size_t n, size_t& dropped);
 // One warning line in mesh.warnings for the polygons addPolygon dropped, if any.
 void noteDroppedPolygons(Mesh& mesh, size_t dropped);
 
+// Index of each vertex's distinct position (first appearance order) and the number of distinct positions.
+std::vector<uint32_t> distinctPositions(const std::vector<glm::dvec3>& positions, uint32_t& count);
+
 // Largest vertex count a mesh may have (indices are uint32).
 constexpr uint64_t kMaxVertices = 0xFFFFFFF0u;
 
