@@ -137,7 +137,7 @@ void weldPositions(Mesh& mesh) {
 
 namespace meshio {
 
-void finishMesh(Mesh& mesh, const std::vector<uint8_t>& fromFile, const std::string& path) {
+void finishMesh(Mesh& mesh, const std::vector<uint8_t>& fromFile, const std::string& path, const std::vector<uint32_t>& normalShared) {
   const size_t n = mesh.positions.size();
   if (n > kMaxVertices) throw inputError(path, 0, "too many vertices");
   if (mesh.triangles.empty()) throw inputError(path, 0, "no triangles");
@@ -146,6 +146,12 @@ void finishMesh(Mesh& mesh, const std::vector<uint8_t>& fromFile, const std::str
       if (i >= n) throw inputError(path, 0, "vertex index " + std::to_string(i) + " out of range");
   for (const auto& p : mesh.positions)
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) throw inputError(path, 0, "non-finite vertex coordinate");
+  for (const auto& t : mesh.texcoords)
+    if (!std::isfinite(t.x) || !std::isfinite(t.y)) throw inputError(path, 0, "non-finite texture coordinate");
+  for (const auto& k : mesh.colors)
+    if (!std::isfinite(k.r) || !std::isfinite(k.g) || !std::isfinite(k.b) || !std::isfinite(k.a)) throw inputError(path, 0, "non-finite colour");
+  if ((!mesh.texcoords.empty() && mesh.texcoords.size() != n) || (!mesh.colors.empty() && mesh.colors.size() != n))
+    throw Error(ErrorKind::Internal, path + ": texture coordinates or colours not one per vertex");
   mesh.normals.resize(n, glm::dvec3(0.0));
   bool anyFromFile = false, anyComputed = false;
   std::vector<uint8_t> compute(n, 1);
@@ -171,6 +177,12 @@ void finishMesh(Mesh& mesh, const std::vector<uint8_t>& fromFile, const std::str
   }
   if (anyComputed) {
     std::vector<glm::dvec3> sum = angleWeightedSums(mesh);
+    if (normalShared.size() == n) {   // vertices split by another value (a texture seam) share one normal
+      for (size_t v = 0; v < n; ++v)
+        if (compute[v] && normalShared[v] != v) sum[normalShared[v]] += sum[v];
+      for (size_t v = 0; v < n; ++v)
+        if (compute[v] && normalShared[v] != v) sum[v] = sum[normalShared[v]];
+    }
     for (size_t v = 0; v < n; ++v)
       if (compute[v]) mesh.normals[v] = unitOrZ(sum[v]);
   }

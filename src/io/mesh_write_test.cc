@@ -1,6 +1,8 @@
 // Mesh writers (mesh_io_write.cpp): binary PLY and STL, and the attributes every format keeps.
 #include <gtest/gtest.h>
 
+#include <fstream>
+
 #include <sffd/error.h>
 
 #include "model/mesh.h"
@@ -66,6 +68,55 @@ TEST(MeshWrite, BinaryIsRefusedForTextFormats) {
     }
     EXPECT_FALSE(fs::exists(p));
   }
+  fs::remove_all(dir);
+}
+
+// Attributes survive OBJ and PLY (text and binary) round trips; PLY colours are bytes.
+TEST(MeshWrite, AttributesRoundTrip) {
+  const fs::path dir = tempDir("mesh_write_attributes");
+  {
+    std::ofstream(dir / "lib.mtl") << "newmtl red\nKd 1 0 0\nd 0.5\nmap_Kd -s 1 1 1 bricks.png\nnewmtl unused\nKd 0 1 0\n";
+    std::ofstream(dir / "in.obj") << "mtllib lib.mtl\nv 0 0 0 1 0 0\nv 1 0 0 0 1 0\nv 0 1 0 0 0 1\nv 1 1 0 1 1 1\n"
+                                     "vt 0 0\nvt 1 0\nvt 0 1\nvt 1 1\nvt 0.5 0.5\n"
+                                     "g a\nusemtl red\nf 1/1 2/2 3/3\ng b\nusemtl blue\nf 2/5 4/4 3/3\n";
+  }
+  const Mesh m = readMesh((dir / "in.obj").string());
+  ASSERT_EQ(m.positions.size(), 5u);   // position 2 with two texture coordinates: two vertices
+  EXPECT_EQ(m.texcoords[4], glm::dvec2(0.5, 0.5));
+  EXPECT_EQ(m.colors[1], glm::dvec4(0, 1, 0, 1));
+  EXPECT_EQ(m.triangleMaterial, (std::vector<uint32_t>{0, 1}));
+  EXPECT_EQ(m.triangleGroup, (std::vector<uint32_t>{0, 1}));
+  ASSERT_EQ(m.materials.size(), 2u);
+  EXPECT_EQ(m.materials[0].baseColor, glm::dvec4(1, 0, 0, 0.5));
+  EXPECT_EQ(m.materials[0].baseColorTexture, "bricks.png");
+  EXPECT_EQ(m.materials[1].baseColor, glm::dvec4(1.0));   // not in the library
+  for (const char* name : {"out.obj", "out.ply", "bin.ply"}) {
+    SCOPED_TRACE(name);
+    const std::string p = (dir / name).string();
+    writeMesh(p, m, MeshWriteOptions{.significantDigits = 17, .binary = std::string(name) == "bin.ply"});
+    const Mesh r = readMesh(p);
+    ASSERT_EQ(r.triangles.size(), 2u);
+    for (size_t f = 0; f < 2; ++f)
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_EQ(r.texcoords[r.triangles[f][c]], m.texcoords[m.triangles[f][c]]);
+        EXPECT_EQ(r.colors[r.triangles[f][c]], m.colors[m.triangles[f][c]]);
+      }
+    if (std::string(name) == "out.obj") {
+      EXPECT_EQ(r.triangleMaterial, m.triangleMaterial);
+      EXPECT_EQ(r.triangleGroup, m.triangleGroup);
+      EXPECT_EQ(r.groups, m.groups);
+      EXPECT_EQ(r.materialLibraries, m.materialLibraries);
+      EXPECT_EQ(r.materials[0].baseColorTexture, "bricks.png");   // lib.mtl is beside out.obj too
+    }
+  }
+  // PLY's other names for texture coordinates, and float colours.
+  std::ofstream(dir / "st.ply") << "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                                   "property float s\nproperty float t\nproperty float red\nproperty float green\nproperty float blue\n"
+                                   "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                                   "0 0 0 0.25 0.5 1 0.5 0\n1 0 0 1 0 0 0 0\n0 1 0 0 1 0 0 0\n3 0 1 2\n";
+  const Mesh st = readMesh((dir / "st.ply").string());
+  EXPECT_EQ(st.texcoords[0], glm::dvec2(0.25, 0.5));
+  EXPECT_EQ(st.colors[0], glm::dvec4(1, 0.5, 0, 1));
   fs::remove_all(dir);
 }
 
