@@ -77,7 +77,7 @@ struct MeshReadOptions {
   int bptResolution = 10;   // .bpt: grid segments per patch side (10: 200 triangles a patch)
 };
 
-// Reads by extension (.obj .off .ply .stl .om, .bpt). Polygons are triangulated; missing or zero
+// Reads by extension (.obj .off .ply .stl .om, .bpt, .gltf .glb). Polygons are triangulated; missing or zero
 // normals are recomputed (angle-weighted). Throws an input Error ("file:line: what") on a bad file.
 Mesh readMesh(const std::string& path, const MeshReadOptions& options = {});
 
@@ -88,10 +88,11 @@ struct MeshWriteOptions {
   bool binary = false;
 };
 
-// Writes by extension (.obj .ply .off .stl) with vertex normals where the format has them, text
+// Writes by extension (.obj .ply .off .stl .gltf .glb) with vertex normals where the format has them, text
 // coordinates with `significantDigits` digits, to a temporary file renamed into place on success.
 // OBJ keeps texture coordinates (`vt`), groups, materials (`usemtl`) and `mtllib`; PLY texture
-// coordinates (u, v) and colours (uchar red green blue alpha).
+// coordinates (u, v) and colours (uchar red green blue alpha); glTF all of them, materials as PBR base
+// colour factor and texture URI.
 void writeMesh(const std::string& path, const Mesh& mesh, int significantDigits = 9);
 void writeMesh(const std::string& path, const Mesh& mesh, const MeshWriteOptions& options);
 

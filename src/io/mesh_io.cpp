@@ -8,6 +8,7 @@
 #include <unordered_map>
 
 #include "io/atomic_file.h"
+#include "io/gltf_io.h"
 #include <sffd/error.h>
 #include "io/io_util.h"
 #include "model/mesh.h"
@@ -17,14 +18,14 @@ namespace sffd {
 
 Mesh readMesh(const std::string& path, const MeshReadOptions& options) {
   std::string ext = io::lowerExtension(path);
-  static const char* known[] = {".obj", ".off", ".ply", ".stl", ".om", ".bpt"};
+  static const char* known[] = {".obj", ".off", ".ply", ".stl", ".om", ".bpt", ".gltf", ".glb"};
   bool ok = false;
   for (const char* k : known) ok = ok || ext == k;
   try {
     if (!ok)
       throw inputError(path, 0,
                        "unknown mesh format " + (ext.empty() ? std::string("(no extension)") : io::quoted(ext)) +
-                           "; expected .obj, .off, .ply, .stl, .om or .bpt");
+                           "; expected .obj, .off, .ply, .stl, .om, .bpt, .gltf or .glb");
     return meshio::readMeshBytes(path, io::readWholeFile(path), options);
   } catch (const Error& e) {
     throw Error(e.kind(), io::oneLine(e.what()));   // a file name with a newline still makes one line
@@ -46,6 +47,7 @@ Mesh dispatch(const std::string& path, std::string text, const MeshReadOptions& 
   if (ext == ".stl") return readStl(path, text);
   if (ext == ".om") return readOm(path, text);
   if (ext == ".bpt") return readBpt(path, text, options);
+  if (ext == ".gltf" || ext == ".glb") return readGltf(path, text);
   throw inputError(path, 0, "unknown mesh format " + io::quoted(ext));
 }
 }  // namespace

@@ -1,5 +1,5 @@
 // Mesh writers: .obj .ply .off .stl, text (numbers by std::to_chars with a fixed count of significant
-// digits) or, for .ply and .stl, binary little-endian. Output is built
+// digits) or, for .ply and .stl, binary little-endian; .gltf and .glb in gltf_write.cpp. Output is built
 // in a buffer handed to the stream in large pieces (a large mesh never sits in memory twice).
 #include <algorithm>
 #include <bit>
@@ -11,6 +11,7 @@
 #include <sffd/error.h>
 
 #include "io/atomic_file.h"
+#include "io/gltf_io.h"
 #include "io/io_util.h"
 #include "io/mesh_io_internal.h"
 
@@ -320,15 +321,17 @@ void writeMesh(const std::string& path, const Mesh& mesh, int significantDigits)
 
 void writeMesh(const std::string& path, const Mesh& mesh, const MeshWriteOptions& options) {
   const std::string ext = io::lowerExtension(path);
-  if (ext != ".obj" && ext != ".ply" && ext != ".off" && ext != ".stl")
+  const bool gltf = ext == ".gltf" || ext == ".glb";
+  if (ext != ".obj" && ext != ".ply" && ext != ".off" && ext != ".stl" && !gltf)
     throw inputError(path, 0,
                      "cannot write mesh format " + (ext.empty() ? std::string("(no extension)") : io::quoted(ext)) +
-                         "; expected .obj, .ply, .off or .stl");
+                         "; expected .obj, .ply, .off, .stl, .gltf or .glb");
   if (options.binary && ext != ".ply" && ext != ".stl")
-    throw inputError(path, 0, "binary output is for .ply and .stl " + io::quoted(ext) + " is text");
+    throw inputError(path, 0, "binary output is for .ply and .stl (.glb is binary glTF), not " + io::quoted(ext));
   const int digits = options.significantDigits;
   if (digits < 1 || digits > 17) throw Error(ErrorKind::Internal, "writeMesh: significant digits must be 1..17");
   const Carried has = checkWritable(path, mesh);
+  if (gltf) return meshio::writeGltf(path, mesh);
   writeFileAtomically(
       path,
       [&](std::ostream& os) {

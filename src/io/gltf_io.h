@@ -1,0 +1,19 @@
+// glTF 2.0 meshes (.gltf with its buffers, .glb): read with tinygltf, written here (one mesh, one
+// primitive per material, float attributes, uint32 indices). docs/CLI.md "glTF".
+#pragma once
+#include <string>
+
+#include "model/mesh.h"
+
+namespace sffd::meshio {
+
+// Every triangle primitive of the default scene (the first when none is named), node transforms
+// applied: POSITION, NORMAL, TEXCOORD_0 (v flipped to the OBJ convention), COLOR_0 and the material.
+// Strips and fans are triangulated; points and lines are skipped with a warning.
+Mesh readGltf(const std::string& path, const std::string& bytes);
+
+// .glb: one file; .gltf: the JSON and a buffer file named like it with .bin, both written whole or
+// not at all. `mesh` is checked by writeMesh.
+void writeGltf(const std::string& path, const Mesh& mesh);
+
+}  // namespace sffd::meshio
