@@ -29,6 +29,33 @@ bool keepImageUndecoded(tinygltf::Image*, const int, std::string*, std::string*,
   return true;
 }
 
+// External buffers are read only from regular files (not a FIFO or /dev/zero, which would never end),
+// and file names are taken as written (tinygltf's default expands them like a shell).
+bool readRegularFile(std::vector<unsigned char>* out, std::string* err, const std::string& path, void*) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) {
+    if (err) *err += "cannot read " + path + ": not a regular file\n";
+    return false;
+  }
+  try {
+    const std::string bytes = io::readWholeFile(path);
+    out->assign(bytes.begin(), bytes.end());
+    return true;
+  } catch (const Error& e) {
+    if (err) *err += std::string(e.what()) + "\n";
+    return false;
+  }
+}
+std::string pathAsWritten(const std::string& path, void*) { return path; }
+bool fileExists(const std::string& path, void*) {
+  std::error_code ec;
+  return std::filesystem::is_regular_file(path, ec);
+}
+bool refuseWrite(std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
+  if (err) *err += "not written\n";
+  return false;
+}
+
 class Reader {
  public:
   Reader(const std::string& path, const tinygltf::Model& model) : path_(path), m_(model) {}
@@ -201,6 +228,7 @@ class Reader {
 Mesh readGltf(const std::string& path, const std::string& bytes) {
   tinygltf::TinyGLTF loader;
   loader.SetImageLoader(keepImageUndecoded, nullptr);
+  loader.SetFsCallbacks(tinygltf::FsCallbacks{fileExists, pathAsWritten, readRegularFile, refuseWrite, nullptr});
   tinygltf::Model model;
   std::string err, warn;
   const std::string baseDir = std::filesystem::path(path).parent_path().string();
