@@ -4,6 +4,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
 
 #include "model/mesh.h"
 #include "support/cli_runner.h"
@@ -135,6 +138,45 @@ TEST(Formats, BadGltfIsOneErrorLine) {
     EXPECT_EQ(r.err.rfind("sffd: error: " + (dir / name).string() + ": ", 0), 0u) << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
     EXPECT_FALSE(fs::exists(dir / "x.obj"));
+  }
+  fs::remove_all(dir);
+}
+
+// Frames of `sffd animate` are separate `sffd deform` runs of the interpolated lattices, byte for byte.
+TEST(Formats, AnimateFramesEqualSeparateDeforms) {
+  const fs::path dir = tempDir("formats_animate");
+  const std::string mesh = kData + "/sphere.obj";
+  for (const auto& [name, preset] : {std::pair{"ident", ""}, {"twist", " --preset twist:0.8"}, {"bend", " --preset bend:1.0"}})
+    ASSERT_EQ(runSffd("lattice " + mesh + " --quiet -o " + (dir / (std::string(name) + ".json")).string() + preset).status, 0);
+  const std::string keys = " -l " + (dir / "ident.json").string() + " -l " + (dir / "twist.json").string() + " -l " + (dir / "bend.json").string();
+  const std::string options = " --backend cpu --quiet --edge-length 0.3 --tess 4 --precision float";
+  // 5 frames over 3 keys: the keys at frames 0, 2, 4, their midpoints at 1 and 3.
+  ASSERT_EQ(runSffd("animate " + mesh + keys + " --frames 5 -o " + (dir / "f_%d.ply").string() + options).status, 0);
+  auto controlPoints = [&](const char* name) { return nlohmann::json::parse(slurp(dir / name))["control_points"]; };
+  const nlohmann::json lattices[3] = {controlPoints("ident.json"), controlPoints("twist.json"), controlPoints("bend.json")};
+  for (int f = 0; f < 5; ++f) {
+    nlohmann::json L = nlohmann::json::parse(slurp(dir / "ident.json"));
+    const nlohmann::json &a = lattices[f / 2], &b = lattices[std::min(f / 2 + 1, 2)];
+    for (size_t i = 0; i < L["control_points"].size(); ++i)
+      for (int c = 0; c < 3; ++c)
+        L["control_points"][i][c] = f % 2 ? 0.5 * a[i][c].get<double>() + 0.5 * b[i][c].get<double>() : a[i][c].get<double>();
+    std::ofstream(dir / "frame.json") << L.dump();
+    ASSERT_EQ(runSffd("deform " + mesh + " -l " + (dir / "frame.json").string() + " -o " + (dir / "frame.ply").string() + options).status, 0);
+    EXPECT_EQ(slurp(dir / ("f_" + std::to_string(f) + ".ply")), slurp(dir / "frame.ply")) << "frame " << f;
+  }
+  // As glTF: morph targets and an animation that Khronos' validator accepts; mixed structures refused.
+  ASSERT_EQ(runSffd("animate " + mesh + keys + " --frames 5 --fps 10 -o " + (dir / "anim.glb").string() + options).status, 0);
+  const Mesh first = readMesh((dir / "anim.glb").string()), frame0 = readMesh((dir / "f_0.ply").string());
+  EXPECT_EQ(first.triangles.size(), frame0.triangles.size());
+  ASSERT_EQ(runSffd("lattice " + mesh + " --quiet --counts 4,4,4 -o " + (dir / "other.json").string()).status, 0);
+  const RunResult r = runSffd("animate " + mesh + " -l " + (dir / "ident.json").string() + " -l " + (dir / "other.json").string() +
+                              " --frames 3 -o " + (dir / "x.glb").string() + options);
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("differ from"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "x.glb"));
+  if (npmPackages()) {
+    const auto [ok, report] = validateGltf({dir / "anim.glb"});
+    EXPECT_TRUE(ok) << report;
   }
   fs::remove_all(dir);
 }

@@ -16,4 +16,9 @@ Mesh readGltf(const std::string& path, const std::string& bytes);
 // not at all. `mesh` is checked by writeMesh.
 void writeGltf(const std::string& path, const Mesh& mesh);
 
+// An animation: frames[0] is the mesh, every further frame (same vertices and triangles) a morph
+// target of POSITION and NORMAL differences, shown one after the other at `fps` frames a second by
+// an animation of the mesh's weights (linear: each frame blends into the next). .glb or .gltf.
+void writeGltfAnimation(const std::string& path, const std::vector<Mesh>& frames, double fps);
+
 }  // namespace sffd::meshio

@@ -10,6 +10,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include <sffd/error.h>
+
 #include "io/atomic_file.h"
 #include "io/gltf_io.h"
 #include "io/io_util.h"
@@ -80,7 +82,10 @@ nlohmann::ordered_json materialsOf(const Mesh& mesh, nlohmann::ordered_json& glt
 
 }  // namespace
 
-void writeGltf(const std::string& path, const Mesh& mesh) {
+void writeGltf(const std::string& path, const Mesh& mesh) { writeGltfAnimation(path, {mesh}, 0); }
+
+void writeGltfAnimation(const std::string& path, const std::vector<Mesh>& frames, double fps) {
+  const Mesh& mesh = frames.at(0);
   const bool glb = io::lowerExtension(path) == ".glb";
   const size_t n = mesh.positions.size();
   Builder b;
@@ -110,13 +115,42 @@ void writeGltf(const std::string& path, const Mesh& mesh) {
   }
   nlohmann::ordered_json gltf = {{"asset", {{"version", "2.0"}, {"generator", "sffd"}}}, {"scene", 0},
                                  {"scenes", {{{"nodes", {0}}}}}, {"nodes", {{{"mesh", 0}}}}};
+  // Morph targets: each further frame's differences from the first.
+  nlohmann::ordered_json targets = nlohmann::ordered_json::array();
+  for (size_t f = 1; f < frames.size(); ++f) {
+    const Mesh& k = frames[f];
+    if (k.positions.size() != n || k.triangles != mesh.triangles || k.normals.size() != mesh.normals.size())
+      throw Error(ErrorKind::Internal, path + ": animation frame " + std::to_string(f) + " has other vertices or triangles than frame 0");
+    nlohmann::ordered_json t;
+    t["POSITION"] = b.floats(flat([&](size_t v, int c) { return k.positions[v][c] - mesh.positions[v][c]; }, 3), 3, "VEC3", true);
+    if (!mesh.normals.empty())
+      t["NORMAL"] = b.floats(flat([&](size_t v, int c) { return k.normals[v][c] - mesh.normals[v][c]; }, 3), 3, "VEC3");
+    targets.push_back(t);
+  }
   nlohmann::ordered_json primitives = nlohmann::ordered_json::array();
   for (uint32_t m : order) {
     nlohmann::ordered_json p = {{"attributes", attributes}, {"indices", b.indices(byMaterial[m])}, {"mode", 4}};
     if (m != Mesh::kNoIndex) p["material"] = m;
+    if (!targets.empty()) p["targets"] = targets;
     primitives.push_back(p);
   }
   gltf["meshes"] = {{{"primitives", primitives}}};
+  if (!targets.empty()) {
+    // Key f (time f / fps) has weight 1 on target f - 1 and 0 elsewhere; key 0 is the mesh itself.
+    const size_t keys = frames.size(), weights = keys - 1;
+    gltf["meshes"][0]["weights"] = std::vector<double>(weights, 0.0);
+    std::vector<float> times, values(keys * weights, 0.0f);
+    for (size_t f = 0; f < keys; ++f) {
+      times.push_back(float(double(f) / fps));
+      if (f > 0) values[f * weights + f - 1] = 1.0f;
+    }
+    const int input = b.floats(times, 1, "SCALAR", true), output = b.floats(values, 1, "SCALAR");
+    b.views[size_t(b.accessors[size_t(input)]["bufferView"])].erase("target");   // animation data is no vertex buffer
+    b.views[size_t(b.accessors[size_t(output)]["bufferView"])].erase("target");
+    gltf["animations"] = {{{"name", "lattice"},
+                           {"samplers", {{{"input", input}, {"output", output}, {"interpolation", "LINEAR"}}}},
+                           {"channels", {{{"sampler", 0}, {"target", {{"node", 0}, {"path", "weights"}}}}}}}};
+  }
   if (!mesh.materials.empty()) gltf["materials"] = materialsOf(mesh, gltf);
   const std::string binName = std::filesystem::path(path).stem().string() + ".bin";
   nlohmann::ordered_json buffer = {{"byteLength", b.bin.size()}};
