@@ -76,6 +76,14 @@ void normalizeMesh(Mesh& mesh, double scale) {
     for (auto& p : patch.points) p = (p - c) * f;
 }
 
+namespace {
+std::string lowerExtensionOf(const std::string& path) {
+  std::string ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
+  return ext;
+}
+}  // namespace
+
 Job loadJob(const ParsedArgs& args) {
   Job job;
   job.meshPath = args.positional.at(0);
@@ -92,8 +100,7 @@ Job loadJob(const ParsedArgs& args) {
   } else if (std::string w = normalsAgainstWindingWarning(job.mesh, job.meshPath); !w.empty()) {
     warnOnSuccess(w);
   }
-  std::string ext = fs::path(job.latticePath).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
+  const std::string ext = lowerExtensionOf(job.latticePath);
   if (args.has("--normalize")) {
     double s = args.getDouble("--normalize", 1.0);
     if (!(s > 0)) throw Error(ErrorKind::Input, "--normalize needs a positive scale");
@@ -102,6 +109,12 @@ Job loadJob(const ParsedArgs& args) {
     job.normalizedTo = 0.99;   // the reference implementation's convention
   }
   if (job.normalizedTo) normalizeMesh(job.mesh, *job.normalizedTo);
+  job.lattice = loadJobLattice(args, job, job.latticePath);
+  return job;
+}
+
+Lattice loadJobLattice(const ParsedArgs& args, const Job& job, const std::string& latticePath) {
+  const std::string ext = lowerExtensionOf(latticePath);
   LatticeReadOptions lo;
   lo.npyDegree = args.getTriple("--degree", {2, 2, 2});
   meshBounds(job.mesh, lo.meshBoxLo, lo.meshBoxHi);
@@ -114,8 +127,7 @@ Job loadJob(const ParsedArgs& args) {
   }
   lo.haveMeshBox = !job.mesh.positions.empty();
   lo.memoryLimit = memoryLimitFromEnvironment();
-  job.lattice = withToolLimitName([&] { return readLattice(job.latticePath, lo); });
-  return job;
+  return withToolLimitName([&] { return readLattice(latticePath, lo); });
 }
 
 void checkOutputPath(const std::string& out, const std::vector<std::string>& inputs) {
