@@ -16,7 +16,7 @@ namespace fs = std::filesystem;
 std::vector<OptionSpec> jobOptions() {
   return {
       {"--lattice|-l", "FILE", "lattice: .json (native), .prm (PyGeM) or .npy (reference implementation)"},
-      {"--backend", "NAME", "auto|vulkan|gl|gl-egl|gl-osmesa|gl-glfw|cpu (auto: Vulkan, then GL, then CPU)"},
+      {"--backend", "NAME", "auto|vulkan|gl|gl-egl|gl-osmesa|gl-glfw|gles|cpu (auto: Vulkan, then GL, then CPU; gles: OpenGL ES 3.1)"},
       {"--device", "SUBSTRING", "use the first device whose name contains SUBSTRING"},
       {"--method", "NAME", "smooth|accurate|classic (default smooth)"},
       {"--clip", "NAME", "regular|knot-box sub-triangle clipping (default regular)"},

@@ -12,8 +12,8 @@ const EmbeddedKernel* findKernel(std::string_view name) {
   return nullptr;
 }
 
-std::string glslForVariant(const EmbeddedKernel& kernel, KernelVariant variant) {
-  std::string src = kernel.glsl;
+std::string glslForVariant(const EmbeddedKernel& kernel, KernelVariant variant, bool es) {
+  std::string src = es ? kernel.gles : kernel.glsl;
   size_t eol = src.find('\n');
   std::string defines = std::string("#define SFFD_STRICT ") + (variant.strict ? "1" : "0") +
                         "\n#define SFFD_F64 " + (variant.f64 ? "1" : "0") + "\n";
