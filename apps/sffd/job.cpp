@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "apps/sffd/cli.h"
+#include "core/backend.h"
 #include <sffd/error.h>
 #include "core/job_budget.h"
 #include "io/lattice_io.h"
@@ -167,7 +168,7 @@ bool wantDouble(const ParsedArgs& args, const DeviceInfo& info, bool autoDouble)
   std::string p = args.get("--precision", "auto");
   if (p == "float") return false;
   if (p == "double") {
-    if (!info.limits.float64) throw deviceError(info.name + " has no double-precision shader support");
+    if (!info.limits.float64) throw noFloat64Error(info);
     return true;
   }
   if (p != "auto") throw Error(ErrorKind::Input, "--precision must be auto, float or double");

@@ -431,7 +431,7 @@ TEST_P(BackendContract, StrictVariantsGiveTheCpuBackendsBits) {
 }
 
 std::vector<std::string> contractBackends() {
-  std::vector<std::string> names = {"vulkan", "vulkan-staging", "gl-egl", "gl-osmesa", "cpu"};
+  std::vector<std::string> names = {"vulkan", "vulkan-staging", "gl-egl", "gl-osmesa", "gles", "cpu"};
   return names;
 }
 

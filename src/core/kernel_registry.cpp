@@ -21,6 +21,12 @@ std::string glslForVariant(const EmbeddedKernel& kernel, KernelVariant variant, 
   return src;
 }
 
+Error noFloat64Error(const DeviceInfo& info) {
+  if (info.api == "gles")
+    return Error(ErrorKind::Input, "OpenGL ES has no double precision: use --precision float (or auto) with --backend gles");
+  return deviceError(info.name + " has no double-precision shader support");
+}
+
 void gridFor(uint64_t threads, const DeviceLimits& limits, uint32_t groups[3]) {
   uint64_t need = (threads + SFFD_LOCAL_SIZE - 1) / SFFD_LOCAL_SIZE;
   uint64_t maxX = std::min<uint64_t>(limits.maxWorkGroupCount[0], SFFD_MAX_GROUPS_X);
