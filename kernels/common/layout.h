@@ -75,14 +75,16 @@ SFFD_STRUCT_BEGIN(LatticeParams)
 SFFD_STRUCT_END(LatticeParams)
 
 // ---- kernel classic_ffd: one thread per vertex, deforms the position and normal ----
-#define SFFD_BINDING_CLASSIC_POS_IN SFFD_SLOT_3    // real4 per vertex (w ignored)
-#define SFFD_BINDING_CLASSIC_NRM_IN SFFD_SLOT_4    // real4 per vertex (w ignored)
-#define SFFD_BINDING_CLASSIC_POS_OUT SFFD_SLOT_5   // real4 per vertex (w = 1 inside the lattice box, 0 outside)
-#define SFFD_BINDING_CLASSIC_NRM_OUT SFFD_SLOT_6   // real4 per vertex (unit normal, w = 0)
+// Four storage blocks in all (the OpenGL ES 3.1 minimum): the lattice, the vertices in, the vertices
+// out, each range holding the positions and, from element range.z on, the normals.
+#define SFFD_BINDING_CLASSIC_IN SFFD_SLOT_3    // real4 per vertex: positions (w ignored), then normals (w ignored)
+#define SFFD_BINDING_CLASSIC_OUT SFFD_SLOT_4   // real4 per vertex: positions (w = 1 inside the lattice box, 0
+                                               // outside), then unit normals (w = 0)
 
 SFFD_STRUCT_BEGIN(ClassicParams)
   SFFD_STRUCT_MEMBER(LatticeParams, lattice)
-  SFFD_UVEC4 range;          // x: first vertex of this chunk (relative to the bound ranges), y: vertex count
+  SFFD_UVEC4 range;          // x: first vertex of this chunk (relative to the bound ranges), y: vertex count,
+                             // z: the element where the normals begin in both ranges
 SFFD_STRUCT_END(ClassicParams)
 
 // ---- kernel pn_triangles: one thread per original triangle (METHOD.md 3.2) ----

@@ -27,8 +27,8 @@ const bool kSoftware = [] {
 // a kernel that uses more than its entry, or a kernel not listed that uses more than 4, fails; so
 // does an entry that is no longer needed (lower it when a kernel's bindings are merged).
 const std::map<std::string, int> kOverStorageLimit = {
-    {"classic_ffd", 6},       {"pn_triangles", 5},     {"clip_count", 9},         {"clip_write", 11},
-    {"deform_smooth", 7},     {"deform_step_sample", 6}, {"deform_step_fit", 7},  {"deform_step_adjust", 7},
+    {"pn_triangles", 5},           {"clip_count", 9},         {"clip_write", 11},      {"deform_smooth", 7},
+    {"deform_step_sample", 6},     {"deform_step_fit", 7},    {"deform_step_adjust", 7},
     {"deform_step_tessellate", 7}, {"accurate_patches", 9}};
 
 std::unique_ptr<Backend> openGles(bool deviceLimits) {
@@ -96,7 +96,7 @@ TEST(GlesLimits, HeldToTheMinimumByDefault) {
         EXPECT_EQ(e.kind(), ErrorKind::Device) << e.what();
         EXPECT_NE(std::string(e.what()).find("SFFD_GLES_LIMITS=device"), std::string::npos) << e.what();
       }
-    } else {   // none today: every kernel is in kOverStorageLimit
+    } else {
       EXPECT_LE(programResources(*b, k.name, {true, false}).storageBlocks, es31::kMaxComputeStorageBlocks) << k.name;
     }
   }
@@ -104,7 +104,7 @@ TEST(GlesLimits, HeldToTheMinimumByDefault) {
   setenv("SFFD_GLES_LIMITS", "device", 1);
   auto own = openGles(false);
   ASSERT_TRUE(own);
-  EXPECT_GE(programResources(*own, "classic_ffd", {true, false}).storageBlocks, 5);
+  EXPECT_EQ(programResources(*own, "pn_triangles", {true, false}).storageBlocks, 5);
   setenv("SFFD_GLES_LIMITS", "phone", 1);
   Options o;
   o.provider = Provider::EGLES;
