@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "apps/sffd/cli.h"
+#include "core/backend.h"
 #include <sffd/error.h>
 #include "core/job_budget.h"
 #include "io/lattice_io.h"
@@ -16,7 +17,7 @@ namespace fs = std::filesystem;
 std::vector<OptionSpec> jobOptions() {
   return {
       {"--lattice|-l", "FILE", "lattice: .json (native), .prm (PyGeM) or .npy (reference implementation)"},
-      {"--backend", "NAME", "auto|vulkan|gl|gl-egl|gl-osmesa|gl-glfw|cpu (auto: Vulkan, then GL, then CPU)"},
+      {"--backend", "NAME", "auto|vulkan|gl|gl-egl|gl-osmesa|gl-glfw|gles|cpu (auto: Vulkan, then GL, then CPU; gles: OpenGL ES 3.1)"},
       {"--device", "SUBSTRING", "use the first device whose name contains SUBSTRING"},
       {"--method", "NAME", "smooth|accurate|classic (default smooth)"},
       {"--clip", "NAME", "regular|knot-box sub-triangle clipping (default regular)"},
@@ -179,7 +180,7 @@ bool wantDouble(const ParsedArgs& args, const DeviceInfo& info, bool autoDouble)
   std::string p = args.get("--precision", "auto");
   if (p == "float") return false;
   if (p == "double") {
-    if (!info.limits.float64) throw deviceError(info.name + " has no double-precision shader support");
+    if (!info.limits.float64) throw noFloat64Error(info);
     return true;
   }
   if (p != "auto") throw Error(ErrorKind::Input, "--precision must be auto, float or double");
