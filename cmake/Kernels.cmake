@@ -1,6 +1,7 @@
 # Compiles every kernel in kernels/<stage>/ to SPIR-V in four variants (strict x f64) with
-# glslangValidator, tracked by depfiles, and embeds them with the include-inlined GLSL into one
-# generated C++ file (src/core/kernel_registry.h). Add a kernel by adding STAGE/STEM to SFFD_KERNELS;
+# glslangValidator, tracked by depfiles; writes its OpenGL ES form ("#version 310 es", f32 only) and
+# checks it with glslang against the ES 3.1 rules in both float variants; and embeds them with the
+# include-inlined GLSL into one generated C++ file (src/core/kernel_registry.h). Add a kernel by adding STAGE/STEM to SFFD_KERNELS;
 # it is registered under its stem.
 set(SFFD_KERNELS
     classic/classic_ffd
@@ -12,7 +13,8 @@ set(SFFD_KERNELS
 
 set(SFFD_KERNEL_DIR ${PROJECT_SOURCE_DIR}/kernels)
 set(SFFD_SPV_DIR ${PROJECT_BINARY_DIR}/spv)
-file(MAKE_DIRECTORY ${SFFD_SPV_DIR})
+set(SFFD_GLES_DIR ${PROJECT_BINARY_DIR}/gles)
+file(MAKE_DIRECTORY ${SFFD_SPV_DIR} ${SFFD_GLES_DIR})
 file(GLOB SFFD_KERNEL_INCLUDES CONFIGURE_DEPENDS ${SFFD_KERNEL_DIR}/*/*.glsl ${SFFD_KERNEL_DIR}/common/layout.h)
 
 add_executable(embed_kernels ${PROJECT_SOURCE_DIR}/tools/embed_kernels.cpp)
@@ -36,13 +38,23 @@ foreach(kernel IN LISTS SFFD_KERNELS)
       VERBATIM)
     list(APPEND _spv_outputs ${out})
   endforeach()
+  set(es ${SFFD_GLES_DIR}/${stem}.comp)
+  add_custom_command(
+    OUTPUT ${es}
+    COMMAND embed_kernels --es ${es} ${SFFD_KERNEL_DIR}/${kernel}.comp
+    COMMAND Vulkan::glslangValidator --quiet -l -DSFFD_STRICT=0 -DSFFD_F64=0 ${es}
+    COMMAND Vulkan::glslangValidator --quiet -l -DSFFD_STRICT=1 -DSFFD_F64=0 ${es}
+    DEPENDS embed_kernels ${SFFD_KERNEL_DIR}/${kernel}.comp ${SFFD_KERNEL_INCLUDES}
+    COMMENT "glslang: ${stem} as OpenGL ES 3.1"
+    VERBATIM)
+  list(APPEND _spv_outputs ${es})
 endforeach()
 
 set(SFFD_KERNELS_CPP ${PROJECT_BINARY_DIR}/generated/kernels_embedded.cpp)
 add_custom_command(
   OUTPUT ${SFFD_KERNELS_CPP}
   COMMAND ${CMAKE_COMMAND} -E make_directory ${PROJECT_BINARY_DIR}/generated
-  COMMAND embed_kernels ${SFFD_KERNELS_CPP} ${SFFD_KERNEL_DIR} ${SFFD_SPV_DIR} ${SFFD_KERNELS}
+  COMMAND embed_kernels ${SFFD_KERNELS_CPP} ${SFFD_KERNEL_DIR} ${SFFD_SPV_DIR} ${SFFD_GLES_DIR} ${SFFD_KERNELS}
   DEPENDS embed_kernels ${_spv_outputs} ${SFFD_KERNEL_INCLUDES}
   COMMENT "Embedding kernels"
   VERBATIM)

@@ -8,7 +8,7 @@ SFFD_PACKAGES=(
   libosmesa6-dev libegl-dev libegl1-mesa-dev libgl-dev libgl1-mesa-dri libegl-mesa0
   mesa-vulkan-drivers libvulkan-dev vulkan-tools vulkan-validationlayers
   glslang-tools glslang-dev spirv-tools
-  libglm-dev libglfw3-dev libopenmesh-dev nlohmann-json3-dev libpng-dev python3-glad
+  libglm-dev libglfw3-dev libopenmesh-dev nlohmann-json3-dev libtinygltf-dev libpng-dev python3-glad
   libgtest-dev libbenchmark-dev
   clang libclang-rt-14-dev
   xvfb xauth

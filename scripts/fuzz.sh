@@ -22,7 +22,7 @@ cmake --build "$build" -j2 --target sffd_fuzz
 # Seeds per target, by extension.
 declare -A exts=(
   [fuzz_mesh_text]="obj off bpt ply stl"
-  [fuzz_mesh_binary]="ply stl om"
+  [fuzz_mesh_binary]="ply stl om glb gltf"
   [fuzz_lattice]="json prm npy"
 )
 declare -A dicts=([fuzz_mesh_text]=fuzz/mesh.dict [fuzz_mesh_binary]=fuzz/mesh.dict [fuzz_lattice]=fuzz/lattice.dict)

@@ -81,6 +81,12 @@ ParsedArgs parseArgs(const CommandSpec& spec, int argc, char** argv) {
             throw usage("option " + canonical + " needs a value (" + o->value + "), not the option '" + argv[i + 1] + "'");
           value = argv[++i];
         }
+        if (o->repeatable) {
+          a.repeated[canonical].push_back(value);
+          a.values.try_emplace(canonical, value);
+          lastValued = canonical;
+          continue;
+        }
         // One value per option: "-l a -l b" would silently keep b.
         if (auto it = a.values.find(canonical); it != a.values.end())
           throw usage("option " + canonical + " is given twice ('" + it->second + "' and '" + value + "'); give it once");
@@ -108,6 +114,12 @@ ParsedArgs parseArgs(const CommandSpec& spec, int argc, char** argv) {
                 " " + spec.usage + ")");
   }
   return a;
+}
+
+std::vector<std::string> ParsedArgs::all(const std::string& name) const {
+  if (auto it = repeated.find(name); it != repeated.end()) return it->second;
+  if (auto it = values.find(name); it != values.end()) return {it->second};
+  return {};
 }
 
 std::string ParsedArgs::get(const std::string& name, const std::string& fallback) const {

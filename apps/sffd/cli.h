@@ -18,6 +18,7 @@ struct OptionSpec {
   const char* name;    // "--backend" (a short alias follows after '|': "--output|-o")
   const char* value;   // placeholder of its value, nullptr for a flag
   const char* help;    // one line
+  bool repeatable = false;   // may be given more than once (ParsedArgs::all); get() is the first value
 };
 
 struct ParsedArgs;
@@ -35,6 +36,8 @@ struct ParsedArgs {
   const CommandSpec* command = nullptr;
   std::vector<std::string> positional;
   std::map<std::string, std::string> values;   // by canonical long name
+  std::map<std::string, std::vector<std::string>> repeated;   // repeatable options: every value in order
+  std::vector<std::string> all(const std::string& name) const;
   bool has(const std::string& name) const { return values.count(name) > 0; }
   std::string get(const std::string& name, const std::string& fallback = "") const;
   double getDouble(const std::string& name, double fallback) const;
@@ -58,6 +61,8 @@ struct Job {
   std::optional<double> normalizedTo;   // the --normalize scale applied to the mesh
 };
 Job loadJob(const ParsedArgs& args);
+// Another lattice for `job`, read with the same conventions as its own (--degree, the .npy box).
+Lattice loadJobLattice(const ParsedArgs& args, const Job& job, const std::string& latticePath);
 
 // A warning when the file's normals contradict the winding for most triangles (each face's geometric
 // normal against the mean of its corners' file normals); empty otherwise or without file normals.
@@ -115,7 +120,8 @@ CommandSpec clipCommand();
 CommandSpec errorCommand();
 CommandSpec renderCommand();
 CommandSpec benchCommand();
-CommandSpec viewCommand();   // cmd_view.cpp (src/view)
+CommandSpec viewCommand();
+CommandSpec animateCommand();   // cmd_animate.cpp   // cmd_view.cpp (src/view)
 
 template <class F>
 auto withToolLimitName(F&& f) -> decltype(f()) {

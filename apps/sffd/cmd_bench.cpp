@@ -196,7 +196,7 @@ CommandSpec benchCommand() {
     if (n == "--backend" || n == "--stats" || n == "--method" || n.rfind("--precision", 0) == 0) continue;
     options.push_back(o);
   }
-  options.insert(options.begin() + 1, {"--backends", "LIST", "comma-separated backends to time: vulkan, gl, gl-egl, gl-osmesa, cpu (default vulkan,gl)"});
+  options.insert(options.begin() + 1, {"--backends", "LIST", "comma-separated backends to time: vulkan, gl, gl-egl, gl-osmesa, gles, cpu (default vulkan,gl)"});
   options.insert(options.begin() + 2, {"--repeat", "N", "timed runs per backend (default 20); the median, min and max are reported"});
   options.insert(options.begin() + 3, {"--warmup", "N", "untimed runs after the cold first run (default 2)"});
   options.insert(options.begin() + 4, {"--json", nullptr, "print the results as JSON (docs/CLI.md) instead of a table"});

@@ -108,10 +108,10 @@ std::vector<BackendRun> readDump(const fs::path& dir, const std::vector<Case>& c
 }
 
 int run(const ParsedArgs& args) {
-  static const std::set<std::string> known{"vulkan", "gl", "gl-egl", "gl-osmesa", "gl-glfw", "cpu"};
+  static const std::set<std::string> known{"vulkan", "gl", "gl-egl", "gl-osmesa", "gl-glfw", "gles", "cpu"};
   const std::vector<std::string> names = listOf(args.get("--backends", "vulkan,gl-egl,gl-osmesa,cpu"));
   for (const std::string& n : names)
-    if (!known.count(n)) throw Error(ErrorKind::Input, "--backends: unknown backend '" + n + "' (vulkan, gl, gl-egl, gl-osmesa, gl-glfw, cpu)");
+    if (!known.count(n)) throw Error(ErrorKind::Input, "--backends: unknown backend '" + n + "' (vulkan, gl, gl-egl, gl-osmesa, gl-glfw, gles, cpu)");
   const std::vector<std::string> required = listOf(args.get("--require"));
   for (const std::string& n : required)
     if (std::find(names.begin(), names.end(), n) == names.end())

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "io/atomic_file.h"
+#include "io/io_util.h"
 #include "apps/sffd/cli.h"
 #include <sffd/error.h>
 #include "apps/sffd/deform_job.h"
@@ -37,6 +38,9 @@ void writePatchFile(const std::string& path, DeformRun& run, const std::vector<d
 int run(const ParsedArgs& args) {
   std::string out = args.requireValue("--output");
   checkJobOptions(args);
+  const std::string outExt = io::lowerExtension(out);
+  if (args.has("--binary") && outExt != ".ply" && outExt != ".stl")
+    throw Error(ErrorKind::Input, "--binary writes .ply and .stl, not '" + outExt + "'");
   checkOutputPath(out, {args.positional[0], args.get("--lattice")});
   if (args.has("--stats")) checkOutputPath(args.get("--stats"), {args.positional[0], args.get("--lattice"), out});
   if (args.has("--patches")) checkOutputPath(args.get("--patches"), {args.positional[0], args.get("--lattice"), out});
@@ -48,7 +52,7 @@ int run(const ParsedArgs& args) {
   const Timings& t = run.deformer.timings();
   const bool f64 = run.deformer.doublePrecision();
   Mesh& deformed = run.mesh;
-  writeMesh(out, deformed, f64 ? 17 : 9);
+  writeMesh(out, deformed, MeshWriteOptions{.significantDigits = f64 ? 17 : 9, .binary = args.has("--binary")});
   if (args.has("--patches")) {
     std::vector<double> controlPoints = run.deformer.patchControlPoints();
     if (controlPoints.empty()) throw Error(ErrorKind::Input, "--patches needs --method smooth");
@@ -90,7 +94,8 @@ CommandSpec deformCommand() {
                 "Deforms a mesh by a lattice and writes the result (.obj .ply .off .stl) with vertex normals.",
                 jobOptions(), run, 1, 1};
   c.options.insert(c.options.begin() + 1, {"--output|-o", "FILE", "output mesh (.obj .ply .off .stl)"});
-  c.options.insert(c.options.begin() + 2, {"--patches", "FILE", "smooth: also write the Bezier patches (docs/CLI.md)"});
+  c.options.insert(c.options.begin() + 2, {"--binary", nullptr, ".ply and .stl: write binary (little-endian float; double PLY with --precision double)"});
+  c.options.insert(c.options.begin() + 3, {"--patches", "FILE", "smooth: also write the Bezier patches (docs/CLI.md)"});
   return c;
 }
 

@@ -128,7 +128,7 @@ CommandSpec viewCommand() {
   for (const OptionSpec& o : jobOptions()) {
     std::string n = o.name;
     if (n == "--stats") c.options.push_back({"--stats", "FILE", "frame-time statistics as JSON at exit"});
-    else if (n == "--backend") c.options.push_back({"--backend", "NAME", "gl (default: the window's context, zero copy)|vulkan|gl-egl|gl-osmesa|cpu"});
+    else if (n == "--backend") c.options.push_back({"--backend", "NAME", "gl (default: the window's context, zero copy)|vulkan|gl-egl|gl-osmesa|gles|cpu"});
     else c.options.push_back(o);
   }
   return c;

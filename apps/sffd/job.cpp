@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "apps/sffd/cli.h"
+#include "core/backend.h"
 #include <sffd/error.h>
 #include "core/job_budget.h"
 #include "io/lattice_io.h"
@@ -16,7 +17,7 @@ namespace fs = std::filesystem;
 std::vector<OptionSpec> jobOptions() {
   return {
       {"--lattice|-l", "FILE", "lattice: .json (native), .prm (PyGeM) or .npy (reference implementation)"},
-      {"--backend", "NAME", "auto|vulkan|gl|gl-egl|gl-osmesa|gl-glfw|cpu (auto: Vulkan, then GL, then CPU)"},
+      {"--backend", "NAME", "auto|vulkan|gl|gl-egl|gl-osmesa|gl-glfw|gles|cpu (auto: Vulkan, then GL, then CPU; gles: OpenGL ES 3.1)"},
       {"--device", "SUBSTRING", "use the first device whose name contains SUBSTRING"},
       {"--method", "NAME", "smooth|accurate|classic (default smooth)"},
       {"--clip", "NAME", "regular|knot-box sub-triangle clipping (default regular)"},
@@ -76,6 +77,14 @@ void normalizeMesh(Mesh& mesh, double scale) {
     for (auto& p : patch.points) p = (p - c) * f;
 }
 
+namespace {
+std::string lowerExtensionOf(const std::string& path) {
+  std::string ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
+  return ext;
+}
+}  // namespace
+
 Job loadJob(const ParsedArgs& args) {
   Job job;
   job.meshPath = args.positional.at(0);
@@ -92,8 +101,7 @@ Job loadJob(const ParsedArgs& args) {
   } else if (std::string w = normalsAgainstWindingWarning(job.mesh, job.meshPath); !w.empty()) {
     warnOnSuccess(w);
   }
-  std::string ext = fs::path(job.latticePath).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
+  const std::string ext = lowerExtensionOf(job.latticePath);
   if (args.has("--normalize")) {
     double s = args.getDouble("--normalize", 1.0);
     if (!(s > 0)) throw Error(ErrorKind::Input, "--normalize needs a positive scale");
@@ -102,6 +110,12 @@ Job loadJob(const ParsedArgs& args) {
     job.normalizedTo = 0.99;   // the reference implementation's convention
   }
   if (job.normalizedTo) normalizeMesh(job.mesh, *job.normalizedTo);
+  job.lattice = loadJobLattice(args, job, job.latticePath);
+  return job;
+}
+
+Lattice loadJobLattice(const ParsedArgs& args, const Job& job, const std::string& latticePath) {
+  const std::string ext = lowerExtensionOf(latticePath);
   LatticeReadOptions lo;
   lo.npyDegree = args.getTriple("--degree", {2, 2, 2});
   meshBounds(job.mesh, lo.meshBoxLo, lo.meshBoxHi);
@@ -114,8 +128,7 @@ Job loadJob(const ParsedArgs& args) {
   }
   lo.haveMeshBox = !job.mesh.positions.empty();
   lo.memoryLimit = memoryLimitFromEnvironment();
-  job.lattice = withToolLimitName([&] { return readLattice(job.latticePath, lo); });
-  return job;
+  return withToolLimitName([&] { return readLattice(latticePath, lo); });
 }
 
 void checkOutputPath(const std::string& out, const std::vector<std::string>& inputs) {
@@ -167,7 +180,7 @@ bool wantDouble(const ParsedArgs& args, const DeviceInfo& info, bool autoDouble)
   std::string p = args.get("--precision", "auto");
   if (p == "float") return false;
   if (p == "double") {
-    if (!info.limits.float64) throw deviceError(info.name + " has no double-precision shader support");
+    if (!info.limits.float64) throw noFloat64Error(info);
     return true;
   }
   if (p != "auto") throw Error(ErrorKind::Input, "--precision must be auto, float or double");

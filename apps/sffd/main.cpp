@@ -21,7 +21,7 @@ static std::string oneLine(const char* what) {
 static std::vector<cli::CommandSpec> commands() {
   return {cli::deformCommand(), cli::latticeCommand(), cli::devicesCommand(), cli::conformCommand(), cli::clipCommand(),
           cli::errorCommand(),
-          cli::renderCommand(), cli::benchCommand(),
+          cli::renderCommand(), cli::benchCommand(), cli::animateCommand(),
 #if SFFD_WITH_VIEWER
           cli::viewCommand(),
 #endif

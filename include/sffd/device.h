@@ -24,8 +24,8 @@ struct DeviceLimits {
 };
 
 struct DeviceInfo {
-  std::string api;       // "vulkan", "gl" or "cpu"
-  std::string provider;  // how it was reached: "vulkan", "egl", "osmesa", "glfw", "cpu", "adopted"
+  std::string api;       // "vulkan", "gl", "gles" (OpenGL ES 3.1) or "cpu"
+  std::string provider;  // how it was reached: "vulkan", "egl", "osmesa", "glfw", "egl-es", "cpu", "adopted"
   std::string name;      // device name as the driver reports it
   std::string driver;    // driver / API version string
   std::string type;      // "discrete", "integrated", "virtual", "cpu", "other"
@@ -39,15 +39,20 @@ struct DeviceInfo {
 
 struct DeviceRequest {
   // auto (Vulkan, then GL through EGL then OSMesa, then the CPU), vulkan, gl, gl-egl, gl-osmesa,
-  // gl-glfw, cpu.
+  // gl-glfw, gles (OpenGL ES 3.1 through EGL; never picked by auto), cpu.
   std::string name = "auto";
   std::string deviceSubstring;   // the first device whose name contains it (case-insensitive)
   bool validation = false;       // Vulkan: VK_LAYER_KHRONOS_validation
+  // gles: use the device's own limits. By default it holds itself to the OpenGL ES 3.1 minimum
+  // limits (4 storage blocks a kernel, 16 KiB uniform blocks, 128 MiB storage ranges, 65535 groups
+  // an axis) whatever the driver reports, as a minimum phone would (docs/GLES.md). SFFD_GLES_LIMITS=
+  // device|minimum overrides it.
+  bool deviceLimits = false;
 };
 
 // One device that can be opened here, as listDevices() reports it.
 struct DeviceEntry {
-  std::string label;   // the name that opens it: "vulkan", "gl-egl", "gl-osmesa", "cpu"
+  std::string label;   // the name that opens it: "vulkan", "gl-egl", "gl-osmesa", "gles", "cpu"
   DeviceInfo info;
 };
 
@@ -61,7 +66,7 @@ class Device {
   Device& operator=(Device&&) noexcept;
   ~Device();
 
-  const std::string& label() const;   // "vulkan", "gl-egl", "gl-osmesa", "gl-glfw", "gl-adopted", "vulkan-adopted", "cpu"
+  const std::string& label() const;   // "vulkan", "gl-egl", "gl-osmesa", "gl-glfw", "gles", "gl-adopted", "gles-adopted", "vulkan-adopted", "cpu"
   const DeviceInfo& info() const;
 
   // Internal: the compute backend (src/core/backend.h). Not part of the stable API.

@@ -2,7 +2,9 @@
 //
 // A vertex is a (position, normal) pair; vertices that share a position but carry different normals
 // (split normals, creases) are separate vertices with the same weldId. Positions and normals are
-// glm::dvec3 (three tightly packed doubles), so `positions.data()` is an xyz array.
+// glm::dvec3 (three tightly packed doubles), so `positions.data()` is an xyz array. Texture
+// coordinates and colours, when the file has them, are per vertex too: a position with two texture
+// coordinates (a seam) is two vertices with the same weldId, as a position with two normals is.
 #pragma once
 #include <array>
 #include <cstddef>
@@ -18,6 +20,14 @@ struct BicubicPatch {
   std::array<glm::dvec3, 16> points;   // P(u,v) = sum_r sum_c B3_r(u) B3_c(v) points[4r+c]
 };
 
+// A material as the mesh files name it: OBJ `usemtl` (with its .mtl's Kd and map_Kd when the library
+// file is found), glTF's PBR base colour. Passed through from input to output; sffd never shades with it.
+struct Material {
+  std::string name;
+  glm::dvec4 baseColor{1.0, 1.0, 1.0, 1.0};   // linear RGBA factor (glTF baseColorFactor, OBJ Kd with alpha 1)
+  std::string baseColorTexture;               // image URI relative to the mesh file; empty: none
+};
+
 struct Mesh {
   std::vector<glm::dvec3> positions;             // per vertex
   std::vector<glm::dvec3> normals;               // per vertex, unit length
@@ -31,6 +41,18 @@ struct Mesh {
   // What reading the file repaired or skipped, one line each (the command-line tool prints them as
   // warnings); empty for a clean file.
   std::vector<std::string> warnings;
+
+  // Carried attributes (empty: the file has none). Every method keeps them: classic per vertex as they
+  // are, smooth and accurate interpolated from the parent triangle's corners at each output vertex.
+  std::vector<glm::dvec2> texcoords;   // per vertex; OBJ convention: (0, 0) is the image's lower left
+  std::vector<glm::dvec4> colors;      // per vertex, RGBA in [0, 1] as the file stores them (no colour space conversion)
+  // Per triangle, an index into `materials` / `groups`, or kNoIndex; empty: none at all.
+  static constexpr uint32_t kNoIndex = 0xFFFFFFFFu;
+  std::vector<uint32_t> triangleMaterial;
+  std::vector<Material> materials;
+  std::vector<uint32_t> triangleGroup;
+  std::vector<std::string> groups;             // OBJ `g` names
+  std::vector<std::string> materialLibraries;  // OBJ `mtllib` file names, written back as they were read
 };
 
 // A triangle mesh in the caller's memory (float or double xyz, 32-bit indices), read once when a
@@ -55,12 +77,23 @@ struct MeshReadOptions {
   int bptResolution = 10;   // .bpt: grid segments per patch side (10: 200 triangles a patch)
 };
 
-// Reads by extension (.obj .off .ply .stl .om, .bpt). Polygons are triangulated; missing or zero
+// Reads by extension (.obj .off .ply .stl .om, .bpt, .gltf .glb). Polygons are triangulated; missing or zero
 // normals are recomputed (angle-weighted). Throws an input Error ("file:line: what") on a bad file.
 Mesh readMesh(const std::string& path, const MeshReadOptions& options = {});
 
-// Writes by extension (.obj .ply .off .stl) with vertex normals where the format has them, text
+struct MeshWriteOptions {
+  int significantDigits = 9;   // text coordinates: 9 for float results, 17 for double (1..17)
+  // .ply and .stl: binary little-endian instead of text (PLY: float, or double with more than 9
+  // digits; STL: float, the format's only type). Other formats refuse it.
+  bool binary = false;
+};
+
+// Writes by extension (.obj .ply .off .stl .gltf .glb) with vertex normals where the format has them, text
 // coordinates with `significantDigits` digits, to a temporary file renamed into place on success.
+// OBJ keeps texture coordinates (`vt`), groups, materials (`usemtl`) and `mtllib`; PLY texture
+// coordinates (u, v) and colours (uchar red green blue alpha); glTF all of them, materials as PBR base
+// colour factor and texture URI.
 void writeMesh(const std::string& path, const Mesh& mesh, int significantDigits = 9);
+void writeMesh(const std::string& path, const Mesh& mesh, const MeshWriteOptions& options);
 
 }  // namespace sffd

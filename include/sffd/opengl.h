@@ -1,6 +1,7 @@
 // sffd/opengl.h: sffd on the application's own OpenGL context (interop).
 //
-// The context must be OpenGL 4.3 core or later and current on the calling thread whenever an sffd
+// The context must be OpenGL 4.3 core or later, or OpenGL ES 3.1 or later (the kernels' ES form, held
+// to the ES 3.1 minimum limits unless SFFD_GLES_LIMITS=device; docs/GLES.md), and current on the calling thread whenever an sffd
 // call that uses the device runs (opening, Deformer construction, deform(), result(), the
 // destructors). sffd never switches contexts on an adopted device, and every call restores the
 // state it changes: the current program, the storage, uniform, copy and pixel buffer bindings (the
@@ -21,8 +22,9 @@ using Proc = void (*)();
 using GetProcAddress = Proc (*)(const char* name);
 
 // A Device on the context current on this thread, its GL entry points loaded through `getProc`
-// (glfwGetProcAddress, eglGetProcAddress, ...). Throws a device Error when no context is current or
-// it is older than OpenGL 4.3 core.
+// (glfwGetProcAddress, eglGetProcAddress, ...). Its label is "gl-adopted", or "gles-adopted" on an
+// OpenGL ES context. Throws a device Error when no context is current or it is older than OpenGL 4.3
+// core (ES: 3.1).
 Device adoptCurrentContext(GetProcAddress getProc);
 
 // The GL buffer object holding a chunk of a Deformer's device output (its bytes from chunk.offset),

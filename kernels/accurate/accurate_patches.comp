@@ -37,10 +37,10 @@ layout(std430, SFFD_SET binding = SFFD_BINDING_ACC_SAMPLES) buffer AccSamples { 
 // variant): on a shared edge one weight is 0 and the sum of the other two terms is the same bits from
 // both sides only without contraction into fma.
 real3 accFlatPoint(real3 c0, real3 c1, real3 c2, uint i, uint j, uint k, uint d) {
-  precise real l0 = real(i) / real(d);
-  precise real l1 = real(j) / real(d);
-  precise real l2 = real(k) / real(d);
-  precise real3 r = (c0 * l0 + c1 * l1) + c2 * l2;
+  SFFD_PRECISE real l0 = real(i) / real(d);
+  SFFD_PRECISE real l1 = real(j) / real(d);
+  SFFD_PRECISE real l2 = real(k) / real(d);
+  SFFD_PRECISE real3 r = (c0 * l0 + c1 * l1) + c2 * l2;
   return r;
 }
 

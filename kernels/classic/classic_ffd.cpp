@@ -24,8 +24,9 @@ void classicRun(Backend& backend, const Mesh& mesh, const PackedLattice& P, Kern
   BufferId bCoeffs = backend.createBuffer(coeffs.size() * sizeof(Real));
   backend.upload(bFrame, 0, frame.data(), frame.size() * sizeof(Real));
   backend.upload(bCoeffs, 0, coeffs.data(), coeffs.size() * sizeof(Real));
-  BufferId io[4];
-  for (BufferId& b : io) b = backend.createBuffer(chunk * vertexBytes);
+  // One buffer in and one out: the positions, then the normals from element `chunk`.
+  BufferId io[2];
+  for (BufferId& b : io) b = backend.createBuffer(2 * chunk * vertexBytes);
 
   out.positions.resize(4 * n);
   out.normals.resize(4 * n);
@@ -40,13 +41,13 @@ void classicRun(Backend& backend, const Mesh& mesh, const PackedLattice& P, Kern
       q[0] = Real(nn.x), q[1] = Real(nn.y), q[2] = Real(nn.z), q[3] = 0;
     }
     backend.upload(io[0], 0, pos.data(), count * vertexBytes);
-    backend.upload(io[1], 0, nrm.data(), count * vertexBytes);
+    backend.upload(io[0], chunk * vertexBytes, nrm.data(), count * vertexBytes);
     dispatchClassicFfd(backend, P.params, variant, count,
                        {{SFFD_BINDING_LATTICE_COEFFS, bCoeffs}, {SFFD_BINDING_LATTICE_FRAME, bFrame},
-                        {SFFD_BINDING_CLASSIC_POS_IN, io[0]}, {SFFD_BINDING_CLASSIC_NRM_IN, io[1]},
-                        {SFFD_BINDING_CLASSIC_POS_OUT, io[2]}, {SFFD_BINDING_CLASSIC_NRM_OUT, io[3]}});
-    backend.download(io[2], 0, pos.data(), count * vertexBytes);
-    backend.download(io[3], 0, nrm.data(), count * vertexBytes);
+                        {SFFD_BINDING_CLASSIC_IN, io[0]}, {SFFD_BINDING_CLASSIC_OUT, io[1]}},
+                       chunk);
+    backend.download(io[1], 0, pos.data(), count * vertexBytes);
+    backend.download(io[1], chunk * vertexBytes, nrm.data(), count * vertexBytes);
     for (size_t i = 0; i < 4 * count; ++i) {
       out.positions[4 * first + i] = pos[i];
       out.normals[4 * first + i] = nrm[i];
@@ -62,8 +63,10 @@ void classicRun(Backend& backend, const Mesh& mesh, const PackedLattice& P, Kern
 }  // namespace
 
 size_t classicChunkVertices(const DeviceLimits& lim, size_t n, size_t realBytes, size_t maxChunk) {
-  // Every binding of a chunk stays within the device's storage range and group-count limits.
-  size_t maxByRange = size_t(lim.maxStorageBufferRange / (4 * realBytes));
+  // Every binding of a chunk (positions and normals, the latter at an aligned offset) stays within the
+  // device's storage range and group-count limits.
+  size_t maxByRange = size_t((lim.maxStorageBufferRange - std::min(lim.maxStorageBufferRange, lim.storageOffsetAlignment)) /
+                             (8 * realBytes));
   size_t maxByGroups = size_t(lim.maxWorkGroupCount[0]) * lim.maxWorkGroupCount[1] * SFFD_LOCAL_SIZE;
   size_t chunk = std::min({maxByRange, maxByGroups, std::max<size_t>(n, 1)});
   if (maxChunk) chunk = std::min(chunk, maxChunk);
@@ -71,16 +74,16 @@ size_t classicChunkVertices(const DeviceLimits& lim, size_t n, size_t realBytes,
 }
 
 void dispatchClassicFfd(Backend& backend, const gpu::LatticeParams& lattice, KernelVariant variant, size_t count,
-                        const ClassicBindings& b) {
+                        const ClassicBindings& b, size_t normalsAt) {
   gpu::ClassicParams params;
   params.lattice = lattice;
-  params.range = {0, uint32_t(count), 0, 0};
+  params.range = {0, uint32_t(count), uint32_t(normalsAt), 0};
   Dispatch d;
   d.kernel = "classic_ffd";
   d.variant = variant;
   d.params = &params;
   d.paramsSize = sizeof(params);
-  d.buffers = {b.coeffs, b.frame, b.posIn, b.nrmIn, b.posOut, b.nrmOut};
+  d.buffers = {b.coeffs, b.frame, b.in, b.out};
   gridFor(count, backend.info().limits, d.groups);
   backend.dispatch(d);
   backend.barrier();
@@ -105,11 +108,11 @@ template <class Real>
 void classicThreads(const CpuKernelArgs& a, uint64_t first, uint64_t last) {
   const auto& p = a.paramsAs<gpu::ClassicParams>();
   LatticeEvaluator<Real> eval = boundLattice<Real>(a, p.lattice);
-  const uint64_t n = 4 * (uint64_t(p.range.x) + p.range.y);
-  const Real* posIn = a.array<const Real>(SFFD_BINDING_CLASSIC_POS_IN, n).data();
-  const Real* nrmIn = a.array<const Real>(SFFD_BINDING_CLASSIC_NRM_IN, n).data();
-  Real* posOut = a.array<Real>(SFFD_BINDING_CLASSIC_POS_OUT, n).data();
-  Real* nrmOut = a.array<Real>(SFFD_BINDING_CLASSIC_NRM_OUT, n).data();
+  const uint64_t n = 4 * (uint64_t(p.range.x) + p.range.y), normals = 4 * uint64_t(p.range.z);
+  const Real* posIn = a.array<const Real>(SFFD_BINDING_CLASSIC_IN, normals + n).data();
+  const Real* nrmIn = posIn + normals;
+  Real* posOut = a.array<Real>(SFFD_BINDING_CLASSIC_OUT, normals + n).data();
+  Real* nrmOut = posOut + normals;
   for (uint64_t t = first; t < std::min<uint64_t>(last, p.range.y); ++t) {
     const size_t v = 4 * size_t(p.range.x + uint32_t(t));
     RVec3<Real> x{posIn[v], posIn[v + 1], posIn[v + 2]}, nr{nrmIn[v], nrmIn[v + 1], nrmIn[v + 2]};

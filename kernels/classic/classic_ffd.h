@@ -29,12 +29,13 @@ ClassicOutput classicFfd(Backend& backend, const Mesh& mesh, const PackedLattice
 size_t classicChunkVertices(const DeviceLimits& limits, size_t vertices, size_t realBytes, size_t maxChunk);
 
 // One dispatch of the kernel over `count` vertices (4 reals each: positions with w = 1, normals w = 0),
-// followed by a barrier.
+// followed by a barrier. `in` and `out` each hold the positions, then from element `normalsAt` of the
+// bound range the normals (layout.h, ClassicParams).
 struct ClassicBindings {
-  BufferBinding coeffs, frame, posIn, nrmIn, posOut, nrmOut;
+  BufferBinding coeffs, frame, in, out;
 };
 void dispatchClassicFfd(Backend& backend, const gpu::LatticeParams& lattice, KernelVariant variant, size_t count,
-                        const ClassicBindings& bindings);
+                        const ClassicBindings& bindings, size_t normalsAt);
 
 struct CpuKernelArgs;
 namespace cpu {

@@ -17,22 +17,51 @@
 // Largest work-group count per dimension guaranteed by the API (and the limit on llvmpipe/lavapipe).
 #define SFFD_MAX_GROUPS_X 65535
 
-// Binding 0 of every kernel is its parameter block (a uniform buffer); storage buffers use 1..SFFD_MAX_STORAGE_BINDINGS.
-// Vulkan shares one binding namespace between uniform and storage buffers, so the numbers never overlap.
+// Binding 0 of every kernel is its parameter block (a uniform buffer); storage buffers use slots
+// 1..SFFD_MAX_STORAGE_BINDINGS. Vulkan shares one binding namespace between uniform and storage
+// buffers, so the numbers never overlap. OpenGL ES counts storage bindings from 0 in a namespace of
+// their own, of which ES 3.1 guarantees only 4: there (GL_ES, the kernels' ES form) slot s is binding
+// s - 1, and the gles backend binds it there. A table, since ES layout qualifiers take only literals
+// and its preprocessor has no token pasting; the host (C++) always sees the slot numbers.
 #define SFFD_BINDING_PARAMS 0
 #define SFFD_MAX_STORAGE_BINDINGS 12
+#if defined(GL_ES)
+#define SFFD_SLOT_1 0
+#define SFFD_SLOT_2 1
+#define SFFD_SLOT_3 2
+#define SFFD_SLOT_4 3
+#define SFFD_SLOT_5 4
+#define SFFD_SLOT_6 5
+#define SFFD_SLOT_7 6
+#define SFFD_SLOT_8 7
+#define SFFD_SLOT_9 8
+#define SFFD_SLOT_10 9
+#define SFFD_SLOT_11 10
+#else
+#define SFFD_SLOT_1 1
+#define SFFD_SLOT_2 2
+#define SFFD_SLOT_3 3
+#define SFFD_SLOT_4 4
+#define SFFD_SLOT_5 5
+#define SFFD_SLOT_6 6
+#define SFFD_SLOT_7 7
+#define SFFD_SLOT_8 8
+#define SFFD_SLOT_9 9
+#define SFFD_SLOT_10 10
+#define SFFD_SLOT_11 11
+#endif
 
 // Highest B-spline degree per axis supported by the kernels.
 #define SFFD_MAX_DEGREE 5
 
 // ---- lattice (shared by every kernel that evaluates the B-spline volume) ----
-#define SFFD_BINDING_LATTICE_COEFFS 1   // per-knot-box Bezier control points: real4 each (w unused)
-#define SFFD_BINDING_LATTICE_FRAME 2    // reals: the affine frame, then the distinct knot values
+#define SFFD_BINDING_LATTICE_COEFFS SFFD_SLOT_1   // per-knot-box Bezier control points: real4 each (w unused)
+#define SFFD_BINDING_LATTICE_FRAME SFFD_SLOT_2    // reals: the affine frame, then the distinct knot values
 
 // Offsets (in reals) inside the lattice frame buffer.
-#define SFFD_FRAME_AFFINE 0        // 12: rows of the 3x4 map world point -> lattice parameter
-#define SFFD_FRAME_COF_AFFINE 12   // 12: rows of cof(A) (A = the 3x3 part), 4th of each row unused
-#define SFFD_FRAME_BREAKS 24       // distinct knot values of u, then v, then w
+#define SFFD_FRAME_AFFINE 0u        // 12: rows of the 3x4 map world point -> lattice parameter
+#define SFFD_FRAME_COF_AFFINE 12u   // 12: rows of cof(A) (A = the 3x3 part), 4th of each row unused
+#define SFFD_FRAME_BREAKS 24u       // distinct knot values of u, then v, then w
 
 // outside_mode values: what happens to a point outside the lattice box.
 #define SFFD_OUTSIDE_EXTRAPOLATE 0u   // evaluate the nearest knot box's polynomial (continuous)
@@ -46,43 +75,45 @@ SFFD_STRUCT_BEGIN(LatticeParams)
 SFFD_STRUCT_END(LatticeParams)
 
 // ---- kernel classic_ffd: one thread per vertex, deforms the position and normal ----
-#define SFFD_BINDING_CLASSIC_POS_IN 3    // real4 per vertex (w ignored)
-#define SFFD_BINDING_CLASSIC_NRM_IN 4    // real4 per vertex (w ignored)
-#define SFFD_BINDING_CLASSIC_POS_OUT 5   // real4 per vertex (w = 1 inside the lattice box, 0 outside)
-#define SFFD_BINDING_CLASSIC_NRM_OUT 6   // real4 per vertex (unit normal, w = 0)
+// Four storage blocks in all (the OpenGL ES 3.1 minimum): the lattice, the vertices in, the vertices
+// out, each range holding the positions and, from element range.z on, the normals.
+#define SFFD_BINDING_CLASSIC_IN SFFD_SLOT_3    // real4 per vertex: positions (w ignored), then normals (w ignored)
+#define SFFD_BINDING_CLASSIC_OUT SFFD_SLOT_4   // real4 per vertex: positions (w = 1 inside the lattice box, 0
+                                               // outside), then unit normals (w = 0)
 
 SFFD_STRUCT_BEGIN(ClassicParams)
   SFFD_STRUCT_MEMBER(LatticeParams, lattice)
-  SFFD_UVEC4 range;          // x: first vertex of this chunk (relative to the bound ranges), y: vertex count
+  SFFD_UVEC4 range;          // x: first vertex of this chunk (relative to the bound ranges), y: vertex count,
+                             // z: the element where the normals begin in both ranges
 SFFD_STRUCT_END(ClassicParams)
 
 // ---- kernel pn_triangles: one thread per original triangle (METHOD.md 3.2) ----
 // Mesh buffers shared by the pre-compute kernels.
-#define SFFD_BINDING_MESH_POSITIONS 3      // real4 per vertex (w unused)
-#define SFFD_BINDING_MESH_NORMALS 4        // real4 per vertex, unit (w unused)
-#define SFFD_BINDING_MESH_TRIANGLES 5      // 2 uvec4 per triangle: vertex ids (w unused), weld ids (w unused)
-#define SFFD_BINDING_MESH_SLOT_NORMALS 6   // 12 real4 per triangle: per corner slot, the first then the second
+#define SFFD_BINDING_MESH_POSITIONS SFFD_SLOT_3      // real4 per vertex (w unused)
+#define SFFD_BINDING_MESH_NORMALS SFFD_SLOT_4        // real4 per vertex, unit (w unused)
+#define SFFD_BINDING_MESH_TRIANGLES SFFD_SLOT_5      // 2 uvec4 per triangle: vertex ids (w unused), weld ids (w unused)
+#define SFFD_BINDING_MESH_SLOT_NORMALS SFFD_SLOT_6   // 12 real4 per triangle: per corner slot, the first then the second
                                            // normal of the slot (w of the first: 1 crease, 0 smooth;
                                            // w of the second: 1 when the first is the triangle's own)
-#define SFFD_BINDING_PN_OUT 7              // SFFD_PN_STRIDE real4 per triangle
-#define SFFD_MESH_TRIANGLE_STRIDE 2
-#define SFFD_SLOT_NORMAL_STRIDE 12
+#define SFFD_BINDING_PN_OUT SFFD_SLOT_7              // SFFD_PN_STRIDE real4 per triangle
+#define SFFD_MESH_TRIANGLE_STRIDE 2u
+#define SFFD_SLOT_NORMAL_STRIDE 12u
 // PN record: the 10 cubic geometry control points (linear index order 300,210,201,120,111,102,030,021,012,003)
 // then the 6 quadratic normal control points (200,110,101,020,011,002).
-#define SFFD_PN_STRIDE 16
-#define SFFD_PN_NORMALS 10
+#define SFFD_PN_STRIDE 16u
+#define SFFD_PN_NORMALS 10u
 
 // ---- kernels clip_count and clip_write: regular clipping by the split-pattern table (METHOD.md 4.2) ----
 // One thread per clip triangle (an original triangle, or a piece of one after the pre-split of
 // triangles whose edges need more than Nmax segments). Buffers 3..7 are the mesh and PN buffers above.
-#define SFFD_BINDING_SPLIT_TABLE 1     // uint: pattern entries (4 each), then vertices (4 each: lambda bits, edge | step << 16), then packed uint16 triangle indices
-#define SFFD_BINDING_CLIP_COUNTS 2     // uint per clip triangle: sub-triangle count (clip_count), exclusive offset (clip_write)
-#define SFFD_BINDING_CLIP_HEADERS 8    // 2 uvec4 per clip triangle: (parent, corner kinds, 0, 0), corner weld ids
-#define SFFD_BINDING_CLIP_REALS 9      // 9 real4 per clip triangle: lam[3], flat[3], edge params[3]
-#define SFFD_BINDING_SUB_HEADERS 10    // uvec4 per sub-triangle: parent, crease slot bits, 0, 0
-#define SFFD_BINDING_SUB_RECORDS 11    // SFFD_SUB_STRIDE real4 per sub-triangle
-#define SFFD_CLIP_HEADER_STRIDE 2
-#define SFFD_CLIP_REAL_STRIDE 9
+#define SFFD_BINDING_SPLIT_TABLE SFFD_SLOT_1     // uint: pattern entries (4 each), then vertices (4 each: lambda bits, edge | step << 16), then packed uint16 triangle indices
+#define SFFD_BINDING_CLIP_COUNTS SFFD_SLOT_2     // uint per clip triangle: sub-triangle count (clip_count), exclusive offset (clip_write)
+#define SFFD_BINDING_CLIP_HEADERS SFFD_SLOT_8    // 2 uvec4 per clip triangle: (parent, corner kinds, 0, 0), corner weld ids
+#define SFFD_BINDING_CLIP_REALS SFFD_SLOT_9      // 9 real4 per clip triangle: lam[3], flat[3], edge params[3]
+#define SFFD_BINDING_SUB_HEADERS SFFD_SLOT_10    // uvec4 per sub-triangle: parent, crease slot bits, 0, 0
+#define SFFD_BINDING_SUB_RECORDS SFFD_SLOT_11    // SFFD_SUB_STRIDE real4 per sub-triangle
+#define SFFD_CLIP_HEADER_STRIDE 2u
+#define SFFD_CLIP_REAL_STRIDE 9u
 // Corner kinds of a clip triangle (packed 8 bits each in header.y): the corner is parent corner k (0..2),
 // lies on parent edge e (3 + e) at the parameter in its edge params, or inside the parent (6).
 #define SFFD_CORNER_INTERIOR 6u
@@ -90,13 +121,13 @@ SFFD_STRUCT_END(ClassicParams)
 // y = parameter of corner e along that parent edge, z = of corner e+1; parameters are measured from
 // the parent edge's endpoint with the lower weld id.
 // Sub-triangle record (METHOD.md 3.3): lam[3], x_pn[3], x_flat[3], n_lin[3], n_pn[3], n_nbr[6].
-#define SFFD_SUB_STRIDE 21
-#define SFFD_SUB_LAM 0
-#define SFFD_SUB_XPN 3
-#define SFFD_SUB_XFLAT 6
-#define SFFD_SUB_NLIN 9
-#define SFFD_SUB_NPN 12
-#define SFFD_SUB_NNBR 15
+#define SFFD_SUB_STRIDE 21u
+#define SFFD_SUB_LAM 0u
+#define SFFD_SUB_XPN 3u
+#define SFFD_SUB_XFLAT 6u
+#define SFFD_SUB_NLIN 9u
+#define SFFD_SUB_NPN 12u
+#define SFFD_SUB_NNBR 15u
 
 SFFD_STRUCT_BEGIN(ClipParams)
   SFFD_UVEC4 range;    // x: first clip triangle, y: clip triangle count
@@ -106,21 +137,21 @@ SFFD_STRUCT_END(ClipParams)
 
 // ---- kernel deform_smooth: the deform stage of smooth FFD, one thread per sub-triangle (METHOD.md 3.4) ----
 // Bindings 1 and 2 are the lattice (lattice_eval.glsl).
-#define SFFD_BINDING_DEFORM_FIT 3          // reals: per interior fitting point SFFD_FIT_STRIDE values
-#define SFFD_BINDING_DEFORM_SUB_HEADERS 4  // uvec4 per sub-triangle (clip_write's headers)
-#define SFFD_BINDING_DEFORM_SUB_RECORDS 5  // SFFD_SUB_STRIDE real4 per sub-triangle (clip_write's records)
-#define SFFD_BINDING_DEFORM_PATCHES 6      // SFFD_PATCH_STRIDE real4 per patch
-#define SFFD_BINDING_DEFORM_TESS 7         // per patch: tessellation positions, then normals (real4 each)
+#define SFFD_BINDING_DEFORM_FIT SFFD_SLOT_3          // reals: per interior fitting point SFFD_FIT_STRIDE values
+#define SFFD_BINDING_DEFORM_SUB_HEADERS SFFD_SLOT_4  // uvec4 per sub-triangle (clip_write's headers)
+#define SFFD_BINDING_DEFORM_SUB_RECORDS SFFD_SLOT_5  // SFFD_SUB_STRIDE real4 per sub-triangle (clip_write's records)
+#define SFFD_BINDING_DEFORM_PATCHES SFFD_SLOT_6      // SFFD_PATCH_STRIDE real4 per patch
+#define SFFD_BINDING_DEFORM_TESS SFFD_SLOT_7         // per patch: tessellation positions, then normals (real4 each)
 // Fitting point record: lambda (3), weight w of the centre fit, then the 10 cubic Bernstein values.
-#define SFFD_FIT_STRIDE 14
+#define SFFD_FIT_STRIDE 14u
 // Patch record: 10 geometry control points, then 10 normal control points (linear index order).
-#define SFFD_PATCH_STRIDE 20
+#define SFFD_PATCH_STRIDE 20u
 #define SFFD_MAX_FIT_POINTS 91   // interior points of the degree-15 lattice: s <= 15
 // Split form (kernels deform_step_sample, _fit, _adjust, _tessellate): the samples of one sub-triangle,
 // SFFD_SAMPLE_FIXED + (interior fitting points) real4: Q[3], QN[3], E[6], EN[6], adj[3], adjNbr[6], then
 // the interior sample normals.
-#define SFFD_BINDING_DEFORM_SAMPLES 8
-#define SFFD_SAMPLE_FIXED 27
+#define SFFD_BINDING_DEFORM_SAMPLES SFFD_SLOT_8
+#define SFFD_SAMPLE_FIXED 27u
 
 // The deform kernels' parameter block also carries the lattice itself (float variants, when it fits):
 // on llvmpipe/lavapipe a uniform-buffer read is a vector load or gather, while every storage-buffer
@@ -153,14 +184,14 @@ SFFD_STRUCT_END(PnParams)
 #define SFFD_ACC_STAGE_SAMPLES 0u
 #define SFFD_ACC_STAGE_PATCHES 1u
 #define SFFD_ACC_STAGE_TESSELLATE 2u
-#define SFFD_BINDING_ACC_MATRIX 3        // reals: A_n^{-1} transposed, entry (sample l, control point k) at l*m + k
-#define SFFD_BINDING_ACC_TESS_BASIS 4    // reals: per tessellation vertex v, B^n_k(lambda_v) for the m control points k
-#define SFFD_BINDING_ACC_CORNERS 5       // 4 real4 per sub-triangle: its flat corners sum_i lam_i V_i, the parent's unit face normal
-#define SFFD_ACC_CORNER_STRIDE 4
-#define SFFD_BINDING_ACC_PATCHES 6       // m real4 per sub-triangle: the patch control points, linear index order (stage 1 writes)
-#define SFFD_BINDING_ACC_POSITIONS 7     // nv real4 per sub-triangle: tessellation positions (stage 2 writes)
-#define SFFD_BINDING_ACC_NORMALS 8       // nv real4 per sub-triangle: unit geometric normals of the patch, cof(J) n_face (stage 2)
-#define SFFD_BINDING_ACC_SAMPLES 9       // m real4 per sub-triangle: the samples S_l (stage 0 writes, stage 1 reads)
+#define SFFD_BINDING_ACC_MATRIX SFFD_SLOT_3        // reals: A_n^{-1} transposed, entry (sample l, control point k) at l*m + k
+#define SFFD_BINDING_ACC_TESS_BASIS SFFD_SLOT_4    // reals: per tessellation vertex v, B^n_k(lambda_v) for the m control points k
+#define SFFD_BINDING_ACC_CORNERS SFFD_SLOT_5       // 4 real4 per sub-triangle: its flat corners sum_i lam_i V_i, the parent's unit face normal
+#define SFFD_ACC_CORNER_STRIDE 4u
+#define SFFD_BINDING_ACC_PATCHES SFFD_SLOT_6       // m real4 per sub-triangle: the patch control points, linear index order (stage 1 writes)
+#define SFFD_BINDING_ACC_POSITIONS SFFD_SLOT_7     // nv real4 per sub-triangle: tessellation positions (stage 2 writes)
+#define SFFD_BINDING_ACC_NORMALS SFFD_SLOT_8       // nv real4 per sub-triangle: unit geometric normals of the patch, cof(J) n_face (stage 2)
+#define SFFD_BINDING_ACC_SAMPLES SFFD_SLOT_9       // m real4 per sub-triangle: the samples S_l (stage 0 writes, stage 1 reads)
 
 SFFD_STRUCT_BEGIN(AccurateParams)
   SFFD_STRUCT_MEMBER(LatticeParams, lattice)

@@ -7,6 +7,26 @@
 #ifndef SFFD_PRELUDE_GLSL
 #define SFFD_PRELUDE_GLSL
 
+// The OpenGL ES form (the gles backend; cmake/Kernels.cmake makes it at build time from this source
+// with "#version 310 es" as its first line, and GL_ES is then defined): ES 3.1 core only, highp
+// everywhere. `precise` is ES 3.2 or OES/EXT_gpu_shader5: taken where the driver has it (the strict
+// kernels need it to forbid contraction), left out on a bare ES 3.1 driver (docs/GLES.md).
+#ifdef GL_ES
+#if defined(GL_OES_gpu_shader5)
+#extension GL_OES_gpu_shader5 : enable
+#define SFFD_PRECISE precise
+#elif defined(GL_EXT_gpu_shader5)
+#extension GL_EXT_gpu_shader5 : enable
+#define SFFD_PRECISE precise
+#else
+#define SFFD_PRECISE
+#endif
+precision highp float;
+precision highp int;
+#else
+#define SFFD_PRECISE precise
+#endif
+
 #ifndef SFFD_STRICT
 #define SFFD_STRICT 0
 #endif
@@ -44,7 +64,7 @@
 
 // P marks a declaration precise in the strict variant (no contraction, no reassociation).
 #if SFFD_STRICT
-#define P precise
+#define P SFFD_PRECISE
 #else
 #define P
 #endif

@@ -326,4 +326,38 @@ TEST(GlInterop, AdoptedEglContextIsCheckedThroughEgl) {
   dlclose(lib);
 }
 
+// An application's OpenGL ES context (made here by sffd's egl-es provider, then treated as the
+// application's), adopted through the public API: a gles device, held to the ES 3.1 minimum limits
+// unless SFFD_GLES_LIMITS=device, that runs the strict session to the CPU reference's bits.
+TEST(GlInterop, AdoptedEsContextIsAGlesDevice) {
+  std::unique_ptr<gl::Context> es;
+  try {
+    es = gl::createEglEsContext();   // current on return
+  } catch (const Error& e) {
+    GTEST_SKIP() << e.what();
+  }
+  void* lib = dlopen("libEGL.so.1", RTLD_NOW | RTLD_NOLOAD);
+  ASSERT_NE(lib, nullptr);
+  auto getProc = reinterpret_cast<sffd::opengl::GetProcAddress>(dlsym(lib, "eglGetProcAddress"));
+  Job j = strictJob();
+  {
+    Device held = sffd::opengl::adoptCurrentContext(getProc);
+    EXPECT_EQ(held.label(), "gles-adopted");
+    EXPECT_EQ(held.info().api, "gles");
+    EXPECT_FALSE(held.info().limits.float64);
+    // Today's kernels bind more storage blocks than ES 3.1 guarantees (gles_limits_test.cc).
+    try {
+      DeformSession s(held.backend(), j.mesh, j.lattice, j.options);
+      ADD_FAILURE() << "a kernel past the ES 3.1 minimum limits ran";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.kind(), ErrorKind::Device) << e.what();
+    }
+  }
+  setenv("SFFD_GLES_LIMITS", "device", 1);
+  Device own = sffd::opengl::adoptCurrentContext(getProc);
+  unsetenv("SFFD_GLES_LIMITS");
+  expectStrictSession(own.backend(), j);
+  dlclose(lib);
+}
+
 }  // namespace

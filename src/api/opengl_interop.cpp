@@ -9,12 +9,15 @@ namespace sffd::opengl {
 
 Device adoptCurrentContext(GetProcAddress getProc) {
   std::shared_ptr<gl::Context> context = gl::adoptCurrentContext(getProc);
-  return Device("gl-adopted", gl::createBackendOn(std::move(context)));
+  std::unique_ptr<Backend> backend = gl::createBackendOn(std::move(context));
+  std::string label = backend->info().api == "gles" ? "gles-adopted" : "gl-adopted";
+  return Device(std::move(label), std::move(backend));
 }
 
 unsigned bufferOf(const Deformer& deformer, const OutputChunk& chunk) {
   Device& device = deformer.device();
-  unsigned name = device.info().api == "gl" ? gl::glBufferObject(device.backend(), chunk.buffer) : 0;
+  const std::string& api = device.info().api;
+  unsigned name = api == "gl" || api == "gles" ? gl::glBufferObject(device.backend(), chunk.buffer) : 0;
   if (!name)
     throw Error(ErrorKind::Input, "sffd::opengl::bufferOf: the Deformer runs on " + device.label() +
                                       ", not on a GL device, or the chunk is not its output");

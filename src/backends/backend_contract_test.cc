@@ -65,37 +65,41 @@ void makeVertices(size_t n, size_t inside, std::vector<Real>& pos, std::vector<R
   }
 }
 
-// The buffers of one classic_ffd job: lattice, vertices in, vertices out.
+// The buffers of one classic_ffd job: lattice, vertices in, vertices out (positions, then normals
+// from element n: layout.h, ClassicParams).
 template <class Real>
 struct ClassicJob {
   Backend& b;
   size_t n;
   HandLattice<Real> lattice;
   std::vector<Real> pos, nrm;
-  BufferId coeffs, frame, posIn, nrmIn, posOut, nrmOut;
+  BufferId coeffs, frame, vertIn, vertOut;
 
   ClassicJob(Backend& backend, size_t count, size_t inside, bool moved = false) : b(backend), n(count), lattice(moved) {
     makeVertices(n, inside, pos, nrm);
     coeffs = upload(lattice.coeffs);
     frame = upload(lattice.frame);
-    posIn = upload(pos);
-    nrmIn = upload(nrm);
-    posOut = b.createBuffer(bytes());
-    nrmOut = b.createBuffer(bytes());
+    vertIn = upload(vertices());
+    vertOut = b.createBuffer(2 * bytes());
   }
   ~ClassicJob() {
-    for (BufferId id : {coeffs, frame, posIn, nrmIn, posOut, nrmOut}) b.destroyBuffer(id);
+    for (BufferId id : {coeffs, frame, vertIn, vertOut}) b.destroyBuffer(id);
   }
   uint64_t bytes() const { return 4 * n * sizeof(Real); }
+  std::vector<Real> vertices() const {
+    std::vector<Real> v = pos;
+    v.insert(v.end(), nrm.begin(), nrm.end());
+    return v;
+  }
   BufferId upload(const std::vector<Real>& v) {
     BufferId id = b.createBuffer(v.size() * sizeof(Real));
     b.upload(id, 0, v.data(), v.size() * sizeof(Real));
     return id;
   }
-  gpu::ClassicParams params(uint32_t first, uint32_t count) const {
+  gpu::ClassicParams params(uint32_t first, uint32_t count, size_t normalsAt = 0) const {
     gpu::ClassicParams p;
     p.lattice = lattice.params;
-    p.range = {first, count, 0, 0};
+    p.range = {first, count, uint32_t(normalsAt ? normalsAt : n), 0};
     return p;
   }
   Dispatch dispatchOf(KernelVariant v, const gpu::ClassicParams& p, BufferId in, BufferId out) const {
@@ -105,8 +109,7 @@ struct ClassicJob {
     d.params = &p;
     d.paramsSize = sizeof p;
     d.buffers = {{SFFD_BINDING_LATTICE_COEFFS, coeffs}, {SFFD_BINDING_LATTICE_FRAME, frame},
-                 {SFFD_BINDING_CLASSIC_POS_IN, in},     {SFFD_BINDING_CLASSIC_NRM_IN, nrmIn},
-                 {SFFD_BINDING_CLASSIC_POS_OUT, out},   {SFFD_BINDING_CLASSIC_NRM_OUT, nrmOut}};
+                 {SFFD_BINDING_CLASSIC_IN, in}, {SFFD_BINDING_CLASSIC_OUT, out}};
     gridFor(p.range.y, b.info().limits, d.groups);
     return d;
   }
@@ -125,7 +128,7 @@ struct ClassicJob {
   // The identity lattice maps vertices [first, first+count) to themselves (w = 1 inside, 0 outside)
   // and keeps their unit normals.
   void expectIdentity(size_t first, size_t count, size_t inside, double tol) {
-    std::vector<Real> p = download(posOut, first, count), m = download(nrmOut, first, count);
+    std::vector<Real> p = download(vertOut, first, count), m = download(vertOut, n + first, count);
     for (size_t i = 0; i < count; ++i) {
       const size_t v = first + i;
       for (int k = 0; k < 3; ++k) {
@@ -237,16 +240,16 @@ TEST_P(BackendContract, ClassicIdentityInEveryVariant) {
       KernelVariant v{strict, f64};
       if (f64 && !b.info().limits.float64) {
         ClassicJob<double> job(b, 100, 100);
-        EXPECT_EQ(errorKindOf([&] { job.dispatch(v, 0, 100, job.posIn, job.posOut); }), ErrorKind::Device);
+        EXPECT_EQ(errorKindOf([&] { job.dispatch(v, 0, 100, job.vertIn, job.vertOut); }), ErrorKind::Device);
         continue;
       }
       if (f64) {
         ClassicJob<double> job(b, 1000, 900);
-        job.dispatch(v, 0, 1000, job.posIn, job.posOut);
+        job.dispatch(v, 0, 1000, job.vertIn, job.vertOut);
         job.expectIdentity(0, 1000, 900, 1e-14);
       } else {
         ClassicJob<float> job(b, 1000, 900);
-        job.dispatch(v, 0, 1000, job.posIn, job.posOut);
+        job.dispatch(v, 0, 1000, job.vertIn, job.vertOut);
         job.expectIdentity(0, 1000, 900, 1e-6);
       }
       ++dispatched;
@@ -261,21 +264,19 @@ TEST_P(BackendContract, BindsRangesAtAlignedOffsetsAndRefusesBadDispatches) {
   Backend& b = backend();
   const uint64_t align = b.info().limits.storageOffsetAlignment;
   ClassicJob<float> job(b, 100, 100);
-  const uint64_t bytes = job.bytes(), off = 3 * align;
-  BufferId big = b.createBuffer(off + 4 * bytes + 4 * align);
-  uint64_t at[4];
-  for (int k = 0; k < 4; ++k) at[k] = off + k * ((bytes + align - 1) / align * align);
-  b.upload(big, at[0], job.pos.data(), bytes);
-  b.upload(big, at[1], job.nrm.data(), bytes);
+  const uint64_t bytes = 2 * job.bytes(), off = 3 * align;
+  BufferId big = b.createBuffer(off + 2 * bytes + 2 * align);
+  uint64_t at[2];
+  for (int k = 0; k < 2; ++k) at[k] = off + k * ((bytes + align - 1) / align * align);
+  b.upload(big, at[0], job.vertices().data(), bytes);
   gpu::ClassicParams params = job.params(0, 100);
-  Dispatch d = job.dispatchOf({true, false}, params, job.posIn, job.posOut);
-  d.buffers = {{SFFD_BINDING_LATTICE_COEFFS, job.coeffs},     {SFFD_BINDING_LATTICE_FRAME, job.frame},
-               {SFFD_BINDING_CLASSIC_POS_IN, big, at[0], bytes},  {SFFD_BINDING_CLASSIC_NRM_IN, big, at[1], bytes},
-               {SFFD_BINDING_CLASSIC_POS_OUT, big, at[2], bytes}, {SFFD_BINDING_CLASSIC_NRM_OUT, big, at[3], bytes}};
+  Dispatch d = job.dispatchOf({true, false}, params, job.vertIn, job.vertOut);
+  d.buffers = {{SFFD_BINDING_LATTICE_COEFFS, job.coeffs}, {SFFD_BINDING_LATTICE_FRAME, job.frame},
+               {SFFD_BINDING_CLASSIC_IN, big, at[0], bytes}, {SFFD_BINDING_CLASSIC_OUT, big, at[1], bytes}};
   b.dispatch(d);
   b.barrier();
   std::vector<float> out(job.pos.size());
-  b.download(big, at[2], out.data(), bytes);
+  b.download(big, at[1], out.data(), job.bytes());
   for (size_t i = 0; i < 4 * 100; ++i) ASSERT_NEAR(out[i], job.pos[i], 1e-6) << i;
 
   auto expectInternal = [&](const Dispatch& bad, const char* what) {
@@ -314,12 +315,12 @@ TEST_P(BackendContract, BarriersOrderDependentDispatches) {
   Backend& b = backend();
   const size_t n = 5000;
   ClassicJob<float> job(b, n, n);
-  BufferId second = b.createBuffer(job.bytes()), third = b.createBuffer(job.bytes());
-  job.dispatch({}, 0, n, job.posIn, job.posOut);   // posOut = pos
+  BufferId second = b.createBuffer(2 * job.bytes()), third = b.createBuffer(2 * job.bytes());
+  job.dispatch({}, 0, n, job.vertIn, job.vertOut);   // posOut = pos
   std::vector<float> shifted = job.pos;
   for (size_t i = 0; i < 4 * n; i += 4) shifted[i] = 0.5f * shifted[i];
-  b.upload(job.posIn, 0, shifted.data(), shifted.size() * sizeof(float));
-  job.dispatch({}, 0, n, job.posIn, second);   // second = shifted
+  b.upload(job.vertIn, 0, shifted.data(), shifted.size() * sizeof(float));
+  job.dispatch({}, 0, n, job.vertIn, second);   // second = shifted
   b.barrier();
   job.dispatch({}, 0, n, second, third);       // third = second, after the barrier
   job.expectIdentity(0, n, n, 1e-6);
@@ -338,7 +339,7 @@ TEST_P(BackendContract, TimesEveryDispatchUnderItsLabel) {
   Backend& b = backend();
   const uint32_t chunks = 700, chunk = 64;
   ClassicJob<float> job(b, chunks * chunk, chunks * chunk);
-  for (uint32_t c = 0; c < chunks; ++c) job.dispatch({}, c * chunk, chunk, job.posIn, job.posOut, c == 0 ? "first chunk" : "");
+  for (uint32_t c = 0; c < chunks; ++c) job.dispatch({}, c * chunk, chunk, job.vertIn, job.vertOut, c == 0 ? "first chunk" : "");
   b.finish();
   job.expectIdentity(0, chunks * chunk, chunks * chunk, 1e-6);
   std::vector<DispatchTiming> t = b.takeTimings();
@@ -351,7 +352,8 @@ TEST_P(BackendContract, TimesEveryDispatchUnderItsLabel) {
 // A 1-D job beyond 65535 groups of 64 runs as a 2-D grid (gridFor): every vertex written.
 TEST_P(BackendContract, LargeJobRunsAsTwoDimensionalGrid) {
   Backend& b = backend();
-  const size_t n = size_t(SFFD_MAX_GROUPS_X) * SFFD_LOCAL_SIZE + 3 * SFFD_LOCAL_SIZE - 5;
+  // Just past 65535 full groups, and positions and normals (one binding) within 128 MiB.
+  const size_t n = size_t(SFFD_MAX_GROUPS_X) * SFFD_LOCAL_SIZE + SFFD_LOCAL_SIZE - 5;
   ClassicJob<float> job(b, 64, 64);
   std::vector<float> pos(4 * n), nrm(4 * n);
   for (size_t i = 0; i < n; ++i) {
@@ -362,11 +364,11 @@ TEST_P(BackendContract, LargeJobRunsAsTwoDimensionalGrid) {
     pos[4 * i + 3] = 1;
     nrm[4 * i + 2] = 1;
   }
-  BufferId in = job.upload(pos), nin = job.upload(nrm), out = b.createBuffer(pos.size() * 4), nout = b.createBuffer(pos.size() * 4);
-  gpu::ClassicParams params = job.params(0, uint32_t(n));
+  std::vector<float> vertices = pos;
+  vertices.insert(vertices.end(), nrm.begin(), nrm.end());
+  BufferId in = job.upload(vertices), out = b.createBuffer(vertices.size() * 4);
+  gpu::ClassicParams params = job.params(0, uint32_t(n), n);
   Dispatch d = job.dispatchOf({}, params, in, out);
-  d.buffers[3].buffer = nin;
-  d.buffers[5].buffer = nout;
   EXPECT_EQ(d.groups[1], 2u);   // more than 65535 groups of work: a second row
   EXPECT_GE(uint64_t(d.groups[0]) * d.groups[1] * SFFD_LOCAL_SIZE, n);
   d.label = "large";
@@ -375,7 +377,7 @@ TEST_P(BackendContract, LargeJobRunsAsTwoDimensionalGrid) {
   b.barrier();
   std::vector<float> p(pos.size()), m(pos.size());
   b.download(out, 0, p.data(), p.size() * 4);
-  b.download(nout, 0, m.data(), m.size() * 4);
+  b.download(out, p.size() * 4, m.data(), m.size() * 4);
   b.finish();
   double wallMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   std::vector<DispatchTiming> t = b.takeTimings();
@@ -392,16 +394,16 @@ TEST_P(BackendContract, LargeJobRunsAsTwoDimensionalGrid) {
     if (!ok && bad++ < 5) ADD_FAILURE() << "vertex " << i << " of " << n << " not written or wrong";
   }
   EXPECT_EQ(bad, 0u);
-  for (BufferId id : {in, nin, out, nout}) b.destroyBuffer(id);
+  for (BufferId id : {in, out}) b.destroyBuffer(id);
 }
 
 // A buffer destroyed while work that uses it is pending lives until that work has run.
 TEST_P(BackendContract, DestroyedBufferOutlivesPendingWork) {
   Backend& b = backend();
   ClassicJob<float> job(b, 256, 256);
-  BufferId scratch = b.createBuffer(job.bytes());
-  b.upload(scratch, 0, job.pos.data(), job.bytes());
-  job.dispatch({}, 0, 256, scratch, job.posOut);
+  BufferId scratch = b.createBuffer(2 * job.bytes());
+  b.upload(scratch, 0, job.vertices().data(), 2 * job.bytes());
+  job.dispatch({}, 0, 256, scratch, job.vertOut);
   b.destroyBuffer(scratch);
   job.expectIdentity(0, 256, 256, 1e-6);
 }
@@ -431,7 +433,7 @@ TEST_P(BackendContract, StrictVariantsGiveTheCpuBackendsBits) {
 }
 
 std::vector<std::string> contractBackends() {
-  std::vector<std::string> names = {"vulkan", "vulkan-staging", "gl-egl", "gl-osmesa", "cpu"};
+  std::vector<std::string> names = {"vulkan", "vulkan-staging", "gl-egl", "gl-osmesa", "gles", "cpu"};
   return names;
 }
 

@@ -13,6 +13,7 @@ OpenedBackend openGl(gl::Provider provider, const std::string& label, const Back
   gl::Options o;
   o.provider = provider;
   o.deviceSubstring = r.device;
+  o.deviceLimits = r.deviceLimits;
   OpenedBackend b;
   b.backend = gl::createBackend(o);
   b.info = b.backend->info();
@@ -35,6 +36,7 @@ OpenedBackend openNamed(const std::string& name, const BackendRequest& r) {
   if (name == "gl-egl") return openGl(gl::Provider::EGL, name, r);
   if (name == "gl-osmesa") return openGl(gl::Provider::OSMesa, name, r);
   if (name == "gl-glfw") return openGl(gl::Provider::GLFW, name, r);
+  if (name == "gles") return openGl(gl::Provider::EGLES, name, r);
   if (name == "cpu") {
     OpenedBackend b;
     b.backend = cpu::createBackend();
@@ -42,7 +44,7 @@ OpenedBackend openNamed(const std::string& name, const BackendRequest& r) {
     b.label = "cpu";
     return b;
   }
-  throw Error(ErrorKind::Input, "unknown backend '" + name + "' (auto, vulkan, gl, gl-egl, gl-osmesa, gl-glfw, cpu)");
+  throw Error(ErrorKind::Input, "unknown backend '" + name + "' (auto, vulkan, gl, gl-egl, gl-osmesa, gl-glfw, gles, cpu)");
 }
 
 }  // namespace
@@ -72,6 +74,14 @@ std::vector<std::pair<std::string, DeviceInfo>> listBackends(std::vector<std::st
     for (DeviceInfo& d : gl::listDevices()) out.emplace_back("gl-" + d.provider, d);
   } catch (const Error& e) {
     problems.push_back(std::string("gl: ") + e.what());
+  }
+  try {
+    gl::Options o;
+    o.provider = gl::Provider::EGLES;
+    out.emplace_back("gles", gl::createBackend(o)->info());
+  } catch (const Error& e) {
+    if (e.kind() != ErrorKind::Device) throw;
+    problems.push_back(std::string("gles: ") + e.what());
   }
   out.emplace_back("cpu", cpu::deviceInfo());
   return out;

@@ -11,15 +11,16 @@ namespace sffd {
 
 // A named way to run a job.
 struct OpenedBackend {
-  std::string label;            // "vulkan", "gl-egl", "gl-osmesa", "gl-glfw", "cpu"
+  std::string label;            // "vulkan", "gl-egl", "gl-osmesa", "gl-glfw", "gles", "cpu"
   DeviceInfo info;
   std::unique_ptr<Backend> backend;
 };
 
 struct BackendRequest {
-  std::string name = "auto";    // auto, vulkan, gl, gl-egl, gl-osmesa, gl-glfw, cpu
+  std::string name = "auto";    // auto, vulkan, gl, gl-egl, gl-osmesa, gl-glfw, gles, cpu
   std::string device;           // device-name substring
   bool validation = false;      // Vulkan validation layer
+  bool deviceLimits = false;    // gles: the device's own limits instead of the ES 3.1 minima
 };
 
 // Opens the backend; throws a device Error (exit 3) when the one asked for is unusable. For "auto",

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include <sffd/device.h>
+#include <sffd/error.h>
 
 namespace sffd {
 
@@ -70,5 +71,9 @@ class Backend {
 // Splits a 1-D job of `threads` threads into a grid within the device's group-count limits
 // (SFFD_LOCAL_SIZE threads a group; kernels rebuild the index with sffdThreadIndex()).
 void gridFor(uint64_t threads, const DeviceLimits& limits, uint32_t groups[3]);
+
+// The error for a double-precision run the device cannot do: a usage error (exit 2) on OpenGL ES,
+// which has no doubles at all, a device error (exit 3) on a device that lacks the feature.
+Error noFloat64Error(const DeviceInfo& info);
 
 }  // namespace sffd

@@ -12,13 +12,19 @@ const EmbeddedKernel* findKernel(std::string_view name) {
   return nullptr;
 }
 
-std::string glslForVariant(const EmbeddedKernel& kernel, KernelVariant variant) {
-  std::string src = kernel.glsl;
+std::string glslForVariant(const EmbeddedKernel& kernel, KernelVariant variant, bool es) {
+  std::string src = es ? kernel.gles : kernel.glsl;
   size_t eol = src.find('\n');
   std::string defines = std::string("#define SFFD_STRICT ") + (variant.strict ? "1" : "0") +
                         "\n#define SFFD_F64 " + (variant.f64 ? "1" : "0") + "\n";
   src.insert(eol == std::string::npos ? src.size() : eol + 1, defines);
   return src;
+}
+
+Error noFloat64Error(const DeviceInfo& info) {
+  if (info.api == "gles")
+    return Error(ErrorKind::Input, "OpenGL ES has no double precision: use --precision float (or auto) with --backend gles");
+  return deviceError(info.name + " has no double-precision shader support");
 }
 
 void gridFor(uint64_t threads, const DeviceLimits& limits, uint32_t groups[3]) {

@@ -15,6 +15,7 @@ namespace sffd {
 struct EmbeddedKernel {
   const char* name;
   const char* glsl;                 // inlined source without variant defines
+  const char* gles;                 // the same as OpenGL ES 3.1 ("#version 310 es"; f32 variants only)
   const uint32_t* spirv[4];         // index variantIndex(): strict + 2 * f64
   size_t spirvWords[4];
 };
@@ -24,7 +25,7 @@ inline int variantIndex(KernelVariant v) { return (v.strict ? 1 : 0) + (v.f64 ? 
 std::span<const EmbeddedKernel> embeddedKernels();
 // nullptr when no kernel has that name.
 const EmbeddedKernel* findKernel(std::string_view name);
-// GLSL source of a variant for an OpenGL driver: the variant defines follow the #version line.
-std::string glslForVariant(const EmbeddedKernel& kernel, KernelVariant variant);
+// GLSL source of a variant for an OpenGL (es: OpenGL ES) driver: the variant defines follow the #version line.
+std::string glslForVariant(const EmbeddedKernel& kernel, KernelVariant variant, bool es = false);
 
 }  // namespace sffd

@@ -248,14 +248,19 @@ Mesh readPly(const std::string& path, const std::string& text) {
   const PlyElement* vertexEl = nullptr;
   const PlyElement* faceEl = nullptr;
   int px = -1, py = -1, pz = -1, pnx = -1, pny = -1, pnz = -1, pidx = -1;
+  int pu = -1, pv = -1, pcolor[4] = {-1, -1, -1, -1};
   for (const auto& e : elements) {
     if (e.name == "vertex" && !vertexEl) {
       vertexEl = &e;
       for (size_t i = 0; i < e.props.size(); ++i) {
         const auto& p = e.props[i];
-        int* slot = p.name == "x" ? &px : p.name == "y" ? &py : p.name == "z" ? &pz : p.name == "nx" ? &pnx : p.name == "ny" ? &pny
-                                                                                   : p.name == "nz" ? &pnz : nullptr;
-        if (slot && !p.list) *slot = int(i);
+        const std::string& q = p.name;
+        int* slot = q == "x" ? &px : q == "y" ? &py : q == "z" ? &pz : q == "nx" ? &pnx : q == "ny" ? &pny : q == "nz" ? &pnz
+                  : q == "u" || q == "s" || q == "texture_u" || q == "texture_s" ? &pu
+                  : q == "v" || q == "t" || q == "texture_v" || q == "texture_t" ? &pv
+                  : q == "red" || q == "diffuse_red" ? &pcolor[0] : q == "green" || q == "diffuse_green" ? &pcolor[1]
+                  : q == "blue" || q == "diffuse_blue" ? &pcolor[2] : q == "alpha" ? &pcolor[3] : nullptr;
+        if (slot && !p.list && *slot < 0) *slot = int(i);
       }
       if (px < 0 || py < 0 || pz < 0) throw inputError(path, e.line, "element vertex lacks x, y or z");
     } else if (e.name == "face" && !faceEl) {
@@ -270,6 +275,14 @@ Mesh readPly(const std::string& path, const std::string& text) {
   if (!faceEl || faceEl->count == 0) throw inputError(path, 0, "no faces");
   if (vertexEl->count > kMaxVertices) throw inputError(path, vertexEl->line, "too many vertices");
   const bool hasNormals = pnx >= 0 && pny >= 0 && pnz >= 0;
+  const bool hasTexcoords = pu >= 0 && pv >= 0, hasColors = pcolor[0] >= 0 && pcolor[1] >= 0 && pcolor[2] >= 0;
+  // Integer colours are fractions of 255 (65535 for 16-bit types); float ones are as given.
+  double colorScale[4] = {1, 1, 1, 1};
+  for (int c = 0; c < 4; ++c)
+    if (pcolor[c] >= 0) {
+      const PlyType t = vertexEl->props[size_t(pcolor[c])].type;
+      colorScale[c] = plyIsFloat(t) ? 1.0 : plySize(t) == 2 ? 1.0 / 65535.0 : 1.0 / 255.0;
+    }
 
   // Least bytes the declared elements need: a count is never trusted beyond what the file can hold.
   const uint64_t dataBytes = text.size() - dataOffset;
@@ -292,6 +305,18 @@ Mesh readPly(const std::string& path, const std::string& text) {
   mesh.triangles.reserve(size_t(faceEl->count));
   std::vector<uint32_t> poly;
   std::vector<double> values;
+  // The vertex whose properties are in `values`.
+  auto addVertex = [&] {
+    mesh.positions.push_back({values[size_t(px)], values[size_t(py)], values[size_t(pz)]});
+    if (hasNormals) mesh.normals.push_back({values[size_t(pnx)], values[size_t(pny)], values[size_t(pnz)]});
+    if (hasTexcoords) mesh.texcoords.push_back({values[size_t(pu)], values[size_t(pv)]});
+    if (hasColors) {
+      glm::dvec4 k(1.0);
+      for (int c = 0; c < 4; ++c)
+        if (pcolor[c] >= 0) k[c] = values[size_t(pcolor[c])] * colorScale[c];
+      mesh.colors.push_back(k);
+    }
+  };
 
   if (format == Ascii) {
     io::Tokenizer tz(std::string_view(text).substr(dataOffset), headerLines + 1);
@@ -340,8 +365,7 @@ Mesh readPly(const std::string& path, const std::string& text) {
           }
         }
         if (isV) {
-          mesh.positions.push_back({values[size_t(px)], values[size_t(py)], values[size_t(pz)]});
-          if (hasNormals) mesh.normals.push_back({values[size_t(pnx)], values[size_t(pny)], values[size_t(pnz)]});
+          addVertex();
         } else if (isF) {
           addPolygon(mesh, poly.data(), poly.size(), dropped);
         }
@@ -389,8 +413,7 @@ Mesh readPly(const std::string& path, const std::string& text) {
           glm::dvec3 q{values[size_t(px)], values[size_t(py)], values[size_t(pz)]};
           if (!std::isfinite(q.x) || !std::isfinite(q.y) || !std::isfinite(q.z))
             throw inputError(path, 0, "vertex " + std::to_string(item) + ": non-finite coordinate");
-          mesh.positions.push_back(q);
-          if (hasNormals) mesh.normals.push_back({values[size_t(pnx)], values[size_t(pny)], values[size_t(pnz)]});
+          addVertex();
         } else if (isF) {
           addPolygon(mesh, poly.data(), poly.size(), dropped);
         }

@@ -23,7 +23,10 @@ Mesh readBpt(const std::string& path, const std::string& text, const MeshReadOpt
 // Completes a mesh whose positions, normals (one slot per vertex, possibly unset) and triangles are
 // filled: checks there is a triangle and every index is in range, normalises the file normals marked in
 // `fromFile`, recomputes (angle-weighted) the others and zero-length ones, sets normalsFromFile and weldId.
-void finishMesh(Mesh& mesh, const std::vector<uint8_t>& fromFile, const std::string& path);
+// `normalShared` (empty, or per vertex a vertex index, its own if none): vertices whose recomputed
+// normals are summed over the vertices naming the same one (an OBJ position split only by `vt`).
+void finishMesh(Mesh& mesh, const std::vector<uint8_t>& fromFile, const std::string& path,
+                const std::vector<uint32_t>& normalShared = {});
 
 // Polygon -> triangles (fan from its first corner).
 inline void fanTriangulate(const uint32_t* corners, size_t n, std::vector<std::array<uint32_t, 3>>& out) {
@@ -35,6 +38,9 @@ inline void fanTriangulate(const uint32_t* corners, size_t n, std::vector<std::a
 void addPolygon(Mesh& mesh, const uint32_t* corners, size_t n, size_t& dropped);
 // One warning line in mesh.warnings for the polygons addPolygon dropped, if any.
 void noteDroppedPolygons(Mesh& mesh, size_t dropped);
+
+// Index of each vertex's distinct position (first appearance order) and the number of distinct positions.
+std::vector<uint32_t> distinctPositions(const std::vector<glm::dvec3>& positions, uint32_t& count);
 
 // Largest vertex count a mesh may have (indices are uint32).
 constexpr uint64_t kMaxVertices = 0xFFFFFFF0u;

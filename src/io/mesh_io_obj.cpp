@@ -2,13 +2,16 @@
 // (a position used with different `vn` in different faces, e.g. a cube with face normals); this one keeps
 // them: every distinct (position, normal) pair used by a face corner is a vertex.
 //
-// Read: `v x y z [w]`, `vn x y z`, `vt ...` (counted, for index checks), `f` with corners `v`, `v/vt`,
-// `v//vn`, `v/vt/vn`, 1-based or negative (relative) indices, polygons fan-triangulated, `\` line
+// Read: `v x y z [w]` or `v x y z r g b` (vertex colours), `vn x y z`, `vt u [v [w]]`, `f` with corners
+// `v`, `v/vt`, `v//vn`, `v/vt/vn`, 1-based or negative (relative) indices, polygons triangulated, `g`,
+// `usemtl`, `mtllib` (the .mtl files beside the OBJ give each material's Kd, d and map_Kd), `\` line
 // continuations, `#` comments. Every other statement is ignored.
-// Vertex order: vertex i is position i (with the first normal a face uses it with; unreferenced positions
-// are kept), and each further normal of a position adds a vertex after all positions.
+// Vertex order: vertex i is position i (with the first normal and texture coordinate a face uses it with;
+// unreferenced positions are kept), and each further (normal, texture coordinate) pair of a position adds
+// a vertex after all positions.
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <unordered_map>
 
 #include <sffd/error.h>
@@ -31,13 +34,82 @@ struct NormalKeyHash {
   }
 };
 
+// The index of each value's first equal value (bit equality, -0 = +0): equal normals or texture
+// coordinates given twice count as one.
+template <class Vec>
+std::vector<int64_t> firstEqual(const std::vector<Vec>& values) {
+  std::vector<int64_t> canon(values.size());
+  std::unordered_map<std::array<uint64_t, 3>, int64_t, NormalKeyHash> first;
+  for (size_t i = 0; i < values.size(); ++i) {
+    std::array<uint64_t, 3> key{};
+    for (int c = 0; c < Vec::length(); ++c) {
+      double d = values[i][c] + 0.0;
+      std::memcpy(&key[size_t(c)], &d, 8);
+    }
+    canon[i] = first.emplace(key, int64_t(i)).first->second;
+  }
+  return canon;
+}
+
+// The index of `name` in `names`, added when new.
+uint32_t indexOfName(std::vector<std::string>& names, std::string_view name) {
+  for (size_t i = 0; i < names.size(); ++i)
+    if (names[i] == name) return uint32_t(i);
+  names.emplace_back(name);
+  return uint32_t(names.size() - 1);
+}
+
+// Kd, d and map_Kd of the materials `mesh` uses, from its material libraries beside `objPath`. A
+// library that is not a readable regular file of at most 16 MiB is named in a warning and skipped.
+void readMaterialLibraries(Mesh& mesh, const std::string& objPath) {
+  namespace fs = std::filesystem;
+  std::vector<std::string_view> tok;
+  for (const std::string& lib : mesh.materialLibraries) {
+    const fs::path p = fs::path(objPath).parent_path() / lib;
+    std::error_code ec;
+    if (!fs::is_regular_file(p, ec) || fs::file_size(p, ec) > (16u << 20)) {
+      mesh.warnings.push_back(objPath + ": material library " + io::quoted(lib) + " not found: materials keep their names only");
+      continue;
+    }
+    std::string text;
+    try {
+      text = io::readWholeFile(p.string());
+    } catch (const Error&) {
+      continue;   // empty or unreadable: nothing to take from it
+    }
+    io::LineReader lines(text);
+    std::string_view raw;
+    size_t lineNo = 0;
+    Material* m = nullptr;
+    while (lines.next(raw, lineNo)) {
+      io::splitTokens(raw.substr(0, raw.find('#')), tok);
+      if (tok.empty()) continue;
+      if (tok[0] == "newmtl" && tok.size() >= 2) {
+        m = nullptr;
+        for (Material& known : mesh.materials)
+          if (known.name == tok[1]) m = &known;
+      } else if (m && tok[0] == "Kd" && tok.size() >= 4) {
+        for (int c = 0; c < 3; ++c) io::parseDouble(tok[1 + c], m->baseColor[c]);
+      } else if (m && tok[0] == "d" && tok.size() >= 2) {
+        io::parseDouble(tok[1], m->baseColor.a);
+      } else if (m && tok[0] == "map_Kd" && tok.size() >= 2) {
+        m->baseColorTexture = std::string(tok.back());   // options (-s, -o ...) come before the file name
+      }
+    }
+  }
+}
+
 }  // namespace
 
 Mesh readObj(const std::string& path, const std::string& text) {
   size_t dropped = 0;   // polygons without area (addPolygon)
   std::vector<size_t> emptyFaceLines;
-  std::vector<glm::dvec3> pos, nrm;
-  int64_t vtCount = 0;
+  std::vector<glm::dvec3> pos, nrm, posColor;
+  std::vector<glm::dvec2> tex;
+  bool anyColor = false;
+  std::vector<std::string> materialNames, groupNames, libraries;
+  uint32_t material = Mesh::kNoIndex, group = Mesh::kNoIndex;
+  std::vector<uint32_t> faceMaterial, faceGroup;   // per face
   std::vector<Corner> corners;
   std::vector<uint64_t> faceStart;   // into corners; one extra at the end
   std::vector<size_t> faceLine;
@@ -98,10 +170,31 @@ Mesh readObj(const std::string& path, const std::string& text) {
     if (kw == "v") {
       pos.push_back(readVec(line, "vertex"));
       if (pos.size() > kMaxVertices) throw fail(line, "too many vertices");
+      glm::dvec3 rgb(1.0);
+      if (tok.size() >= 7) {   // "v x y z r g b": the vertex colour extension
+        tok.erase(tok.begin() + 1, tok.begin() + 4);
+        rgb = readVec(line, "vertex colour");
+        anyColor = true;
+      }
+      posColor.push_back(rgb);
     } else if (kw == "vn") {
       nrm.push_back(readVec(line, "normal"));
     } else if (kw == "vt") {
-      ++vtCount;
+      if (tok.size() < 2) throw fail(line, "texture coordinate needs a value");
+      glm::dvec2 t(0.0);
+      for (size_t c = 0; c < 2 && c + 1 < tok.size(); ++c) {
+        if (!io::parseDouble(tok[1 + c], t[int(c)])) throw fail(line, "bad number " + io::quoted(tok[1 + c]));
+        if (!std::isfinite(t[int(c)])) throw fail(line, "non-finite texture coordinate " + io::quoted(tok[1 + c]));
+      }
+      tex.push_back(t);
+    } else if (kw == "usemtl" && tok.size() >= 2) {
+      material = indexOfName(materialNames, tok[1]);
+    } else if (kw == "g") {
+      std::string name;
+      for (size_t i = 1; i < tok.size(); ++i) name += (i > 1 ? " " : "") + std::string(tok[i]);
+      group = indexOfName(groupNames, name.empty() ? "default" : name);
+    } else if (kw == "mtllib") {
+      for (size_t i = 1; i < tok.size(); ++i) indexOfName(libraries, tok[i]);
     } else if (kw == "f") {
       size_t n = tok.size() - 1;
       if (n == 0) {   // skipped, as Assimp, MeshLab and Blender do
@@ -111,6 +204,8 @@ Mesh readObj(const std::string& path, const std::string& text) {
       if (n < 3) throw fail(line, "face with " + std::to_string(n) + " vertices (at least 3 needed)");
       faceStart.push_back(corners.size());
       faceLine.push_back(line);
+      faceMaterial.push_back(material);
+      faceGroup.push_back(group);
       for (size_t c = 1; c < tok.size(); ++c) {
         std::string_view f = tok[c];
         std::string_view fields[3];
@@ -124,7 +219,7 @@ Mesh readObj(const std::string& path, const std::string& text) {
           s = slash + 1;
         }
         Corner k{index(fields[0], int64_t(pos.size()), line, "vertex"), -1, -1};
-        if (nf >= 2 && !fields[1].empty()) k.t = index(fields[1], vtCount, line, "texture coordinate");
+        if (nf >= 2 && !fields[1].empty()) k.t = index(fields[1], int64_t(tex.size()), line, "texture coordinate");
         if (nf >= 3) {
           if (fields[2].empty()) throw fail(line, "bad face corner " + io::quoted(f));
           k.n = index(fields[2], int64_t(nrm.size()), line, "normal");
@@ -132,7 +227,7 @@ Mesh readObj(const std::string& path, const std::string& text) {
         corners.push_back(k);
       }
     }
-    // every other statement (vt values, o, g, s, usemtl, mtllib, l, p, ...) is ignored
+    // every other statement (o, s, l, p, ...) is ignored
   }
   if (faceStart.empty()) throw inputError(path, 0, "no faces");
   faceStart.push_back(corners.size());
@@ -143,69 +238,95 @@ Mesh readObj(const std::string& path, const std::string& text) {
       const Corner& k = corners[c];
       if (k.p >= int64_t(pos.size()))
         throw fail(faceLine[f], "vertex index " + std::to_string(k.p + 1) + " out of range (" + std::to_string(pos.size()) + " vertices)");
-      if (k.t >= vtCount)
+      if (k.t >= int64_t(tex.size()))
         throw fail(faceLine[f], "texture coordinate index " + std::to_string(k.t + 1) + " out of range (" +
-                                    std::to_string(vtCount) + " texture coordinates)");
+                                    std::to_string(int64_t(tex.size())) + " texture coordinates)");
       if (k.n >= int64_t(nrm.size()))
         throw fail(faceLine[f], "normal index " + std::to_string(k.n + 1) + " out of range (" + std::to_string(nrm.size()) + " normals)");
     }
 
-  // Equal normal values count as the same normal.
-  std::vector<int64_t> canon(nrm.size());
-  {
-    std::unordered_map<std::array<uint64_t, 3>, int64_t, NormalKeyHash> first;
-    for (size_t i = 0; i < nrm.size(); ++i) {
-      std::array<uint64_t, 3> key;
-      for (int c = 0; c < 3; ++c) {
-        double d = nrm[i][c] + 0.0;
-        std::memcpy(&key[c], &d, 8);
-      }
-      canon[i] = first.emplace(key, int64_t(i)).first->second;
-    }
-  }
+  // Equal normal (texture coordinate) values count as the same normal (texture coordinate).
+  const std::vector<int64_t> canonN = firstEqual(nrm), canonT = firstEqual(tex);
 
+  // A vertex is a position with one (normal, texture coordinate) pair: its slot, -1 for none.
+  struct Slot {
+    int64_t n = -2, t = -2;   // -2: the position is not used yet
+    bool operator==(const Slot&) const = default;
+  };
   Mesh mesh;
   mesh.positions = pos;
-  std::vector<int64_t> slot(pos.size(), -2);   // normal slot of the primary vertex: -2 unused, -1 none
-  std::unordered_map<uint64_t, uint32_t> extra;   // (position, normal slot + 1) -> vertex
+  std::vector<Slot> slot(pos.size());
+  std::vector<uint32_t> positionOf(pos.size());
+  for (size_t i = 0; i < pos.size(); ++i) positionOf[i] = uint32_t(i);
+  std::unordered_map<std::array<uint64_t, 3>, uint32_t, NormalKeyHash> extra;   // (position, n + 1, t + 1) -> vertex
   std::vector<uint32_t> vid;
   mesh.triangles.reserve(corners.size());
+  const bool perTriangleMaterial = !materialNames.empty(), perTriangleGroup = !groupNames.empty();
   for (size_t f = 0; f + 1 < faceStart.size(); ++f) {
     vid.clear();
     for (uint64_t c = faceStart[f]; c < faceStart[f + 1]; ++c) {
       const Corner& k = corners[c];
-      int64_t s = k.n >= 0 ? canon[k.n] : -1;
+      const Slot s{k.n >= 0 ? canonN[size_t(k.n)] : -1, k.t >= 0 ? canonT[size_t(k.t)] : -1};
       uint32_t v;
-      if (slot[k.p] == -2 || slot[k.p] == s) {
-        slot[k.p] = s;
+      if (slot[size_t(k.p)].n == -2 || slot[size_t(k.p)] == s) {
+        slot[size_t(k.p)] = s;
         v = uint32_t(k.p);
       } else {
-        uint64_t key = (uint64_t(k.p) << 32) ^ uint64_t(s + 1);
+        const std::array<uint64_t, 3> key{uint64_t(k.p), uint64_t(s.n + 1), uint64_t(s.t + 1)};
         auto it = extra.find(key);
         if (it == extra.end()) {
           if (mesh.positions.size() >= kMaxVertices) throw fail(faceLine[f], "too many vertices");
           it = extra.emplace(key, uint32_t(mesh.positions.size())).first;
-          mesh.positions.push_back(pos[k.p]);
+          mesh.positions.push_back(pos[size_t(k.p)]);
           slot.push_back(s);
+          positionOf.push_back(uint32_t(k.p));
         }
         v = it->second;
       }
       vid.push_back(v);
     }
     addPolygon(mesh, vid.data(), vid.size(), dropped);
+    if (perTriangleMaterial) mesh.triangleMaterial.resize(mesh.triangles.size(), faceMaterial[f]);
+    if (perTriangleGroup) mesh.triangleGroup.resize(mesh.triangles.size(), faceGroup[f]);
   }
-  mesh.normals.assign(mesh.positions.size(), glm::dvec3(0.0));
-  std::vector<uint8_t> fromFile(mesh.positions.size(), 0);
-  for (size_t v = 0; v < mesh.positions.size(); ++v)
-    if (slot[v] >= 0) {
-      mesh.normals[v] = nrm[size_t(slot[v])];
+  const size_t n = mesh.positions.size();
+  mesh.normals.assign(n, glm::dvec3(0.0));
+  std::vector<uint8_t> fromFile(n, 0);
+  bool anyTexcoord = false;
+  for (size_t v = 0; v < n; ++v) {
+    if (slot[v].n >= 0) {
+      mesh.normals[v] = nrm[size_t(slot[v].n)];
       fromFile[v] = 1;
     }
+    anyTexcoord = anyTexcoord || slot[v].t >= 0;
+  }
+  if (anyTexcoord) {   // corners without one get (0, 0), as Blender reads them
+    mesh.texcoords.assign(n, glm::dvec2(0.0));
+    for (size_t v = 0; v < n; ++v)
+      if (slot[v].t >= 0) mesh.texcoords[v] = tex[size_t(slot[v].t)];
+  }
+  if (anyColor)
+    for (size_t v = 0; v < n; ++v) mesh.colors.push_back(glm::dvec4(posColor[positionOf[v]], 1.0));
+  for (const std::string& name : materialNames) mesh.materials.push_back(Material{name, glm::dvec4(1.0), ""});
+  mesh.groups = std::move(groupNames);
+  mesh.materialLibraries = std::move(libraries);
+  if (!mesh.materialLibraries.empty() && !mesh.materials.empty()) readMaterialLibraries(mesh, path);
   noteDroppedPolygons(mesh, dropped);
   if (!emptyFaceLines.empty())
     mesh.warnings.push_back(path + ":" + std::to_string(emptyFaceLines[0]) + ": " + std::to_string(emptyFaceLines.size()) +
                             (emptyFaceLines.size() == 1 ? " empty face line" : " empty face lines") + " skipped");
-  finishMesh(mesh, fromFile, path);
+  // A position used without `vn` by corners with different `vt` gets one computed normal (a texture
+  // seam is no crease).
+  std::vector<uint32_t> normalShared(n);
+  std::vector<int64_t> firstWithout(pos.size(), -1);
+  for (size_t v = 0; v < n; ++v) {
+    normalShared[v] = uint32_t(v);
+    if (slot[v].n != -1) continue;
+    int64_t& first = firstWithout[positionOf[v]];
+    if (first < 0) first = int64_t(v);
+    normalShared[v] = uint32_t(first);
+  }
+  finishMesh(mesh, fromFile, path, normalShared);
   return mesh;
 }
 

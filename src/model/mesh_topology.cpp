@@ -183,6 +183,14 @@ MeshTopology buildTopology(const Mesh& mesh) {
   return topo;
 }
 
+// Appends vertex v's texture coordinate and colour (where the mesh has them) for a copy of v.
+namespace {
+void copyCarriedAttributes(Mesh& mesh, uint32_t v) {
+  if (!mesh.texcoords.empty()) mesh.texcoords.push_back(glm::dvec2(mesh.texcoords[v]));
+  if (!mesh.colors.empty()) mesh.colors.push_back(glm::dvec4(mesh.colors[v]));
+}
+}  // namespace
+
 void applyCreaseAngle(Mesh& mesh, double creaseAngleDeg) {
   // Normals from the file are the sharpness model itself (METHOD.md 3.1): never overridden.
   if (mesh.normalsFromFile) return;
@@ -265,6 +273,7 @@ void applyCreaseAngle(Mesh& mesh, double creaseAngleDeg) {
         mesh.positions.push_back(position);
         mesh.normals.push_back(normal);
         mesh.weldId.push_back(weld);
+        copyCarriedAttributes(mesh, v);
         if (hasPatchData) {
           const uint32_t patch = mesh.vertexPatch[v];
           const glm::dvec2 uv = mesh.vertexUV[v];

@@ -9,6 +9,7 @@
 
 #include <sffd/error.h>
 
+#include "core/backend.h"
 #include "core/job_budget.h"
 #include "core/wall_clock.h"
 #include "model/mesh_topology.h"
@@ -63,7 +64,7 @@ ResolvedOptions resolve(const DeformOptions& o, const DeviceInfo& info, const Me
   r.method = o.method;
   r.variant.strict = o.strict;
   if (o.precision == Precision::Double && !info.limits.float64)
-    throw deviceError(info.name + " has no double-precision shader support");
+    throw noFloat64Error(info);
   // Classic and accurate FFD default to double: PyGeM's 1.5e-6 is below float resolution at its
   // coordinates, and accurate FFD is the reference the others are measured against.
   r.variant.f64 = o.precision == Precision::Double ||

@@ -19,7 +19,7 @@ class AccurateRun final : public MethodRun {
  public:
   AccurateRun(Backend& backend, const Mesh& input, const Lattice& lattice, const ResolvedOptions& r, Timings& t,
               const ProgressReporter& progress)
-      : B_(backend), variant_(r.variant) {
+      : B_(backend), input_(input), variant_(r.variant) {
     const auto t0 = std::chrono::steady_clock::now();
     progress("clip", 0);
     job_ = makeAccurateJob(input, lattice, clipAgainstKnotBoxes(input, lattice), r.tess);
@@ -99,7 +99,9 @@ class AccurateRun final : public MethodRun {
       std::copy(pos.begin(), pos.end(), out.positions.begin() + c.first * nv * 4);
       std::copy(nrm.begin(), nrm.end(), out.normals.begin() + c.first * nv * 4);
     }
-    return accuratePatchVertices(job_, out);
+    PatchVertices p = accuratePatchVertices(job_, out);
+    carryAttributes(p, input_);
+    return p;
   }
 
   size_t subTriangles() const override { return job_.count(); }
@@ -118,6 +120,7 @@ class AccurateRun final : public MethodRun {
   };
   Backend& B_;
   OwnedBuffers owned_{B_};   // first: destroyed last, after everything that names its buffers
+  const Mesh& input_;   // Deformer::Impl::input, which outlives the run
   KernelVariant variant_;
   AccurateJob job_;
   gpu::LatticeParams params_;

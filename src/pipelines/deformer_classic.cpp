@@ -58,9 +58,8 @@ class ClassicRun final : public MethodRun {
       const Chunk& c = chunks_[i];
       const uint64_t bytes = c.count * 4 * (variant_.f64 ? 8 : 4);
       ClassicBindings b{{SFFD_BINDING_LATTICE_COEFFS, coeffs_}, {SFFD_BINDING_LATTICE_FRAME, frame_},
-                        {SFFD_BINDING_CLASSIC_POS_IN, c.in, 0, bytes},   {SFFD_BINDING_CLASSIC_NRM_IN, c.in, c.half, bytes},
-                        {SFFD_BINDING_CLASSIC_POS_OUT, c.out, 0, bytes}, {SFFD_BINDING_CLASSIC_NRM_OUT, c.out, c.half, bytes}};
-      dispatchClassicFfd(B_, params_, variant_, c.count, b);
+                        {SFFD_BINDING_CLASSIC_IN, c.in, 0, c.half + bytes}, {SFFD_BINDING_CLASSIC_OUT, c.out, 0, c.half + bytes}};
+      dispatchClassicFfd(B_, params_, variant_, c.count, b, c.half / (4 * (variant_.f64 ? 8 : 4)));
       progress("deform", double(i + 1) / double(chunks_.size() + 1));
     }
     B_.finish();

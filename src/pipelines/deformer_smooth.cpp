@@ -10,7 +10,8 @@ namespace {
 class SmoothRun final : public MethodRun {
  public:
   SmoothRun(Backend& backend, const Mesh& input, const Lattice& lattice, const ResolvedOptions& r, Timings& t,
-            const ProgressReporter& progress) {
+            const ProgressReporter& progress)
+      : input_(input) {
     DeformSessionOptions o;
     o.variant = r.variant;
     o.edgeLength = r.edgeLength;
@@ -37,7 +38,9 @@ class SmoothRun final : public MethodRun {
 
   std::optional<PatchVertices> patchVertices() const override {
     if (!records_) records_ = session_->records();   // fixed by the pre-compute: downloaded once
-    return patchVerticesOf(*records_, session_->output());
+    PatchVertices p = patchVerticesOf(*records_, session_->output());
+    carryAttributes(p, input_);
+    return p;
   }
 
   std::vector<double> patchControlPoints() const override { return session_->output().patches; }
@@ -61,6 +64,7 @@ class SmoothRun final : public MethodRun {
   DeformSession* session() override { return session_.get(); }
 
  private:
+  const Mesh& input_;   // Deformer::Impl::input, which outlives the run
   std::unique_ptr<DeformSession> session_;
   mutable std::optional<SubTriangleRecords> records_;
 };

@@ -1,4 +1,6 @@
-// OpenGL 4.3+ core compute driver (sffd::Backend) on a context from gl_context.h.
+// OpenGL 4.3+ core and OpenGL ES 3.1 compute driver (sffd::Backend) on a context from gl_context.h.
+// The two APIs share this code; where they differ (no doubles, glGetBufferSubData, glBufferStorage or
+// core timestamps in ES; storage bindings from 0; the ES 3.1 minimum limits) it asks ctx_->es().
 // Every GL call goes through glad, whose entry points the context loads when it becomes current;
 // each public method activates the backend's context first, so backends of several providers can
 // live in one process, and restores the bindings it changes (gl_state.h), so that an application's
@@ -17,6 +19,7 @@
 #include <utility>
 
 #include <sffd/error.h>
+#include "backends/opengl/gl_es_limits.h"
 #include "backends/opengl/gl_state.h"
 #include "core/device_timeout.h"
 #include "core/kernel_registry.h"
@@ -54,8 +57,9 @@ void checkGl(const char* what) {
 }
 
 // Lowers "#version 450" to the context's version (4.3, 4.4): the kernels use nothing past GLSL 4.30.
+// The ES form ("#version 310 es", made at build time) is left as it is.
 void fitVersion(std::string& src, int contextVersion) {
-  if (src.rfind("#version ", 0) != 0) return;
+  if (src.rfind("#version ", 0) != 0 || src.rfind("#version 310 es", 0) == 0) return;
   int want = std::atoi(src.c_str() + 9);
   int have = contextVersion * 10;
   if (want > have && have >= 430) src.replace(9, 3, std::to_string(have));
@@ -68,24 +72,73 @@ std::string variantName(KernelVariant v) {
 struct Program {
   GLuint name = 0;
   GLint paramsBlockSize = -1;   // GL_UNIFORM_BLOCK_DATA_SIZE of the block at binding 0 (-1: none)
+  ProgramResources resources;
 };
+
+// What a linked compute program uses, as GL reports it.
+ProgramResources queryResources(GLuint prog) {
+  ProgramResources r;
+  GLint blocks = 0;
+  glGetProgramInterfaceiv(prog, GL_SHADER_STORAGE_BLOCK, GL_ACTIVE_RESOURCES, &blocks);
+  r.storageBlocks = blocks;
+  for (GLint i = 0; i < blocks; ++i) {
+    const GLenum prop = GL_BUFFER_BINDING;
+    GLint binding = 0;
+    glGetProgramResourceiv(prog, GL_SHADER_STORAGE_BLOCK, GLuint(i), 1, &prop, 1, nullptr, &binding);
+    r.maxStorageBinding = std::max(r.maxStorageBinding, binding);
+  }
+  glGetProgramInterfaceiv(prog, GL_UNIFORM_BLOCK, GL_ACTIVE_RESOURCES, &blocks);
+  for (GLint i = 0; i < blocks; ++i) {
+    const GLenum prop = GL_BUFFER_DATA_SIZE;
+    GLint size = 0;
+    glGetProgramResourceiv(prog, GL_UNIFORM_BLOCK, GLuint(i), 1, &prop, 1, nullptr, &size);
+    r.maxUniformBlockBytes = std::max(r.maxUniformBlockBytes, size);
+  }
+  glGetProgramiv(prog, GL_COMPUTE_WORK_GROUP_SIZE, r.groupSize);
+  return r;
+}
+
+// The first ES 3.1 minimum limit the program is past, or "" when it fits them all.
+std::string pastEsMinimum(const ProgramResources& r) {
+  auto past = [](const char* what, long long have, long long limit) {
+    return std::string(what) + " " + std::to_string(have) + " (OpenGL ES 3.1 guarantees " + std::to_string(limit) + ")";
+  };
+  if (r.storageBlocks > es31::kMaxComputeStorageBlocks)
+    return past("storage blocks", r.storageBlocks, es31::kMaxComputeStorageBlocks);
+  if (r.maxStorageBinding >= es31::kMaxStorageBindings)
+    return past("storage binding", r.maxStorageBinding, es31::kMaxStorageBindings - 1);
+  if (r.maxUniformBlockBytes > es31::kMaxUniformBlockSize)
+    return past("uniform block bytes", r.maxUniformBlockBytes, es31::kMaxUniformBlockSize);
+  long long invocations = 1;
+  for (int i = 0; i < 3; ++i) {
+    if (r.groupSize[i] > es31::kMaxGroupSize[i]) return past("work-group size", r.groupSize[i], es31::kMaxGroupSize[i]);
+    invocations *= r.groupSize[i];
+  }
+  if (invocations > es31::kMaxInvocations) return past("work-group invocations", invocations, es31::kMaxInvocations);
+  return {};
+}
 
 class GlBackend final : public Backend {
  public:
-  explicit GlBackend(std::shared_ptr<Context> context) : ctx_(std::move(context)) {
+  GlBackend(std::shared_ptr<Context> context, bool deviceLimits) : ctx_(std::move(context)) {
     ctx_->activate();
+    es_ = ctx_->es();
+    heldToEsMinimum_ = es_ && !deviceLimits;
     GLint major = 0, minor = 0, profile = 0;
     glGetIntegerv(GL_MAJOR_VERSION, &major);
     glGetIntegerv(GL_MINOR_VERSION, &minor);
-    glGetIntegerv(GL_CONTEXT_PROFILE_MASK, &profile);
-    info_.api = "gl";
+    if (!es_) glGetIntegerv(GL_CONTEXT_PROFILE_MASK, &profile);
+    info_.api = es_ ? "gles" : "gl";
     info_.provider = ctx_->name();
     info_.name = glString(GL_RENDERER);
     info_.driver = glString(GL_VERSION);
     // "4.5 (Core Profile) Mesa 22.3.6": the driver's own version where it names one.
     size_t mesa = info_.driver.find("Mesa ");
     info_.driverVersion = mesa == std::string::npos ? info_.driver : info_.driver.substr(mesa);
-    if (major * 10 + minor < 43 || !(profile & GL_CONTEXT_CORE_PROFILE_BIT))
+    if (es_ && major * 10 + minor < 31)
+      throw deviceError("gles/" + info_.provider + ": compute needs OpenGL ES 3.1, the context is " +
+                        std::to_string(major) + "." + std::to_string(minor) + " (" + info_.driver + ", " + info_.name + ")");
+    if (!es_ && (major * 10 + minor < 43 || !(profile & GL_CONTEXT_CORE_PROFILE_BIT)))
       throw deviceError("gl/" + info_.provider + ": compute needs OpenGL 4.3 core, the context is " +
                         std::to_string(major) + "." + std::to_string(minor) +
                         ((profile & GL_CONTEXT_CORE_PROFILE_BIT) ? " core" : " (not core)") + " (" + info_.driver +
@@ -107,9 +160,10 @@ class GlBackend final : public Backend {
       glGetIntegeri_v(GL_MAX_COMPUTE_WORK_GROUP_COUNT, i, &n);
       L.maxWorkGroupCount[i] = static_cast<uint32_t>(std::max(n, 0));
     }
-    L.float64 = true;   // GL 4.0+ core has doubles (ARB_gpu_shader_fp64)
+    L.float64 = !es_;   // GL 4.0+ core has doubles (ARB_gpu_shader_fp64); ES has none
     GLint bits = 0;
-    glGetQueryiv(GL_TIMESTAMP, GL_QUERY_COUNTER_BITS, &bits);
+    // ES: timestamps only through EXT_disjoint_timer_query (gl_loader_es.cpp points glQueryCounter at it).
+    if (!es_ || glad_glQueryCounter) glGetQueryiv(GL_TIMESTAMP, GL_QUERY_COUNTER_BITS, &bits);
     L.timestamps = bits > 0;
 
     GLint uboAlign = 0, maxBlock = 0;
@@ -117,6 +171,11 @@ class GlBackend final : public Backend {
     glGetIntegerv(GL_MAX_UNIFORM_BLOCK_SIZE, &maxBlock);
     uboAlign_ = static_cast<uint64_t>(std::max(uboAlign, 16));
     maxParams_ = static_cast<uint64_t>(std::max(maxBlock, 16384));
+    if (heldToEsMinimum_) {
+      L.maxStorageBufferRange = std::min(L.maxStorageBufferRange, es31::kMaxStorageBlockSize);
+      for (uint32_t& n : L.maxWorkGroupCount) n = std::min(n, es31::kMaxGroupCount);
+      maxParams_ = es31::kMaxUniformBlockSize;
+    }
     uboSize_ = std::max<uint64_t>(kRingBytes, alignUp(maxParams_, uboAlign_));
     StateGuard state;
     state.buffer(GL_UNIFORM_BUFFER);
@@ -147,6 +206,12 @@ class GlBackend final : public Backend {
   }
 
   const DeviceInfo& info() const override { return info_; }
+  const ProgramResources& resources(std::string_view kernelName, KernelVariant variant) {
+    ctx_->activate();
+    const EmbeddedKernel* kernel = findKernel(kernelName);
+    if (!kernel) throw Error(ErrorKind::Internal, "gl: no kernel named '" + std::string(kernelName) + "'");
+    return program(*kernel, variant).resources;
+  }
   GLuint bufferObject(BufferId id) const {
     auto it = buffers_.find(id);
     return it == buffers_.end() ? 0 : it->second.name;
@@ -161,7 +226,7 @@ class GlBackend final : public Backend {
     glBindBuffer(GL_COPY_WRITE_BUFFER, name);
     // Zero-sized storage is an error in GL: keep 16 bytes behind an empty buffer.
     GLsizeiptr size = static_cast<GLsizeiptr>(std::max<uint64_t>(bytes, 16));
-    if (GLAD_GL_VERSION_4_4)
+    if (!es_ && GLAD_GL_VERSION_4_4)
       glBufferStorage(GL_COPY_WRITE_BUFFER, size, nullptr, GL_DYNAMIC_STORAGE_BIT);
     else
       glBufferData(GL_COPY_WRITE_BUFFER, size, nullptr, GL_DYNAMIC_DRAW);
@@ -209,7 +274,15 @@ class GlBackend final : public Backend {
     state.buffer(GL_COPY_READ_BUFFER);
     glBindBuffer(GL_COPY_READ_BUFFER, b.name);
     waitIdle("download");   // bounded: glGetBufferSubData alone would wait forever on a hung driver
-    glGetBufferSubData(GL_COPY_READ_BUFFER, static_cast<GLintptr>(offset), static_cast<GLsizeiptr>(bytes), data);
+    if (es_) {
+      // ES has no glGetBufferSubData: map the range for reading.
+      void* mapped = glMapBufferRange(GL_COPY_READ_BUFFER, static_cast<GLintptr>(offset),
+                                      static_cast<GLsizeiptr>(bytes), GL_MAP_READ_BIT);
+      if (mapped) std::memcpy(data, mapped, bytes);
+      if (mapped && !glUnmapBuffer(GL_COPY_READ_BUFFER)) throw deviceError("gles: a downloaded buffer was lost (glUnmapBuffer)");
+    } else {
+      glGetBufferSubData(GL_COPY_READ_BUFFER, static_cast<GLintptr>(offset), static_cast<GLsizeiptr>(bytes), data);
+    }
     checkGl("download");
   }
 
@@ -239,7 +312,7 @@ class GlBackend final : public Backend {
     state.program();
     state.indexed(GL_UNIFORM_BUFFER, SFFD_BINDING_PARAMS);
     for (const BufferBinding& bb : d.buffers)
-      if (bb.slot >= 1 && bb.slot <= SFFD_MAX_STORAGE_BINDINGS) state.indexed(GL_SHADER_STORAGE_BUFFER, bb.slot);
+      if (bb.slot >= 1 && bb.slot <= SFFD_MAX_STORAGE_BINDINGS) state.indexed(GL_SHADER_STORAGE_BUFFER, storageIndex(bb.slot));
     glBindBuffer(GL_UNIFORM_BUFFER, ubo_);
     if (uboHead_ + span > uboSize_) {
       glBufferData(GL_UNIFORM_BUFFER, static_cast<GLsizeiptr>(uboSize_), nullptr, GL_STREAM_DRAW);
@@ -274,7 +347,7 @@ class GlBackend final : public Backend {
         throw Error(ErrorKind::Internal, "gl: " + what + ": slot " + std::to_string(bb.slot) + " binds " +
                                              std::to_string(size) + " bytes, the device allows " +
                                              std::to_string(L.maxStorageBufferRange) + " (process in chunks)");
-      glBindBufferRange(GL_SHADER_STORAGE_BUFFER, bb.slot, b.name, static_cast<GLintptr>(bb.offset),
+      glBindBufferRange(GL_SHADER_STORAGE_BUFFER, storageIndex(bb.slot), b.name, static_cast<GLintptr>(bb.offset),
                         static_cast<GLsizeiptr>(size));
     }
 
@@ -371,6 +444,10 @@ class GlBackend final : public Backend {
     return it->second;
   }
 
+  // The GL binding index of a storage slot (layout.h numbers them from 1 after the parameter block, as
+  // Vulkan's shared namespace needs; ES kernels number them from 0, prelude.glsl's SFFD_SSBO).
+  GLuint storageIndex(uint32_t slot) const { return es_ ? slot - 1 : slot; }
+
   GLuint takeQuery() {
     if (freeQueries_.empty()) {
       GLuint q[16];
@@ -387,9 +464,10 @@ class GlBackend final : public Backend {
     auto it = programs_.find(key);
     if (it != programs_.end()) return it->second;
     std::string what = std::string(kernel.name) + " (" + variantName(variant) + ")";
-    if (variant.f64 && !info_.limits.float64) throw deviceError("gl: the device has no float64 for " + what);
+    if (variant.f64 && !info_.limits.float64)
+      throw deviceError(info_.api + ": the device has no float64 for " + what);
 
-    std::string src = glslForVariant(kernel, variant);
+    std::string src = glslForVariant(kernel, variant, es_);
     fitVersion(src, ctx_->glVersion());
     GLuint shader = glCreateShader(GL_COMPUTE_SHADER);
     const char* text = src.c_str();
@@ -415,6 +493,14 @@ class GlBackend final : public Backend {
     }
     Program p;
     p.name = prog;
+    p.resources = queryResources(prog);
+    if (heldToEsMinimum_) {
+      std::string past = pastEsMinimum(p.resources);
+      if (!past.empty()) {
+        glDeleteProgram(prog);
+        throw deviceError("gles: kernel " + what + " uses " + past + "; SFFD_GLES_LIMITS=device uses the device's own limits");
+      }
+    }
     GLint blocks = 0;
     glGetProgramiv(prog, GL_ACTIVE_UNIFORM_BLOCKS, &blocks);
     for (GLint i = 0; i < blocks; ++i) {
@@ -452,12 +538,24 @@ class GlBackend final : public Backend {
   std::vector<Pending> pending_;
   std::vector<GLuint> freeQueries_;
   bool dirty_ = false;   // dispatches since the last barrier
+  bool es_ = false;                // an OpenGL ES context (the gles backend)
+  bool heldToEsMinimum_ = false;   // es_, and held to the ES 3.1 minimum limits (gl_es_limits.h)
   bool hung_ = false;    // a wait timed out: the device may still use our objects
 };
 
+// Whether the gles backend uses the device's own limits: asked for, or SFFD_GLES_LIMITS=device.
+bool useDeviceLimits(bool asked) {
+  const char* env = std::getenv("SFFD_GLES_LIMITS");
+  if (!env || !*env) return asked;
+  std::string v = env;
+  if (v == "device") return true;
+  if (v == "minimum") return false;
+  throw Error(ErrorKind::Input, "SFFD_GLES_LIMITS='" + v + "': expected minimum or device");
+}
+
 // A backend of one explicit provider, refused when its renderer does not match the device substring.
-std::unique_ptr<Backend> backendOf(Provider provider, const std::string& deviceSubstring) {
-  auto backend = std::make_unique<GlBackend>(std::shared_ptr<Context>(createContext(provider)));
+std::unique_ptr<Backend> backendOf(Provider provider, const std::string& deviceSubstring, bool deviceLimits = false) {
+  auto backend = std::make_unique<GlBackend>(std::shared_ptr<Context>(createContext(provider)), useDeviceLimits(deviceLimits));
   if (!deviceSubstring.empty() && lower(backend->info().name).find(lower(deviceSubstring)) == std::string::npos)
     throw deviceError("gl/" + backend->info().provider + ": renderer '" + backend->info().name +
                       "' does not contain '" + deviceSubstring + "'");
@@ -472,7 +570,7 @@ std::unique_ptr<Backend> createBackend(const Options& options) {
     const char* env = std::getenv("SFFD_GL_PROVIDER");
     if (env && *env) provider = parseProvider(env);
   }
-  if (provider != Provider::Auto) return backendOf(provider, options.deviceSubstring);
+  if (provider != Provider::Auto) return backendOf(provider, options.deviceSubstring, options.deviceLimits);
   std::string reasons;
   for (Provider p : {Provider::EGL, Provider::OSMesa}) {
     try {
@@ -487,7 +585,13 @@ std::unique_ptr<Backend> createBackend(const Options& options) {
 
 std::unique_ptr<Backend> createBackendOn(std::shared_ptr<Context> context) {
   if (!context) throw Error(ErrorKind::Internal, "gl: createBackendOn without a context");
-  return std::make_unique<GlBackend>(std::move(context));
+  return std::make_unique<GlBackend>(std::move(context), useDeviceLimits(false));
+}
+
+const ProgramResources& programResources(Backend& backend, std::string_view kernel, KernelVariant variant) {
+  auto* gl = dynamic_cast<GlBackend*>(&backend);
+  if (!gl) throw Error(ErrorKind::Internal, "programResources: not a GL backend");
+  return gl->resources(kernel, variant);
 }
 
 unsigned glBufferObject(const Backend& backend, BufferId buffer) {

@@ -107,24 +107,23 @@ ClassicRun<Real> runClassic(Backend& b, KernelVariant v, const HandLattice<Real>
   const size_t n = pos.size() / 4, bytes = pos.size() * sizeof(Real);
   BufferId frame = b.createBuffer(L.frame.size() * sizeof(Real));
   BufferId coeffs = b.createBuffer(L.coeffs.size() * sizeof(Real));
-  BufferId io[4];
-  for (BufferId& id : io) id = b.createBuffer(bytes);
+  BufferId io[2];   // positions, then normals from element n
+  for (BufferId& id : io) id = b.createBuffer(2 * bytes);
   b.upload(frame, 0, L.frame.data(), L.frame.size() * sizeof(Real));
   b.upload(coeffs, 0, L.coeffs.data(), L.coeffs.size() * sizeof(Real));
   b.upload(io[0], 0, pos.data(), bytes);
-  b.upload(io[1], 0, nrm.data(), bytes);
+  b.upload(io[0], bytes, nrm.data(), bytes);
 
   gpu::ClassicParams params;
   params.lattice = L.params;
-  params.range = {0, uint32_t(n), 0, 0};
+  params.range = {0, uint32_t(n), uint32_t(n), 0};
   Dispatch d;
   d.kernel = "classic_ffd";
   d.variant = v;
   d.params = &params;
   d.paramsSize = sizeof(params);
   d.buffers = {{SFFD_BINDING_LATTICE_COEFFS, coeffs}, {SFFD_BINDING_LATTICE_FRAME, frame},
-               {SFFD_BINDING_CLASSIC_POS_IN, io[0]},  {SFFD_BINDING_CLASSIC_NRM_IN, io[1]},
-               {SFFD_BINDING_CLASSIC_POS_OUT, io[2]}, {SFFD_BINDING_CLASSIC_NRM_OUT, io[3]}};
+               {SFFD_BINDING_CLASSIC_IN, io[0]}, {SFFD_BINDING_CLASSIC_OUT, io[1]}};
   d.label = "classic test";
   ClassicRun<Real> r;
   gridFor(n, b.info().limits, d.groups);
@@ -134,8 +133,8 @@ ClassicRun<Real> runClassic(Backend& b, KernelVariant v, const HandLattice<Real>
   b.barrier();
   r.pos.resize(pos.size());
   r.nrm.resize(nrm.size());
-  b.download(io[2], 0, r.pos.data(), bytes);
-  b.download(io[3], 0, r.nrm.data(), bytes);
+  b.download(io[1], 0, r.pos.data(), bytes);
+  b.download(io[1], bytes, r.nrm.data(), bytes);
   b.finish();
   r.wallMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   r.timings = b.takeTimings();

@@ -3,6 +3,8 @@
 
 #include <dlfcn.h>
 
+#include <string_view>
+
 #include <glad/gl.h>
 
 #include <sffd/error.h>
@@ -16,6 +18,14 @@ thread_local Context* tCurrent = nullptr;
 GLADapiproc loadThrough(void* userptr, const char* name) {
   return reinterpret_cast<GLADapiproc>(static_cast<const Context*>(userptr)->procAddress(name));
 }
+GLProc procThrough(void* userptr, const char* name) { return static_cast<const Context*>(userptr)->procAddress(name); }
+
+// Whether the current context is OpenGL ES, from its version string ("OpenGL ES 3.2 Mesa 22.3.6").
+bool currentIsEs(const Context& context) {
+  auto getString = reinterpret_cast<const GLubyte* (*)(GLenum)>(context.procAddress("glGetString"));
+  const GLubyte* version = getString ? getString(GL_VERSION) : nullptr;
+  return version && std::string_view(reinterpret_cast<const char*>(version)).starts_with("OpenGL ES");
+}
 }  // namespace
 
 const char* providerName(Provider provider) {
@@ -24,6 +34,7 @@ const char* providerName(Provider provider) {
     case Provider::EGL: return "egl";
     case Provider::OSMesa: return "osmesa";
     case Provider::GLFW: return "glfw";
+    case Provider::EGLES: return "egl-es";
   }
   return "?";
 }
@@ -33,7 +44,8 @@ Provider parseProvider(const std::string& name) {
   if (name == "egl") return Provider::EGL;
   if (name == "osmesa") return Provider::OSMesa;
   if (name == "glfw") return Provider::GLFW;
-  throw Error(ErrorKind::Input, "unknown GL provider '" + name + "' (egl, osmesa, glfw)");
+  if (name == "egl-es") return Provider::EGLES;
+  throw Error(ErrorKind::Input, "unknown GL provider '" + name + "' (egl, osmesa, glfw, egl-es)");
 }
 
 bool providerLibraryPresent(Provider provider) {
@@ -43,7 +55,8 @@ bool providerLibraryPresent(Provider provider) {
   switch (provider) {
     case Provider::Auto: return providerLibraryPresent(Provider::EGL) || providerLibraryPresent(Provider::OSMesa);
     case Provider::GLFW: return true;   // linked in
-    case Provider::EGL: names = egl; break;
+    case Provider::EGL:
+    case Provider::EGLES: names = egl; break;
     case Provider::OSMesa: names = osmesa; break;
   }
   for (const char* const* n = names; *n; ++n) {
@@ -85,13 +98,18 @@ void Context::activate() {
 void Context::loadGlad() {
   // The GL entry points belong to the provider's library (OSMesa has its own copy of Mesa's GL):
   // reload them whenever another context becomes current.
-  int version = gladLoadGLUserPtr(loadThrough, this);
-  if (version == 0) {
+  es_ = currentIsEs(*this);
+  if (es_) {
+    glVersion_ = loadGlesEntryPoints(procThrough, this);
+  } else {
+    int version = gladLoadGLUserPtr(loadThrough, this);
+    glVersion_ = version ? GLAD_VERSION_MAJOR(version) * 10 + GLAD_VERSION_MINOR(version) : 0;
+  }
+  if (glVersion_ == 0) {
     release();
     tCurrent = nullptr;
     throw deviceError(std::string(name()) + ": cannot load the GL entry points (glad found no GL version)");
   }
-  glVersion_ = GLAD_VERSION_MAJOR(version) * 10 + GLAD_VERSION_MINOR(version);
 }
 
 void Context::deactivateCurrent() {
@@ -113,6 +131,7 @@ std::unique_ptr<Context> createContext(Provider provider) {
     case Provider::EGL: return createEglContext();
     case Provider::OSMesa: return createOSMesaContext();
     case Provider::GLFW: return createGlfwContext();
+    case Provider::EGLES: return createEglEsContext();
     case Provider::Auto: break;
   }
   throw Error(ErrorKind::Internal, "createContext: pick a provider (Auto is resolved by the GL driver)");

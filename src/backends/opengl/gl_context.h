@@ -3,6 +3,7 @@
 // out its entry points; the driver only ever talks to GL through glad.
 //
 //   egl     EGL surfaceless (libEGL.so.1, opened at run time): the durable headless path
+//   egl-es  the same with an OpenGL ES 3.1 context (the gles backend, docs/GLES.md)
 //   osmesa  Mesa's off-screen library (libOSMesa.so.8, opened at run time; removed in Mesa 25.1)
 //   glfw    a GLFW window (hidden for compute, visible for the viewer); needs an X display
 //
@@ -14,9 +15,9 @@
 
 namespace sffd::gl {
 
-enum class Provider { Auto, EGL, OSMesa, GLFW };
+enum class Provider { Auto, EGL, OSMesa, GLFW, EGLES };
 
-// "egl", "osmesa", "glfw" ("auto" for Auto).
+// "egl", "osmesa", "glfw", "egl-es" ("auto" for Auto).
 const char* providerName(Provider provider);
 // Parses a provider name as SFFD_GL_PROVIDER and the command line spell it; throws an input Error otherwise.
 Provider parseProvider(const std::string& name);
@@ -50,8 +51,11 @@ class Context {
   // Releases whichever sffd context is current on the calling thread.
   static void deactivateCurrent();
   bool isCurrent() const;
-  // The GL version glad found at the last activate(): major * 10 + minor (45 for 4.5).
+  // The GL version glad found at the last activate(): major * 10 + minor (45 for 4.5, 32 for ES 3.2).
   int glVersion() const { return glVersion_; }
+  // Whether the context is OpenGL ES (its GL_VERSION begins "OpenGL ES"); glad then loads the ES 3.1
+  // entry points into the same table (cmake/Glad.cmake).
+  bool es() const { return es_; }
   // An application's context (adoptCurrentContext): activate() never switches to it or away from
   // it, only checks that it is current here (a device Error otherwise) and loads glad through it.
   virtual bool adopted() const { return false; }
@@ -69,12 +73,19 @@ class Context {
  private:
   void loadGlad();
   int glVersion_ = 0;
+  bool es_ = false;
 };
 
 // Each throws a device Error naming the provider and the reason when no GL 4.3+ core context can be made
 // (library missing, no display, version too old). The context is current when they return.
 std::unique_ptr<Context> createEglContext();
 std::unique_ptr<Context> createOSMesaContext();
+// An OpenGL ES 3.1 context (a later compatible version where the driver gives one) through EGL.
+std::unique_ptr<Context> createEglEsContext();
+
+// Loads the OpenGL ES 3.1 entry points of the current ES context into glad's table (gl_loader_es.cpp);
+// returns major * 10 + minor of the context's ES version, 0 when none could be read.
+int loadGlesEntryPoints(GLProc (*load)(void* user, const char* name), void* user);
 
 struct GlfwWindowOptions {
   bool visible = false;

@@ -1,6 +1,8 @@
-// EGL context provider: a GL 4.3+ core context with no surface, on Mesa's surfaceless platform
-// (EGL_MESA_platform_surfaceless), else on each EGL device (EGL_EXT_platform_device, e.g. NVIDIA).
-// libEGL.so.1 is opened at run time; the EGL headers are used for types and constants only.
+// EGL context providers: a GL 4.3+ core context (egl) or an OpenGL ES 3.1+ context (egl-es, the gles
+// backend) with no surface, on Mesa's surfaceless platform (EGL_MESA_platform_surfaceless), else on
+// each EGL device (EGL_EXT_platform_device, e.g. NVIDIA). The two differ only in the client API bound
+// (eglBindAPI) and the attributes asked for. libEGL.so.1 is opened at run time; the EGL headers are
+// used for types and constants only.
 #define EGL_NO_X11 1
 #include <EGL/egl.h>
 #include <EGL/eglext.h>
@@ -128,21 +130,30 @@ void unrefDisplay(EGLDisplay dpy) {
   }
 }
 
+// Which client API a context speaks: eglBindAPI is per thread, so every EGL call that depends on it
+// binds it first.
+struct EglApi {
+  bool es = false;
+  EGLenum api() const { return es ? EGL_OPENGL_ES_API : EGL_OPENGL_API; }
+  const char* provider() const { return es ? "egl-es" : "egl"; }
+  const char* wants() const { return es ? "OpenGL ES 3.1+ context" : "OpenGL 4.3+ core context"; }
+};
+
 class EglContext final : public Context {
  public:
-  EglContext(EGLDisplay dpy, EGLContext ctx) : dpy_(dpy), ctx_(ctx) {}
+  EglContext(EGLDisplay dpy, EGLContext ctx, EglApi api) : dpy_(dpy), ctx_(ctx), api_(api) {}
   ~EglContext() override {
     releaseIfCurrent();
     EglLib& l = lib();
     if (l.GetCurrentContext() == ctx_) {
-      l.BindAPI(EGL_OPENGL_API);
+      l.BindAPI(api_.api());
       l.MakeCurrent(dpy_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
     }
     l.DestroyContext(dpy_, ctx_);
     unrefDisplay(dpy_);
     if (displayUsers().empty()) l.ReleaseThread();
   }
-  const char* name() const override { return "egl"; }
+  const char* name() const override { return api_.provider(); }
   GLProc procAddress(const char* function) const override {
     return reinterpret_cast<GLProc>(lib().GetProcAddress(function));
   }
@@ -150,24 +161,28 @@ class EglContext final : public Context {
  protected:
   void makeCurrent() override {
     EglLib& l = lib();
-    l.BindAPI(EGL_OPENGL_API);
+    l.BindAPI(api_.api());
     if (!l.MakeCurrent(dpy_, EGL_NO_SURFACE, EGL_NO_SURFACE, ctx_))
-      throw deviceError("egl: eglMakeCurrent failed (" + lastError() + ")");
+      throw deviceError(std::string(api_.provider()) + ": eglMakeCurrent failed (" + lastError() + ")");
   }
-  bool providerCurrent() const override { return lib().GetCurrentContext() == ctx_; }
+  bool providerCurrent() const override {
+    lib().BindAPI(api_.api());   // eglGetCurrentContext answers for the bound API
+    return lib().GetCurrentContext() == ctx_;
+  }
   void release() override {
     EglLib& l = lib();
-    l.BindAPI(EGL_OPENGL_API);
+    l.BindAPI(api_.api());
     l.MakeCurrent(dpy_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
   }
 
  private:
   EGLDisplay dpy_;
   EGLContext ctx_;
+  EglApi api_;
 };
 
-// A 4.5..4.3 core context on an initialised display, or EGL_NO_CONTEXT with the reason.
-EGLContext createOn(EGLDisplay dpy, std::string& why) {
+// A 4.5..4.3 core context (or an ES 3.1 one) on an initialised display, or EGL_NO_CONTEXT with the reason.
+EGLContext createOn(EGLDisplay dpy, EglApi api, std::string& why) {
   EglLib& l = lib();
   const char* ext = l.QueryString(dpy, EGL_EXTENSIONS);
   if (!hasExtension(ext, "EGL_KHR_surfaceless_context")) {
@@ -175,22 +190,31 @@ EGLContext createOn(EGLDisplay dpy, std::string& why) {
     return EGL_NO_CONTEXT;
   }
   const char* apis = l.QueryString(dpy, EGL_CLIENT_APIS);
-  if (apis && std::string(apis).find("OpenGL") == std::string::npos) {
+  if (apis && !hasExtension(apis, api.es ? "OpenGL_ES" : "OpenGL")) {
     why = std::string("the display offers only ") + apis;
     return EGL_NO_CONTEXT;
   }
-  if (!l.BindAPI(EGL_OPENGL_API)) {
-    why = "eglBindAPI(EGL_OPENGL_API) failed (" + lastError() + ")";
+  if (!l.BindAPI(api.api())) {
+    why = std::string("eglBindAPI(") + (api.es ? "EGL_OPENGL_ES_API" : "EGL_OPENGL_API") + ") failed (" + lastError() + ")";
     return EGL_NO_CONTEXT;
   }
   EGLConfig config = nullptr;   // EGL_NO_CONFIG_KHR
   if (!hasExtension(ext, "EGL_KHR_no_config_context") && !hasExtension(ext, "EGL_MESA_configless_context")) {
-    const EGLint want[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_SURFACE_TYPE, 0, EGL_NONE};
+    const EGLint want[] = {EGL_RENDERABLE_TYPE, api.es ? EGL_OPENGL_ES3_BIT : EGL_OPENGL_BIT, EGL_SURFACE_TYPE, 0,
+                           EGL_NONE};
     EGLint n = 0;
     if (!l.ChooseConfig(dpy, want, &config, 1, &n) || n < 1) {
-      why = "no EGL config renders OpenGL (" + lastError() + ")";
+      why = std::string("no EGL config renders ") + (api.es ? "OpenGL ES 3" : "OpenGL") + " (" + lastError() + ")";
       return EGL_NO_CONTEXT;
     }
+  }
+  if (api.es) {
+    // ES 3.1 exactly is asked for; a driver may hand out a later, compatible version (Mesa: 3.2), and
+    // the gles backend uses nothing past 3.1 either way.
+    const EGLint attribs[] = {EGL_CONTEXT_MAJOR_VERSION, 3, EGL_CONTEXT_MINOR_VERSION, 1, EGL_NONE};
+    EGLContext ctx = l.CreateContext(dpy, config, EGL_NO_CONTEXT, attribs);
+    if (ctx == EGL_NO_CONTEXT) why = "no OpenGL ES 3.1 context (" + lastError() + ")";
+    return ctx;
   }
   for (int minor = 5; minor >= 3; --minor) {
     const EGLint attribs[] = {EGL_CONTEXT_MAJOR_VERSION, 4, EGL_CONTEXT_MINOR_VERSION, minor,
@@ -203,7 +227,7 @@ EGLContext createOn(EGLDisplay dpy, std::string& why) {
 }
 
 // Initialises the display and makes a context on it; EGL_NO_CONTEXT (display released) on failure.
-std::unique_ptr<Context> tryDisplay(EGLDisplay dpy, const std::string& what, std::string& reasons) {
+std::unique_ptr<Context> tryDisplay(EGLDisplay dpy, EglApi api, const std::string& what, std::string& reasons) {
   EglLib& l = lib();
   auto fail = [&](const std::string& why) {
     reasons += (reasons.empty() ? "" : "; ") + what + ": " + why;
@@ -214,19 +238,17 @@ std::unique_ptr<Context> tryDisplay(EGLDisplay dpy, const std::string& what, std
   if (!l.Initialize(dpy, &major, &minor)) return fail("eglInitialize failed (" + lastError() + ")");
   ++displayUsers()[dpy];
   std::string why;
-  EGLContext ctx = createOn(dpy, why);
+  EGLContext ctx = createOn(dpy, api, why);
   if (ctx == EGL_NO_CONTEXT) {
     unrefDisplay(dpy);
     return fail(why);
   }
-  return std::make_unique<EglContext>(dpy, ctx);
+  return std::make_unique<EglContext>(dpy, ctx, api);
 }
 
-}  // namespace
-
-std::unique_ptr<Context> createEglContext() {
+std::unique_ptr<Context> createEglContextOf(EglApi api) {
   EglLib& l = lib();
-  if (!l.ok()) throw deviceError("egl: cannot load libEGL.so.1 (" + l.loadError + ")");
+  if (!l.ok()) throw deviceError(std::string(api.provider()) + ": cannot load libEGL.so.1 (" + l.loadError + ")");
   const char* clientExt = l.QueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
   auto platformDisplay = [&](EGLenum platform, void* native) -> EGLDisplay {
     if (l.GetPlatformDisplay) return l.GetPlatformDisplay(platform, native, nullptr);
@@ -240,7 +262,7 @@ std::unique_ptr<Context> createEglContext() {
   };
 
   if (hasExtension(clientExt, "EGL_MESA_platform_surfaceless")) {
-    if (auto ctx = tryDisplay(platformDisplay(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY), "surfaceless",
+    if (auto ctx = tryDisplay(platformDisplay(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY), api, "surfaceless",
                               reasons))
       return finish(std::move(ctx));
   } else {
@@ -252,13 +274,18 @@ std::unique_ptr<Context> createEglContext() {
       std::vector<EGLDeviceEXT> devices(static_cast<size_t>(n));
       l.QueryDevicesEXT(n, devices.data(), &n);
       for (EGLint i = 0; i < n; ++i) {
-        if (auto ctx = tryDisplay(platformDisplay(EGL_PLATFORM_DEVICE_EXT, devices[static_cast<size_t>(i)]),
+        if (auto ctx = tryDisplay(platformDisplay(EGL_PLATFORM_DEVICE_EXT, devices[static_cast<size_t>(i)]), api,
                                   "device " + std::to_string(i), reasons))
           return finish(std::move(ctx));
       }
     }
   }
-  throw deviceError("egl: no OpenGL 4.3+ core context without a surface (" + reasons + ")");
+  throw deviceError(std::string(api.provider()) + ": no " + api.wants() + " without a surface (" + reasons + ")");
 }
+
+}  // namespace
+
+std::unique_ptr<Context> createEglContext() { return createEglContextOf({.es = false}); }
+std::unique_ptr<Context> createEglEsContext() { return createEglContextOf({.es = true}); }
 
 }  // namespace sffd::gl

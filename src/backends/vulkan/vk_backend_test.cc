@@ -78,12 +78,12 @@ std::vector<T> identityCoeffs() {
   return c;
 }
 
-gpu::ClassicParams identityParams(uint32_t first, uint32_t count) {
+gpu::ClassicParams identityParams(uint32_t first, uint32_t count, uint32_t normalsAt) {
   gpu::ClassicParams p{};
   p.lattice.degree = {1, 1, 1, SFFD_OUTSIDE_EXTRAPOLATE};
   p.lattice.boxes = {1, 1, 1, 8};
   p.lattice.break_offset = {SFFD_FRAME_BREAKS, SFFD_FRAME_BREAKS + 2, SFFD_FRAME_BREAKS + 4, 0};
-  p.range = {first, count, 0, 0};
+  p.range = {first, count, normalsAt, 0};
   return p;
 }
 
@@ -108,12 +108,13 @@ void makeVertices(size_t n, std::vector<T>& pos, std::vector<T>& nrm) {
   }
 }
 
-// Buffers of one classic_ffd job on the identity lattice.
+// Buffers of one classic_ffd job on the identity lattice: vertices in and out, each the positions
+// then the normals from element n.
 template <typename T>
 struct ClassicJob {
   Backend& gpu;
   size_t n;
-  BufferId coeffs, frame, posIn, nrmIn, posOut, nrmOut;
+  BufferId coeffs, frame, vertIn, vertOut;
   std::vector<T> pos, nrm;
 
   ClassicJob(Backend& backend, size_t count) : gpu(backend), n(count) {
@@ -121,13 +122,13 @@ struct ClassicJob {
     coeffs = upload(c);
     frame = upload(f);
     makeVertices(n, pos, nrm);
-    posIn = upload(pos);
-    nrmIn = upload(nrm);
-    posOut = gpu.createBuffer(bytes());
-    nrmOut = gpu.createBuffer(bytes());
+    std::vector<T> vertices = pos;
+    vertices.insert(vertices.end(), nrm.begin(), nrm.end());
+    vertIn = upload(vertices);
+    vertOut = gpu.createBuffer(2 * bytes());
   }
   ~ClassicJob() {
-    for (BufferId b : {coeffs, frame, posIn, nrmIn, posOut, nrmOut}) gpu.destroyBuffer(b);
+    for (BufferId b : {coeffs, frame, vertIn, vertOut}) gpu.destroyBuffer(b);
   }
   uint64_t bytes() const { return 4 * n * sizeof(T); }
   BufferId upload(const std::vector<T>& v) {
@@ -137,15 +138,14 @@ struct ClassicJob {
   }
   // Dispatch over vertices [first, first+count) of the bound buffers.
   void dispatch(KernelVariant variant, uint32_t first, uint32_t count, BufferId in, BufferId out, std::string label = {}) {
-    gpu::ClassicParams params = identityParams(first, count);
+    gpu::ClassicParams params = identityParams(first, count, uint32_t(n));
     Dispatch d;
     d.kernel = "classic_ffd";
     d.variant = variant;
     d.params = &params;
     d.paramsSize = sizeof(params);
     d.buffers = {{SFFD_BINDING_LATTICE_COEFFS, coeffs}, {SFFD_BINDING_LATTICE_FRAME, frame},
-                 {SFFD_BINDING_CLASSIC_POS_IN, in},     {SFFD_BINDING_CLASSIC_NRM_IN, nrmIn},
-                 {SFFD_BINDING_CLASSIC_POS_OUT, out},   {SFFD_BINDING_CLASSIC_NRM_OUT, nrmOut}};
+                 {SFFD_BINDING_CLASSIC_IN, in}, {SFFD_BINDING_CLASSIC_OUT, out}};
     gridFor(count, gpu.info().limits, d.groups);
     d.label = label;
     gpu.dispatch(d);
@@ -158,7 +158,7 @@ struct ClassicJob {
   // Vertices [first, first+count) came out where they went in, with w = 1 (inside), and their
   // normals unchanged and unit.
   void expectIdentity(size_t first, size_t count, double tol) {
-    std::vector<T> p = download(posOut, first, count), m = download(nrmOut, first, count);
+    std::vector<T> p = download(vertOut, first, count), m = download(vertOut, n + first, count);
     for (size_t i = 0; i < count; ++i) {
       const T* in = &pos[4 * (first + i)];
       const T* nin = &nrm[4 * (first + i)];
@@ -202,7 +202,7 @@ TEST_F(VkBackendTest, PicksDeviceBySubstring) {
 template <typename T>
 void runIdentity(Backend& gpu, KernelVariant variant, double tol) {
   ClassicJob<T> job(gpu, 1000);
-  job.dispatch(variant, 0, 1000, job.posIn, job.posOut);
+  job.dispatch(variant, 0, 1000, job.vertIn, job.vertOut);
   job.expectIdentity(0, 1000, tol);
 }
 

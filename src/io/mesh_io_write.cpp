@@ -1,0 +1,347 @@
+// Mesh writers: .obj .ply .off .stl, text (numbers by std::to_chars with a fixed count of significant
+// digits) or, for .ply and .stl, binary little-endian; .gltf and .glb in gltf_write.cpp. Output is built
+// in a buffer handed to the stream in large pieces (a large mesh never sits in memory twice).
+#include <algorithm>
+#include <bit>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <ostream>
+
+#include <sffd/error.h>
+
+#include "io/atomic_file.h"
+#include "io/gltf_io.h"
+#include "io/io_util.h"
+#include "io/mesh_io_internal.h"
+
+namespace sffd {
+namespace {
+
+static_assert(std::endian::native == std::endian::little, "the binary writers copy little-endian values as they are");
+
+class ChunkedWriter {
+ public:
+  explicit ChunkedWriter(std::ostream& os) : os_(os) { buf_.reserve(kChunk + 4096); }
+  std::string& buf() { return buf_; }
+  void maybeFlush() {
+    if (buf_.size() >= kChunk) flush();
+  }
+  void flush() {
+    os_.write(buf_.data(), std::streamsize(buf_.size()));
+    buf_.clear();
+  }
+
+ private:
+  static constexpr size_t kChunk = 1 << 20;
+  std::ostream& os_;
+  std::string buf_;
+};
+
+void appendVec(std::string& s, const glm::dvec3& v, int digits) {
+  io::appendNumber(s, v.x, digits);
+  s += ' ';
+  io::appendNumber(s, v.y, digits);
+  s += ' ';
+  io::appendNumber(s, v.z, digits);
+}
+
+void appendIndex(std::string& s, uint64_t i) {
+  char b[24];
+  s.append(b, std::to_chars(b, b + sizeof b, i).ptr);
+}
+
+template <class T>
+void appendRaw(std::string& s, T v) {
+  char b[sizeof(T)];
+  std::memcpy(b, &v, sizeof(T));
+  s.append(b, sizeof(T));
+}
+
+// Binary PLY: float or double, as the digits ask (the same rule as the text header's type).
+void appendReal(std::string& s, double v, bool f64) {
+  if (f64) appendRaw(s, v);
+  else appendRaw(s, float(v));
+}
+
+uint8_t colorByte(double c) { return uint8_t(std::lround(std::clamp(c, 0.0, 1.0) * 255.0)); }
+
+struct Carried {
+  bool normals = false, texcoords = false, colors = false, alpha = false;
+};
+
+Carried checkWritable(const std::string& path, const Mesh& mesh) {
+  const size_t n = mesh.positions.size();
+  auto sized = [&](size_t count, const char* what) {
+    if (count != 0 && count != n)
+      throw Error(ErrorKind::Internal, path + ": mesh has " + std::to_string(count) + " " + what + " for " + std::to_string(n) + " vertices");
+    return count != 0;
+  };
+  Carried c;
+  c.normals = sized(mesh.normals.size(), "normals");
+  c.texcoords = sized(mesh.texcoords.size(), "texture coordinates");
+  c.colors = sized(mesh.colors.size(), "colours");
+  for (const glm::dvec4& k : mesh.colors) c.alpha = c.alpha || k.a != 1.0;
+  for (const auto& t : mesh.triangles)
+    for (uint32_t i : t)
+      if (i >= n) throw Error(ErrorKind::Internal, path + ": mesh triangle index out of range");
+  auto perTriangle = [&](const std::vector<uint32_t>& index, size_t tableSize, const char* what) {
+    if (index.empty()) return;
+    if (index.size() != mesh.triangles.size()) throw Error(ErrorKind::Internal, path + ": mesh " + what + " not one per triangle");
+    for (uint32_t i : index)
+      if (i != Mesh::kNoIndex && i >= tableSize) throw Error(ErrorKind::Internal, path + ": mesh " + what + " index out of range");
+  };
+  perTriangle(mesh.triangleMaterial, mesh.materials.size(), "materials");
+  perTriangle(mesh.triangleGroup, mesh.groups.size(), "groups");
+  // A lattice that sends points beyond the floating-point range gives inf or NaN: refuse to write a
+  // file of them, and say where (the lattice is the input at fault, so this is an input error).
+  auto finite = [](const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
+  for (size_t v = 0; v < n; ++v)
+    if (!finite(mesh.positions[v]) || (c.normals && !finite(mesh.normals[v])))
+      throw Error(ErrorKind::Input, path + ": not written: vertex " + std::to_string(v) + " of the result has a " +
+                                        (finite(mesh.positions[v]) ? "non-finite normal" : "non-finite position") +
+                                        " (the lattice moves it beyond the floating-point range of the computation)");
+  return c;
+}
+
+void writeObj(std::ostream& os, const Mesh& mesh, int digits, const Carried& has) {
+  // Positions are written once per distinct value (so a welded mesh stays welded for every OBJ reader),
+  // texture coordinates and normals once per vertex; a face corner is "position/vertex/vertex".
+  uint32_t count = 0;
+  std::vector<uint32_t> pid = meshio::distinctPositions(mesh.positions, count);
+  ChunkedWriter w(os);
+  std::string& s = w.buf();
+  s += "# sffd mesh: " + std::to_string(count) + " positions, " + std::to_string(mesh.positions.size()) + " vertices, " +
+       std::to_string(mesh.triangles.size()) + " triangles\n";
+  for (const std::string& lib : mesh.materialLibraries) s += "mtllib " + lib + "\n";
+  uint32_t next = 0;
+  for (size_t v = 0; v < mesh.positions.size(); ++v) {
+    if (pid[v] != next) continue;   // written already
+    ++next;
+    s += "v ";
+    appendVec(s, mesh.positions[v], digits);
+    if (has.colors) {   // the common "v x y z r g b" extension (MeshLab, Blender)
+      s += ' ';
+      appendVec(s, glm::dvec3(mesh.colors[v]), digits);
+    }
+    s += '\n';
+    w.maybeFlush();
+  }
+  if (has.texcoords)
+    for (const glm::dvec2& t : mesh.texcoords) {
+      s += "vt ";
+      io::appendNumber(s, t.x, digits);
+      s += ' ';
+      io::appendNumber(s, t.y, digits);
+      s += '\n';
+      w.maybeFlush();
+    }
+  if (has.normals)
+    for (const auto& nrm : mesh.normals) {
+      s += "vn ";
+      appendVec(s, nrm, digits);
+      s += '\n';
+      w.maybeFlush();
+    }
+  uint32_t group = Mesh::kNoIndex, material = Mesh::kNoIndex;
+  for (size_t f = 0; f < mesh.triangles.size(); ++f) {
+    if (!mesh.triangleGroup.empty() && mesh.triangleGroup[f] != group) {
+      group = mesh.triangleGroup[f];
+      s += "g " + (group == Mesh::kNoIndex ? std::string("default") : mesh.groups[group]) + "\n";
+    }
+    if (!mesh.triangleMaterial.empty() && mesh.triangleMaterial[f] != material && mesh.triangleMaterial[f] != Mesh::kNoIndex) {
+      material = mesh.triangleMaterial[f];
+      s += "usemtl " + mesh.materials[material].name + "\n";
+    }
+    s += 'f';
+    for (uint32_t i : mesh.triangles[f]) {
+      s += ' ';
+      appendIndex(s, pid[i] + 1);
+      if (has.texcoords || has.normals) s += '/';
+      if (has.texcoords) appendIndex(s, i + 1);
+      if (has.normals) {
+        s += '/';
+        appendIndex(s, i + 1);
+      }
+    }
+    s += '\n';
+    w.maybeFlush();
+  }
+  w.flush();
+}
+
+void writePly(std::ostream& os, const Mesh& mesh, int digits, const Carried& has, bool binary) {
+  const bool f64 = digits > 9;
+  const char* type = f64 ? "double" : "float";
+  ChunkedWriter w(os);
+  std::string& s = w.buf();
+  s += binary ? "ply\nformat binary_little_endian 1.0\n" : "ply\nformat ascii 1.0\n";
+  s += "comment written by sffd\n";
+  s += "element vertex " + std::to_string(mesh.positions.size()) + "\n";
+  auto properties = [&](std::initializer_list<const char*> names, const char* t) {
+    for (const char* c : names) s += std::string("property ") + t + " " + c + "\n";
+  };
+  properties({"x", "y", "z"}, type);
+  if (has.normals) properties({"nx", "ny", "nz"}, type);
+  if (has.texcoords) properties({"u", "v"}, type);
+  if (has.colors) properties({"red", "green", "blue"}, "uchar");
+  if (has.alpha) properties({"alpha"}, "uchar");
+  s += "element face " + std::to_string(mesh.triangles.size()) + "\n";
+  s += "property list uchar int vertex_indices\nend_header\n";
+  const int colorChannels = has.alpha ? 4 : 3;
+  for (size_t v = 0; v < mesh.positions.size(); ++v) {
+    if (binary) {
+      for (int c = 0; c < 3; ++c) appendReal(s, mesh.positions[v][c], f64);
+      if (has.normals)
+        for (int c = 0; c < 3; ++c) appendReal(s, mesh.normals[v][c], f64);
+      if (has.texcoords)
+        for (int c = 0; c < 2; ++c) appendReal(s, mesh.texcoords[v][c], f64);
+      if (has.colors)
+        for (int c = 0; c < colorChannels; ++c) appendRaw(s, colorByte(mesh.colors[v][c]));
+    } else {
+      appendVec(s, mesh.positions[v], digits);
+      if (has.normals) {
+        s += ' ';
+        appendVec(s, mesh.normals[v], digits);
+      }
+      for (int c = 0; has.texcoords && c < 2; ++c) {
+        s += ' ';
+        io::appendNumber(s, mesh.texcoords[v][c], digits);
+      }
+      for (int c = 0; has.colors && c < colorChannels; ++c) {
+        s += ' ';
+        appendIndex(s, colorByte(mesh.colors[v][c]));
+      }
+      s += '\n';
+    }
+    w.maybeFlush();
+  }
+  for (const auto& t : mesh.triangles) {
+    if (binary) {
+      appendRaw(s, uint8_t(3));
+      for (uint32_t i : t) appendRaw(s, int32_t(i));
+    } else {
+      s += '3';
+      for (uint32_t i : t) {
+        s += ' ';
+        appendIndex(s, i);
+      }
+      s += '\n';
+    }
+    w.maybeFlush();
+  }
+  w.flush();
+}
+
+void writeOff(std::ostream& os, const Mesh& mesh, int digits) {
+  // OFF holds positions only: one per distinct position, so a welded mesh stays welded.
+  uint32_t count = 0;
+  std::vector<uint32_t> pid = meshio::distinctPositions(mesh.positions, count);
+  ChunkedWriter w(os);
+  std::string& s = w.buf();
+  s += "OFF\n" + std::to_string(count) + " " + std::to_string(mesh.triangles.size()) + " 0\n";
+  uint32_t next = 0;
+  for (size_t v = 0; v < mesh.positions.size(); ++v) {
+    if (pid[v] != next) continue;
+    ++next;
+    appendVec(s, mesh.positions[v], digits);
+    s += '\n';
+    w.maybeFlush();
+  }
+  for (const auto& t : mesh.triangles) {
+    s += '3';
+    for (uint32_t i : t) {
+      s += ' ';
+      appendIndex(s, pid[i]);
+    }
+    s += '\n';
+    w.maybeFlush();
+  }
+  w.flush();
+}
+
+// The facet normal STL stores: the geometric one, or the mean vertex normal for a degenerate triangle.
+glm::dvec3 facetNormal(const Mesh& mesh, const std::array<uint32_t, 3>& t, bool withNormals) {
+  const glm::dvec3& a = mesh.positions[t[0]];
+  glm::dvec3 fn = glm::cross(mesh.positions[t[1]] - a, mesh.positions[t[2]] - a);
+  double len = glm::length(fn);
+  if (len > 0 && std::isfinite(len)) return fn / len;
+  if (!withNormals) return glm::dvec3(0.0);
+  fn = mesh.normals[t[0]] + mesh.normals[t[1]] + mesh.normals[t[2]];
+  len = glm::length(fn);
+  return (len > 0 && std::isfinite(len)) ? fn / len : glm::dvec3(0.0);
+}
+
+void writeStl(std::ostream& os, const Mesh& mesh, int digits, bool withNormals) {
+  // ASCII STL, so that coordinates keep `digits` digits.
+  ChunkedWriter w(os);
+  std::string& s = w.buf();
+  s += "solid sffd\n";
+  for (const auto& t : mesh.triangles) {
+    s += "  facet normal ";
+    appendVec(s, facetNormal(mesh, t, withNormals), digits);
+    s += "\n    outer loop\n";
+    for (uint32_t i : t) {
+      s += "      vertex ";
+      appendVec(s, mesh.positions[i], digits);
+      s += '\n';
+    }
+    s += "    endloop\n  endfacet\n";
+    w.maybeFlush();
+  }
+  s += "endsolid sffd\n";
+  w.flush();
+}
+
+void writeStlBinary(std::ostream& os, const Mesh& mesh, bool withNormals) {
+  if (mesh.triangles.size() > 0xFFFFFFFFull) throw Error(ErrorKind::Input, "binary STL holds at most 2^32 - 1 triangles");
+  ChunkedWriter w(os);
+  std::string& s = w.buf();
+  std::string header = "binary STL written by sffd";   // not "solid ...": readers would take it for text
+  header.resize(80, ' ');
+  s += header;
+  appendRaw(s, uint32_t(mesh.triangles.size()));
+  auto vec = [&](const glm::dvec3& v) {
+    for (int c = 0; c < 3; ++c) appendRaw(s, float(v[c]));
+  };
+  for (const auto& t : mesh.triangles) {
+    vec(facetNormal(mesh, t, withNormals));
+    for (uint32_t i : t) vec(mesh.positions[i]);
+    appendRaw(s, uint16_t(0));   // attribute byte count
+    w.maybeFlush();
+  }
+  w.flush();
+}
+
+}  // namespace
+
+void writeMesh(const std::string& path, const Mesh& mesh, int significantDigits) {
+  writeMesh(path, mesh, MeshWriteOptions{significantDigits, false});
+}
+
+void writeMesh(const std::string& path, const Mesh& mesh, const MeshWriteOptions& options) {
+  const std::string ext = io::lowerExtension(path);
+  const bool gltf = ext == ".gltf" || ext == ".glb";
+  if (ext != ".obj" && ext != ".ply" && ext != ".off" && ext != ".stl" && !gltf)
+    throw inputError(path, 0,
+                     "cannot write mesh format " + (ext.empty() ? std::string("(no extension)") : io::quoted(ext)) +
+                         "; expected .obj, .ply, .off, .stl, .gltf or .glb");
+  if (options.binary && ext != ".ply" && ext != ".stl")
+    throw inputError(path, 0, "binary output is for .ply and .stl (.glb is binary glTF), not " + io::quoted(ext));
+  const int digits = options.significantDigits;
+  if (digits < 1 || digits > 17) throw Error(ErrorKind::Internal, "writeMesh: significant digits must be 1..17");
+  const Carried has = checkWritable(path, mesh);
+  if (gltf) return meshio::writeGltf(path, mesh);
+  writeFileAtomically(
+      path,
+      [&](std::ostream& os) {
+        if (ext == ".obj") writeObj(os, mesh, digits, has);
+        else if (ext == ".ply") writePly(os, mesh, digits, has, options.binary);
+        else if (ext == ".off") writeOff(os, mesh, digits);
+        else if (options.binary) writeStlBinary(os, mesh, has.normals);
+        else writeStl(os, mesh, digits, has.normals);
+      },
+      true);
+}
+
+}  // namespace sffd

@@ -1,0 +1,123 @@
+// Mesh writers (mesh_io_write.cpp): binary PLY and STL, and the attributes every format keeps.
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include <sffd/error.h>
+
+#include "model/mesh.h"
+#include "tests/support/cli_runner.h"
+
+using namespace sffd;
+using sffd::test::slurp;
+using sffd::test::tempDir;
+namespace fs = std::filesystem;
+
+namespace {
+
+const std::string kData = SFFD_TEST_DATA;
+
+glm::dvec3 asFloat(const glm::dvec3& v) {
+  volatile float x = float(v.x), y = float(v.y), z = float(v.z);   // through memory: no folding at -O3
+  return {double(x), double(y), double(z)};
+}
+
+TEST(MeshWrite, BinaryPlyAndStlReadBackAsTheirText) {
+  const fs::path dir = tempDir("mesh_write_binary");
+  const Mesh teapot = readMesh(kData + "/teapot.bpt");
+  for (const char* ext : {".ply", ".stl"})
+    for (int digits : {9, 17}) {
+      SCOPED_TRACE(std::string(ext) + " " + std::to_string(digits) + " digits");
+      const std::string bin = (dir / (std::string("bin") + ext)).string(), text = (dir / (std::string("text") + ext)).string();
+      writeMesh(bin, teapot, MeshWriteOptions{.significantDigits = digits, .binary = true});
+      writeMesh(text, teapot, digits);
+      EXPECT_LT(fs::file_size(bin), fs::file_size(text));
+      const Mesh b = readMesh(bin), t = readMesh(text);
+      ASSERT_EQ(b.triangles.size(), teapot.triangles.size());
+      // PLY keeps the vertices (float, or double with 17 digits); STL welds them back by position.
+      const bool exact = std::string(ext) == ".ply" && digits == 17;
+      for (size_t f = 0; f < teapot.triangles.size(); ++f)
+        for (int c = 0; c < 3; ++c) {
+          const glm::dvec3 want = teapot.positions[teapot.triangles[f][c]];
+          ASSERT_EQ(b.positions[b.triangles[f][c]], exact ? want : asFloat(want)) << "triangle " << f;
+          const glm::dvec3 fromText = t.positions[t.triangles[f][c]];
+          ASSERT_EQ(b.positions[b.triangles[f][c]], exact ? fromText : asFloat(fromText)) << "triangle " << f;
+        }
+      if (std::string(ext) == ".ply") {
+        // (float normals are normalised again on reading: equal to float resolution)
+        for (size_t v = 0; v < b.normals.size(); ++v) ASSERT_LE(glm::length(b.normals[v] - t.normals[v]), exact ? 0.0 : 1e-7);
+        EXPECT_TRUE(b.normalsFromFile);
+      }
+    }
+  // The binary STL header does not start with "solid" (readers would try it as text).
+  EXPECT_NE(slurp(dir / "bin.stl").rfind("solid", 0), 0u);
+  fs::remove_all(dir);
+}
+
+TEST(MeshWrite, BinaryIsRefusedForTextFormats) {
+  const fs::path dir = tempDir("mesh_write_refused");
+  const Mesh cube = readMesh(kData + "/cube.obj");
+  for (const char* name : {"x.obj", "x.off"}) {
+    const std::string p = (dir / name).string();
+    try {
+      writeMesh(p, cube, MeshWriteOptions{.binary = true});
+      ADD_FAILURE() << name << " written in binary";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.kind(), ErrorKind::Input);
+      EXPECT_NE(std::string(e.what()).find("binary output is for .ply and .stl"), std::string::npos) << e.what();
+    }
+    EXPECT_FALSE(fs::exists(p));
+  }
+  fs::remove_all(dir);
+}
+
+// Attributes survive OBJ and PLY (text and binary) round trips; PLY colours are bytes.
+TEST(MeshWrite, AttributesRoundTrip) {
+  const fs::path dir = tempDir("mesh_write_attributes");
+  {
+    std::ofstream(dir / "lib.mtl") << "newmtl red\nKd 1 0 0\nd 0.5\nmap_Kd -s 1 1 1 bricks.png\nnewmtl unused\nKd 0 1 0\n";
+    std::ofstream(dir / "in.obj") << "mtllib lib.mtl\nv 0 0 0 1 0 0\nv 1 0 0 0 1 0\nv 0 1 0 0 0 1\nv 1 1 0 1 1 1\n"
+                                     "vt 0 0\nvt 1 0\nvt 0 1\nvt 1 1\nvt 0.5 0.5\n"
+                                     "g a\nusemtl red\nf 1/1 2/2 3/3\ng b\nusemtl blue\nf 2/5 4/4 3/3\n";
+  }
+  const Mesh m = readMesh((dir / "in.obj").string());
+  ASSERT_EQ(m.positions.size(), 5u);   // position 2 with two texture coordinates: two vertices
+  EXPECT_EQ(m.texcoords[4], glm::dvec2(0.5, 0.5));
+  EXPECT_EQ(m.colors[1], glm::dvec4(0, 1, 0, 1));
+  EXPECT_EQ(m.triangleMaterial, (std::vector<uint32_t>{0, 1}));
+  EXPECT_EQ(m.triangleGroup, (std::vector<uint32_t>{0, 1}));
+  ASSERT_EQ(m.materials.size(), 2u);
+  EXPECT_EQ(m.materials[0].baseColor, glm::dvec4(1, 0, 0, 0.5));
+  EXPECT_EQ(m.materials[0].baseColorTexture, "bricks.png");
+  EXPECT_EQ(m.materials[1].baseColor, glm::dvec4(1.0));   // not in the library
+  for (const char* name : {"out.obj", "out.ply", "bin.ply"}) {
+    SCOPED_TRACE(name);
+    const std::string p = (dir / name).string();
+    writeMesh(p, m, MeshWriteOptions{.significantDigits = 17, .binary = std::string(name) == "bin.ply"});
+    const Mesh r = readMesh(p);
+    ASSERT_EQ(r.triangles.size(), 2u);
+    for (size_t f = 0; f < 2; ++f)
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_EQ(r.texcoords[r.triangles[f][c]], m.texcoords[m.triangles[f][c]]);
+        EXPECT_EQ(r.colors[r.triangles[f][c]], m.colors[m.triangles[f][c]]);
+      }
+    if (std::string(name) == "out.obj") {
+      EXPECT_EQ(r.triangleMaterial, m.triangleMaterial);
+      EXPECT_EQ(r.triangleGroup, m.triangleGroup);
+      EXPECT_EQ(r.groups, m.groups);
+      EXPECT_EQ(r.materialLibraries, m.materialLibraries);
+      EXPECT_EQ(r.materials[0].baseColorTexture, "bricks.png");   // lib.mtl is beside out.obj too
+    }
+  }
+  // PLY's other names for texture coordinates, and float colours.
+  std::ofstream(dir / "st.ply") << "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                                   "property float s\nproperty float t\nproperty float red\nproperty float green\nproperty float blue\n"
+                                   "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                                   "0 0 0 0.25 0.5 1 0.5 0\n1 0 0 1 0 0 0 0\n0 1 0 0 1 0 0 0\n3 0 1 2\n";
+  const Mesh st = readMesh((dir / "st.ply").string());
+  EXPECT_EQ(st.texcoords[0], glm::dvec2(0.25, 0.5));
+  EXPECT_EQ(st.colors[0], glm::dvec4(1, 0.5, 0, 1));
+  fs::remove_all(dir);
+}
+
+}  // namespace

@@ -1,0 +1,185 @@
+// End-to-end: the file formats users exchange (docs/CLI.md "Mesh files"): binary output, attributes
+// kept through every method, glTF written for Khronos' validator and read from an outside converter.
+// The npm packages (gltf-validator, obj2gltf) are installed at test time into the build tree.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+
+#include "model/mesh.h"
+#include "support/cli_runner.h"
+
+namespace sffd::test {
+namespace {
+
+const std::string kData = SFFD_TEST_DATA;
+const fs::path kNpm = fs::path(SFFD_BINARY).parent_path() / "npm";
+
+// The npm packages in build/npm (installed once, under a lock: ctest runs tests in parallel); false
+// when npm or its registry cannot be reached.
+bool npmPackages() {
+  if (fs::exists(kNpm / "node_modules/gltf-validator") && fs::exists(kNpm / "node_modules/.bin/obj2gltf")) return true;
+  fs::create_directories(kNpm);
+  const std::string cmd = "flock " + (kNpm / "lock").string() + " npm install --no-audit --no-fund --prefix " + kNpm.string() +
+                          " gltf-validator obj2gltf >" + (kNpm / "install.log").string() + " 2>&1";
+  return std::system(cmd.c_str()) == 0 && fs::exists(kNpm / "node_modules/gltf-validator");
+}
+
+// Khronos' glTF-Validator on `files`: its output, and whether every file had no error.
+std::pair<bool, std::string> validateGltf(const std::vector<fs::path>& files) {
+  std::string cmd = "NODE_PATH=" + (kNpm / "node_modules").string() + " node " + SFFD_SOURCE_DIR + "/tests/tools/gltf_validate.js";
+  for (const fs::path& f : files) cmd += " " + f.string();
+  const fs::path log = kNpm / ("validate_" + std::to_string(::getpid()) + ".log");
+  const int raw = std::system((cmd + " >" + log.string() + " 2>&1").c_str());
+  return {WIFEXITED(raw) && WEXITSTATUS(raw) == 0, slurp(log)};
+}
+
+// Texture coordinates at each triangle corner, to float resolution (glTF stores floats).
+void expectSameCornerTexcoords(const Mesh& a, const Mesh& b) {
+  ASSERT_EQ(a.triangles.size(), b.triangles.size());
+  ASSERT_FALSE(a.texcoords.empty());
+  ASSERT_FALSE(b.texcoords.empty());
+  for (size_t f = 0; f < a.triangles.size(); ++f)
+    for (int c = 0; c < 3; ++c) ASSERT_LE(glm::length(a.texcoords[a.triangles[f][c]] - b.texcoords[b.triangles[f][c]]), 1e-7) << f;
+}
+const std::string kSphere = kData + "/sphere.obj -l " + kData + "/lattices/sphere_twist.npy --normalize 0.99 --backend cpu --quiet";
+
+TEST(Formats, BinaryOutputEqualsText) {
+  const fs::path dir = tempDir("formats_binary");
+  for (const char* method : {"classic", "smooth"})
+    for (const char* ext : {".ply", ".stl"}) {
+      SCOPED_TRACE(std::string(method) + ext);
+      const std::string bin = (dir / (std::string("b") + ext)).string(), text = (dir / (std::string("t") + ext)).string();
+      const std::string base = "deform " + kSphere + " --method " + method + " --precision float --edge-length 0.3 -o ";
+      ASSERT_EQ(runSffd(base + bin + " --binary").status, 0);
+      ASSERT_EQ(runSffd(base + text).status, 0);
+      // Binary holds floats, text 9 digits: the same values to float resolution (the model is in [-1, 1]).
+      const Mesh b = readMesh(bin), t = readMesh(text);
+      ASSERT_EQ(b.triangles.size(), t.triangles.size());
+      for (size_t f = 0; f < b.triangles.size(); ++f)
+        for (int c = 0; c < 3; ++c) ASSERT_LE(glm::length(b.positions[b.triangles[f][c]] - t.positions[t.triangles[f][c]]), 1.2e-7);
+    }
+  const RunResult r = runSffd("deform " + kSphere + " --method classic -o " + (dir / "x.obj").string() + " --binary");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.err, "sffd: error: --binary writes .ply and .stl, not '.obj'\n");
+  EXPECT_FALSE(fs::exists(dir / "x.obj"));
+  fs::remove_all(dir);
+}
+
+TEST(Formats, ObjKeepsTexcoordsThroughEveryMethod) {
+  const fs::path dir = tempDir("formats_obj");
+  const Mesh input = readMesh(kData + "/sphere.obj");
+  ASSERT_FALSE(input.texcoords.empty());
+  for (const char* method : {"classic", "smooth", "accurate"}) {
+    const fs::path out = dir / (std::string(method) + ".obj");
+    ASSERT_EQ(runSffd("deform " + kSphere + " --method " + method + " --edge-length 0.3 --tess 4 -o " + out.string()).status, 0);
+    const Mesh r = readMesh(out.string());
+    ASSERT_EQ(r.texcoords.size(), r.positions.size()) << method;
+    // Classic: the same vertices with the same texture coordinates (17 digits: exact).
+    if (std::string(method) == "classic") EXPECT_EQ(r.texcoords, input.texcoords);
+  }
+  fs::remove_all(dir);
+}
+
+TEST(Formats, GltfOutputValidatesAndKeepsTexcoords) {
+  if (!npmPackages()) GTEST_SKIP() << "npm cannot install gltf-validator (no registry?): see " << (kNpm / "install.log");
+  const fs::path dir = tempDir("formats_gltf");
+  std::vector<fs::path> written;
+  for (const char* method : {"classic", "smooth", "accurate"})
+    for (const char* ext : {".glb", ".gltf"}) {
+      const fs::path out = dir / (std::string(method) + ext);
+      const RunResult r = runSffd("deform " + kSphere + " --method " + method + " --edge-length 0.3 --tess 4 -o " + out.string());
+      ASSERT_EQ(r.status, 0) << r.err;
+      written.push_back(out);
+      // What the same run writes as OBJ, read back: the same corners' texture coordinates.
+      const fs::path obj = dir / (std::string(method) + ext + ".obj");
+      ASSERT_EQ(runSffd("deform " + kSphere + " --method " + method + " --edge-length 0.3 --tess 4 -o " + obj.string()).status, 0);
+      expectSameCornerTexcoords(readMesh(obj.string()), readMesh(out.string()));
+    }
+  EXPECT_TRUE(fs::exists(dir / "smooth.bin"));
+  const auto [ok, report] = validateGltf(written);
+  EXPECT_TRUE(ok) << report;
+  fs::remove_all(dir);
+}
+
+TEST(Formats, GlbFromObj2gltfIsReadAndDeformed) {
+  if (!npmPackages()) GTEST_SKIP() << "npm cannot install obj2gltf (no registry?): see " << (kNpm / "install.log");
+  const fs::path dir = tempDir("formats_obj2gltf");
+  const fs::path glb = dir / "sphere.glb";
+  ASSERT_EQ(std::system(((kNpm / "node_modules/.bin/obj2gltf").string() + " -i " + kData + "/sphere.obj -o " + glb.string() + " >/dev/null 2>&1").c_str()), 0);
+  const Mesh converted = readMesh(glb.string()), original = readMesh(kData + "/sphere.obj");
+  expectSameCornerTexcoords(original, converted);   // obj2gltf keeps the OBJ's triangles and flips v; the reader flips back
+  const fs::path out = dir / "deformed.glb";
+  const std::string lattice = kData + "/lattices/sphere_twist.npy --normalize 0.99 --backend cpu --quiet";
+  ASSERT_EQ(runSffd("deform " + glb.string() + " -l " + lattice + " --method smooth --edge-length 0.3 --tess 4 -o " + out.string()).status, 0);
+  EXPECT_FALSE(readMesh(out.string()).texcoords.empty());
+  const auto [ok, report] = validateGltf({out});
+  EXPECT_TRUE(ok) << report;
+  fs::remove_all(dir);
+}
+
+TEST(Formats, BadGltfIsOneErrorLine) {
+  const fs::path dir = tempDir("formats_bad_gltf");
+  const std::pair<const char*, const char*> cases[] = {
+      {"truncated.gltf", "{\"asset\": {\"version\": \"2.0\"}"},
+      {"noscene.gltf", "{\"asset\": {\"version\": \"2.0\"}}"},
+      {"badglb.glb", "glTF\x02\x00\x00\x00\xff\xff\x00\x00"},
+      {"outside.gltf", "{\"asset\": {\"version\": \"2.0\"}, \"scenes\": [{\"nodes\": [0]}], \"nodes\": [{\"mesh\": 0}],"
+                       "\"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0}}]}],"
+                       "\"accessors\": [{\"bufferView\": 0, \"componentType\": 5126, \"count\": 3, \"type\": \"VEC3\"}],"
+                       "\"bufferViews\": [{\"buffer\": 0, \"byteLength\": 36}],"
+                       "\"buffers\": [{\"byteLength\": 12, \"uri\": \"data:application/octet-stream;base64,AAAAAAAAAAAAAAAA\"}]}"}};
+  for (const auto& [name, text] : cases) {
+    std::ofstream(dir / name) << text;
+    const RunResult r = runSffd("deform " + (dir / name).string() + " -l " + kData + "/lattices/sphere_twist.npy -o " + (dir / "x.obj").string());
+    EXPECT_EQ(r.status, 2) << name << ": " << r.err;
+    EXPECT_EQ(r.err.rfind("sffd: error: " + (dir / name).string() + ": ", 0), 0u) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_FALSE(fs::exists(dir / "x.obj"));
+  }
+  fs::remove_all(dir);
+}
+
+// Frames of `sffd animate` are separate `sffd deform` runs of the interpolated lattices, byte for byte.
+TEST(Formats, AnimateFramesEqualSeparateDeforms) {
+  const fs::path dir = tempDir("formats_animate");
+  const std::string mesh = kData + "/sphere.obj";
+  for (const auto& [name, preset] : {std::pair{"ident", ""}, {"twist", " --preset twist:0.8"}, {"bend", " --preset bend:1.0"}})
+    ASSERT_EQ(runSffd("lattice " + mesh + " --quiet -o " + (dir / (std::string(name) + ".json")).string() + preset).status, 0);
+  const std::string keys = " -l " + (dir / "ident.json").string() + " -l " + (dir / "twist.json").string() + " -l " + (dir / "bend.json").string();
+  const std::string options = " --backend cpu --quiet --edge-length 0.3 --tess 4 --precision float";
+  // 5 frames over 3 keys: the keys at frames 0, 2, 4, their midpoints at 1 and 3.
+  ASSERT_EQ(runSffd("animate " + mesh + keys + " --frames 5 -o " + (dir / "f_%d.ply").string() + options).status, 0);
+  auto controlPoints = [&](const char* name) { return nlohmann::json::parse(slurp(dir / name))["control_points"]; };
+  const nlohmann::json lattices[3] = {controlPoints("ident.json"), controlPoints("twist.json"), controlPoints("bend.json")};
+  for (int f = 0; f < 5; ++f) {
+    nlohmann::json L = nlohmann::json::parse(slurp(dir / "ident.json"));
+    const nlohmann::json &a = lattices[f / 2], &b = lattices[std::min(f / 2 + 1, 2)];
+    for (size_t i = 0; i < L["control_points"].size(); ++i)
+      for (int c = 0; c < 3; ++c)
+        L["control_points"][i][c] = f % 2 ? 0.5 * a[i][c].get<double>() + 0.5 * b[i][c].get<double>() : a[i][c].get<double>();
+    std::ofstream(dir / "frame.json") << L.dump();
+    ASSERT_EQ(runSffd("deform " + mesh + " -l " + (dir / "frame.json").string() + " -o " + (dir / "frame.ply").string() + options).status, 0);
+    EXPECT_EQ(slurp(dir / ("f_" + std::to_string(f) + ".ply")), slurp(dir / "frame.ply")) << "frame " << f;
+  }
+  // As glTF: morph targets and an animation that Khronos' validator accepts; mixed structures refused.
+  ASSERT_EQ(runSffd("animate " + mesh + keys + " --frames 5 --fps 10 -o " + (dir / "anim.glb").string() + options).status, 0);
+  const Mesh first = readMesh((dir / "anim.glb").string()), frame0 = readMesh((dir / "f_0.ply").string());
+  EXPECT_EQ(first.triangles.size(), frame0.triangles.size());
+  ASSERT_EQ(runSffd("lattice " + mesh + " --quiet --counts 4,4,4 -o " + (dir / "other.json").string()).status, 0);
+  const RunResult r = runSffd("animate " + mesh + " -l " + (dir / "ident.json").string() + " -l " + (dir / "other.json").string() +
+                              " --frames 3 -o " + (dir / "x.glb").string() + options);
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("differ from"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "x.glb"));
+  if (npmPackages()) {
+    const auto [ok, report] = validateGltf({dir / "anim.glb"});
+    EXPECT_TRUE(ok) << report;
+  }
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace sffd::test

@@ -1,0 +1,53 @@
+// sffd on the gles backend as a user runs it: held to the OpenGL ES 3.1 minimum limits by default,
+// classic FFD runs there (its kernel fits 4 storage blocks) and gives the CPU reference's bytes in
+// strict mode; the kernels still past the minimum are refused with the limit named (exit 3) and run
+// with SFFD_GLES_LIMITS=device; double precision is a usage error (exit 2). docs/GLES.md.
+#include <gtest/gtest.h>
+
+#include "tests/support/cli_runner.h"
+
+namespace sffd::test {
+namespace {
+
+class Gles : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (runSffd("devices").out.find("gles ") == std::string::npos) GTEST_SKIP() << "no gles device here";
+    dir = tempDir("gles");
+    mesh = std::string(SFFD_TEST_DATA) + "/sphere.obj";
+    lattice = std::string(SFFD_TEST_DATA) + "/lattices/sphere_twist.npy";
+  }
+  void TearDown() override { fs::remove_all(dir); }
+  RunResult deform(const std::string& options, const std::string& out, const std::string& env = "") {
+    return runSffd("deform " + mesh + " -l " + lattice + " " + options + " -o " + (dir / out).string() + " --quiet", env);
+  }
+  fs::path dir;
+  std::string mesh, lattice;
+};
+
+TEST_F(Gles, ClassicRunsWithinTheMinimumLimitsToTheCpuBytes) {
+  ASSERT_EQ(deform("--method classic --strict --precision float --backend gles", "gles.obj").status, 0);
+  ASSERT_EQ(deform("--method classic --strict --precision float --backend cpu", "cpu.obj").status, 0);
+  EXPECT_EQ(slurp(dir / "gles.obj"), slurp(dir / "cpu.obj"));
+}
+
+TEST_F(Gles, KernelsPastTheMinimumAreRefusedUnlessTheDevicesLimitsAreAsked) {
+  RunResult held = deform("--method smooth --strict --backend gles", "held.obj");
+  EXPECT_EQ(held.status, 3) << held.err;
+  EXPECT_NE(held.err.find("OpenGL ES 3.1 guarantees 4"), std::string::npos) << held.err;
+  EXPECT_NE(held.err.find("SFFD_GLES_LIMITS=device"), std::string::npos) << held.err;
+  EXPECT_FALSE(fs::exists(dir / "held.obj"));
+  ASSERT_EQ(deform("--method smooth --strict --backend gles", "own.obj", "SFFD_GLES_LIMITS=device").status, 0);
+  ASSERT_EQ(deform("--method smooth --strict --backend cpu", "cpu.obj").status, 0);
+  EXPECT_EQ(slurp(dir / "own.obj"), slurp(dir / "cpu.obj"));
+}
+
+TEST_F(Gles, DoublePrecisionIsAUsageError) {
+  RunResult r = deform("--method classic --precision double --backend gles", "d.obj");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("OpenGL ES has no double precision"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "d.obj"));
+}
+
+}  // namespace
+}  // namespace sffd::test
