@@ -120,8 +120,10 @@ class Reader {
     if (a.sparse.isSparse) throw inputError(path_, 0, where + ": sparse accessors are not supported");
     if (tinygltf::GetNumComponentsInType(uint32_t(a.type)) != components)
       throw inputError(path_, 0, where + ": expected " + std::to_string(components) + " components");
-    std::vector<double> out(a.count * size_t(components), 0.0);
-    if (a.bufferView < 0) return out;   // all zeros, as the specification says
+    if (a.bufferView < 0) {   // all zeros, as the specification says
+      if (a.count > kMaxVertices) throw inputError(path_, 0, where + ": too many elements");
+      return std::vector<double>(a.count * size_t(components), 0.0);
+    }
     if (size_t(a.bufferView) >= m_.bufferViews.size()) throw inputError(path_, 0, where + ": no such buffer view");
     const tinygltf::BufferView& v = m_.bufferViews[size_t(a.bufferView)];
     if (v.buffer < 0 || size_t(v.buffer) >= m_.buffers.size()) throw inputError(path_, 0, where + ": no such buffer");
@@ -131,8 +133,13 @@ class Reader {
     const size_t element = size_t(componentBytes) * size_t(components);
     const size_t stride = v.byteStride ? v.byteStride : element;
     const size_t first = v.byteOffset + a.byteOffset;
-    if (v.byteOffset + v.byteLength > buffer.size() || (a.count > 0 && (first + (a.count - 1) * stride + element > v.byteOffset + v.byteLength)))
-      throw inputError(path_, 0, where + ": reaches beyond its buffer");
+    // Every size is checked against the buffer's before it is multiplied: no overflow, no allocation
+    // beyond what the file holds.
+    const bool fits = v.byteOffset <= buffer.size() && v.byteLength <= buffer.size() - v.byteOffset && a.byteOffset <= v.byteLength &&
+                      stride <= buffer.size() && a.count <= buffer.size() &&
+                      (a.count == 0 || (a.count - 1) * stride + element <= v.byteLength - a.byteOffset);
+    if (!fits) throw inputError(path_, 0, where + ": reaches beyond its buffer");
+    std::vector<double> out(a.count * size_t(components), 0.0);
     for (size_t i = 0; i < a.count; ++i)
       for (int c = 0; c < components; ++c) {
         const unsigned char* b = buffer.data() + first + i * stride + size_t(c * componentBytes);
