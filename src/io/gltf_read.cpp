@@ -86,9 +86,25 @@ class Reader {
     const int t = gm.pbrMetallicRoughness.baseColorTexture.index;
     if (t >= 0 && size_t(t) < m_.textures.size()) {
       const int source = m_.textures[size_t(t)].source;
-      if (source >= 0 && size_t(source) < m_.images.size()) mat.baseColorTexture = m_.images[size_t(source)].uri;
+      if (source >= 0 && size_t(source) < m_.images.size()) {
+        const tinygltf::Image& image = m_.images[size_t(source)];
+        mat.baseColorTexture = image.uri;
+        if (image.uri.empty() && image.bufferView >= 0) {
+          mat.baseColorImage = bytesOfView(image.bufferView, "image");
+          mat.baseColorImageMime = image.mimeType;
+        }
+      }
     }
     return mat;
+  }
+
+  std::vector<uint8_t> bytesOfView(int index, const char* what) const {
+    if (index < 0 || size_t(index) >= m_.bufferViews.size()) throw inputError(path_, 0, std::string(what) + ": no such buffer view");
+    const tinygltf::BufferView& v = m_.bufferViews[size_t(index)];
+    if (v.buffer < 0 || size_t(v.buffer) >= m_.buffers.size()) throw inputError(path_, 0, std::string(what) + ": no such buffer");
+    const std::vector<unsigned char>& b = m_.buffers[size_t(v.buffer)].data;
+    if (v.byteOffset > b.size() || v.byteLength > b.size() - v.byteOffset) throw inputError(path_, 0, std::string(what) + ": reaches beyond its buffer");
+    return std::vector<uint8_t>(b.begin() + ptrdiff_t(v.byteOffset), b.begin() + ptrdiff_t(v.byteOffset + v.byteLength));
   }
 
   glm::dmat4 localMatrix(const tinygltf::Node& n) const {
