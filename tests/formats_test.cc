@@ -107,14 +107,28 @@ TEST(Formats, GltfOutputValidatesAndKeepsTexcoords) {
 TEST(Formats, GlbFromObj2gltfIsReadAndDeformed) {
   if (!npmPackages()) GTEST_SKIP() << "npm cannot install obj2gltf (no registry?): see " << (kNpm / "install.log");
   const fs::path dir = tempDir("formats_obj2gltf");
+  // The test sphere with a material whose texture is a 2 x 2 PNG: obj2gltf embeds the image in the .glb.
+  {
+    std::ofstream(dir / "sphere.obj") << "mtllib sphere.mtl\nusemtl painted\n" << slurp(kData + "/sphere.obj");
+    std::ofstream(dir / "sphere.mtl") << "newmtl painted\nKd 1 1 1\nmap_Kd paint.png\n";
+    std::ofstream(dir / "paint.png", std::ios::binary)
+        << std::string("\x89\x50\x4e\x47\x0d\x0a\x1a\x0a\x00\x00\x00\x0d\x49\x48\x44\x52\x00\x00\x00\x02\x00\x00\x00\x02\x08\x02\x00"
+                       "\x00\x00\xfd\xd4\x9a\x73\x00\x00\x00\x10\x49\x44\x41\x54\x78\x9c\x63\x38\x91\x62\x04\x44\x0c\x10\x0a\x00"
+                       "\x28\xae\x05\x79\x42\xe1\x27\xee\x00\x00\x00\x00\x49\x45\x4e\x44\xae\x42\x60\x82", 73);
+  }
   const fs::path glb = dir / "sphere.glb";
-  ASSERT_EQ(std::system(((kNpm / "node_modules/.bin/obj2gltf").string() + " -i " + kData + "/sphere.obj -o " + glb.string() + " >/dev/null 2>&1").c_str()), 0);
+  ASSERT_EQ(std::system(((kNpm / "node_modules/.bin/obj2gltf").string() + " -i " + (dir / "sphere.obj").string() + " -o " + glb.string() + " >/dev/null 2>&1").c_str()), 0);
   const Mesh converted = readMesh(glb.string()), original = readMesh(kData + "/sphere.obj");
   expectSameCornerTexcoords(original, converted);   // obj2gltf keeps the OBJ's triangles and flips v; the reader flips back
   const fs::path out = dir / "deformed.glb";
   const std::string lattice = kData + "/lattices/sphere_twist.npy --normalize 0.99 --backend cpu --quiet";
   ASSERT_EQ(runSffd("deform " + glb.string() + " -l " + lattice + " --method smooth --edge-length 0.3 --tess 4 -o " + out.string()).status, 0);
-  EXPECT_FALSE(readMesh(out.string()).texcoords.empty());
+  const Mesh deformed = readMesh(out.string());
+  EXPECT_FALSE(deformed.texcoords.empty());
+  // The embedded texture is passed through: the same PNG bytes in the output.
+  ASSERT_EQ(deformed.materials.size(), 1u);
+  EXPECT_EQ(deformed.materials[0].baseColorImageMime, "image/png");
+  EXPECT_EQ(std::string(deformed.materials[0].baseColorImage.begin(), deformed.materials[0].baseColorImage.end()), slurp(dir / "paint.png"));
   const auto [ok, report] = validateGltf({out});
   EXPECT_TRUE(ok) << report;
   fs::remove_all(dir);

@@ -91,9 +91,9 @@ int run(const ParsedArgs& args) {
 
 CommandSpec deformCommand() {
   CommandSpec c{"deform", "MESH -l LATTICE -o OUT [options]",
-                "Deforms a mesh by a lattice and writes the result (.obj .ply .off .stl) with vertex normals.",
+                "Deforms a mesh by a lattice and writes the result (.obj .ply .off .stl .gltf .glb) with vertex normals.",
                 jobOptions(), run, 1, 1};
-  c.options.insert(c.options.begin() + 1, {"--output|-o", "FILE", "output mesh (.obj .ply .off .stl)"});
+  c.options.insert(c.options.begin() + 1, {"--output|-o", "FILE", "output mesh (.obj .ply .off .stl .gltf .glb)"});
   c.options.insert(c.options.begin() + 2, {"--binary", nullptr, ".ply and .stl: write binary (little-endian float; double PLY with --precision double)"});
   c.options.insert(c.options.begin() + 3, {"--patches", "FILE", "smooth: also write the Bezier patches (docs/CLI.md)"});
   return c;

@@ -26,6 +26,10 @@ struct Material {
   std::string name;
   glm::dvec4 baseColor{1.0, 1.0, 1.0, 1.0};   // linear RGBA factor (glTF baseColorFactor, OBJ Kd with alpha 1)
   std::string baseColorTexture;               // image URI relative to the mesh file; empty: none
+  // An image the file embeds instead (a .glb's buffer view): its bytes and MIME type, written back
+  // embedded by the glTF writer; empty: none.
+  std::vector<uint8_t> baseColorImage;
+  std::string baseColorImageMime;
 };
 
 struct Mesh {

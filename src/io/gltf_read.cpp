@@ -86,9 +86,25 @@ class Reader {
     const int t = gm.pbrMetallicRoughness.baseColorTexture.index;
     if (t >= 0 && size_t(t) < m_.textures.size()) {
       const int source = m_.textures[size_t(t)].source;
-      if (source >= 0 && size_t(source) < m_.images.size()) mat.baseColorTexture = m_.images[size_t(source)].uri;
+      if (source >= 0 && size_t(source) < m_.images.size()) {
+        const tinygltf::Image& image = m_.images[size_t(source)];
+        mat.baseColorTexture = image.uri;
+        if (image.uri.empty() && image.bufferView >= 0) {
+          mat.baseColorImage = bytesOfView(image.bufferView, "image");
+          mat.baseColorImageMime = image.mimeType;
+        }
+      }
     }
     return mat;
+  }
+
+  std::vector<uint8_t> bytesOfView(int index, const char* what) const {
+    if (index < 0 || size_t(index) >= m_.bufferViews.size()) throw inputError(path_, 0, std::string(what) + ": no such buffer view");
+    const tinygltf::BufferView& v = m_.bufferViews[size_t(index)];
+    if (v.buffer < 0 || size_t(v.buffer) >= m_.buffers.size()) throw inputError(path_, 0, std::string(what) + ": no such buffer");
+    const std::vector<unsigned char>& b = m_.buffers[size_t(v.buffer)].data;
+    if (v.byteOffset > b.size() || v.byteLength > b.size() - v.byteOffset) throw inputError(path_, 0, std::string(what) + ": reaches beyond its buffer");
+    return std::vector<uint8_t>(b.begin() + ptrdiff_t(v.byteOffset), b.begin() + ptrdiff_t(v.byteOffset + v.byteLength));
   }
 
   glm::dmat4 localMatrix(const tinygltf::Node& n) const {
@@ -120,8 +136,10 @@ class Reader {
     if (a.sparse.isSparse) throw inputError(path_, 0, where + ": sparse accessors are not supported");
     if (tinygltf::GetNumComponentsInType(uint32_t(a.type)) != components)
       throw inputError(path_, 0, where + ": expected " + std::to_string(components) + " components");
-    std::vector<double> out(a.count * size_t(components), 0.0);
-    if (a.bufferView < 0) return out;   // all zeros, as the specification says
+    if (a.bufferView < 0) {   // all zeros, as the specification says
+      if (a.count > kMaxVertices) throw inputError(path_, 0, where + ": too many elements");
+      return std::vector<double>(a.count * size_t(components), 0.0);
+    }
     if (size_t(a.bufferView) >= m_.bufferViews.size()) throw inputError(path_, 0, where + ": no such buffer view");
     const tinygltf::BufferView& v = m_.bufferViews[size_t(a.bufferView)];
     if (v.buffer < 0 || size_t(v.buffer) >= m_.buffers.size()) throw inputError(path_, 0, where + ": no such buffer");
@@ -131,8 +149,13 @@ class Reader {
     const size_t element = size_t(componentBytes) * size_t(components);
     const size_t stride = v.byteStride ? v.byteStride : element;
     const size_t first = v.byteOffset + a.byteOffset;
-    if (v.byteOffset + v.byteLength > buffer.size() || (a.count > 0 && (first + (a.count - 1) * stride + element > v.byteOffset + v.byteLength)))
-      throw inputError(path_, 0, where + ": reaches beyond its buffer");
+    // Every size is checked against the buffer's before it is multiplied: no overflow, no allocation
+    // beyond what the file holds.
+    const bool fits = v.byteOffset <= buffer.size() && v.byteLength <= buffer.size() - v.byteOffset && a.byteOffset <= v.byteLength &&
+                      stride <= buffer.size() && a.count <= buffer.size() &&
+                      (a.count == 0 || (a.count - 1) * stride + element <= v.byteLength - a.byteOffset);
+    if (!fits) throw inputError(path_, 0, where + ": reaches beyond its buffer");
+    std::vector<double> out(a.count * size_t(components), 0.0);
     for (size_t i = 0; i < a.count; ++i)
       for (int c = 0; c < components; ++c) {
         const unsigned char* b = buffer.data() + first + i * stride + size_t(c * componentBytes);

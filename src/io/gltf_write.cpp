@@ -64,12 +64,19 @@ struct Builder {
 
 double unit(double x) { return std::clamp(x, 0.0, 1.0); }
 
-nlohmann::ordered_json materialsOf(const Mesh& mesh, nlohmann::ordered_json& gltf) {
+// Materials, with their images by URI or embedded (in `b`'s buffer) as they were read.
+nlohmann::ordered_json materialsOf(const Mesh& mesh, nlohmann::ordered_json& gltf, Builder& b) {
   nlohmann::ordered_json materials = nlohmann::ordered_json::array();
   for (const Material& m : mesh.materials) {
     nlohmann::ordered_json pbr = {{"baseColorFactor", {unit(m.baseColor.r), unit(m.baseColor.g), unit(m.baseColor.b), unit(m.baseColor.a)}}};
-    if (!m.baseColorTexture.empty()) {
-      gltf["images"].push_back({{"uri", m.baseColorTexture}});
+    const bool embedded = !m.baseColorImage.empty() && !m.baseColorImageMime.empty();
+    if (!m.baseColorTexture.empty() || embedded) {
+      nlohmann::ordered_json image = {{"uri", m.baseColorTexture}};
+      if (embedded) {
+        image = {{"bufferView", b.view(m.baseColorImage.data(), m.baseColorImage.size(), 0)}, {"mimeType", m.baseColorImageMime}};
+        b.views.back().erase("target");
+      }
+      gltf["images"].push_back(image);
       gltf["textures"].push_back({{"source", gltf["images"].size() - 1}});
       pbr["baseColorTexture"] = {{"index", gltf["textures"].size() - 1}};
     }
@@ -151,7 +158,7 @@ void writeGltfAnimation(const std::string& path, const std::vector<Mesh>& frames
                            {"samplers", {{{"input", input}, {"output", output}, {"interpolation", "LINEAR"}}}},
                            {"channels", {{{"sampler", 0}, {"target", {{"node", 0}, {"path", "weights"}}}}}}}};
   }
-  if (!mesh.materials.empty()) gltf["materials"] = materialsOf(mesh, gltf);
+  if (!mesh.materials.empty()) gltf["materials"] = materialsOf(mesh, gltf, b);
   const std::string binName = std::filesystem::path(path).stem().string() + ".bin";
   nlohmann::ordered_json buffer = {{"byteLength", b.bin.size()}};
   if (!glb) buffer["uri"] = binName;

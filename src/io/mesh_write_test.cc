@@ -1,6 +1,7 @@
 // Mesh writers (mesh_io_write.cpp): binary PLY and STL, and the attributes every format keeps.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 
 #include <sffd/error.h>
@@ -117,6 +118,63 @@ TEST(MeshWrite, AttributesRoundTrip) {
   const Mesh st = readMesh((dir / "st.ply").string());
   EXPECT_EQ(st.texcoords[0], glm::dvec2(0.25, 0.5));
   EXPECT_EQ(st.colors[0], glm::dvec4(1, 0.5, 0, 1));
+  fs::remove_all(dir);
+}
+
+std::string base64(const std::string& bytes) {
+  static const char* abc = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  for (size_t i = 0; i < bytes.size(); i += 3) {
+    const size_t n = std::min<size_t>(3, bytes.size() - i);   // bytes in this group; 4 - (3 - n) characters, then '='
+    uint32_t v = 0;
+    for (size_t k = 0; k < 3; ++k) v = (v << 8) | (k < n ? uint8_t(bytes[i + k]) : 0u);
+    for (size_t k = 0; k < 4; ++k) out += k <= n ? abc[(v >> (18 - 6 * k)) & 63] : '=';
+  }
+  return out;
+}
+
+// The glTF reader on a file made here: node transforms (a translated child of a mirroring node),
+// strips, fans, normalized byte colours, flipped texture coordinates, a skipped line primitive.
+TEST(MeshRead, GltfPrimitivesAndTransforms) {
+  const fs::path dir = tempDir("mesh_read_gltf");
+  std::string bin;
+  auto floats = [&](std::initializer_list<float> v) {
+    for (float f : v) bin.append(reinterpret_cast<const char*>(&f), 4);
+  };
+  floats({0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0});   // 4 positions, offset 0, 48 bytes
+  floats({0, 0, 1, 0, 0, 1, 1, 1});               // 4 texture coordinates, offset 48, 32 bytes
+  bin += std::string("\xff\x00\x00\x00\xff\x00\x00\x00\xff\xff\xff\xff", 12);   // 4 colours (ubyte), offset 80
+  const std::string json = R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+    "nodes": [{"scale": [-1, 1, 1], "children": [1]}, {"translation": [10, 0, 0], "mesh": 0}],
+    "meshes": [{"primitives": [
+      {"attributes": {"POSITION": 0, "TEXCOORD_0": 1, "COLOR_0": 2}, "mode": 5},
+      {"attributes": {"POSITION": 0}, "mode": 6},
+      {"attributes": {"POSITION": 0}, "mode": 1}]}],
+    "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
+                  {"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC2"},
+                  {"bufferView": 2, "componentType": 5121, "normalized": true, "count": 4, "type": "VEC3"}],
+    "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 32},
+                    {"buffer": 0, "byteOffset": 80, "byteLength": 12}],
+    "buffers": [{"byteLength": )" + std::to_string(bin.size()) + R"(, "uri": "data:application/octet-stream;base64,)" + base64(bin) + R"("}]})";
+  std::ofstream(dir / "t.gltf") << json;
+  const Mesh m = readMesh((dir / "t.gltf").string());
+  ASSERT_EQ(m.positions.size(), 8u);   // two primitives of 4 vertices (the line primitive skipped)
+  ASSERT_EQ(m.triangles.size(), 4u);   // a strip of 4: 2 triangles; a fan of 4: 2 triangles
+  EXPECT_EQ(m.positions[3], glm::dvec3(-11, 1, 0));   // scale(-1, 1, 1) * translate(10, 0, 0) * (1, 1, 0)
+  EXPECT_EQ(m.texcoords[1], glm::dvec2(1, 1));        // glTF (1, 0) with v flipped
+  EXPECT_EQ(m.texcoords[5], glm::dvec2(0, 0));        // no TEXCOORD_0 in the fan: (0, 0)
+  EXPECT_EQ(m.colors[1], glm::dvec4(0, 1, 0, 1));
+  EXPECT_EQ(m.colors[3], glm::dvec4(1, 1, 1, 1));
+  ASSERT_EQ(m.warnings.size(), 1u);
+  EXPECT_NE(m.warnings[0].find("1 point or line primitive skipped"), std::string::npos) << m.warnings[0];
+  // Strip (0 1 2), (2 1 3) and fan (0 1 2), (0 2 3), each turned (b and c swapped) by the mirror.
+  using T = std::array<uint32_t, 3>;
+  EXPECT_EQ(m.triangles, (std::vector<T>{{0, 2, 1}, {2, 3, 1}, {4, 6, 5}, {4, 7, 6}}));
+  // So the strip, counter-clockwise in its own frame, is counter-clockwise in the world too.
+  for (size_t f = 0; f < 2; ++f) {
+    const T& t = m.triangles[f];
+    EXPECT_GT(glm::cross(m.positions[t[1]] - m.positions[t[0]], m.positions[t[2]] - m.positions[t[0]]).z, 0.0) << f;
+  }
   fs::remove_all(dir);
 }
 
