@@ -1,6 +1,6 @@
 // sffd on the gles backend as a user runs it: held to the OpenGL ES 3.1 minimum limits by default,
-// classic FFD runs there (its kernel fits 4 storage blocks) and gives the CPU reference's bytes in
-// strict mode; the kernels still past the minimum are refused with the limit named (exit 3) and run
+// classic and accurate FFD run there (their kernels fit 4 storage blocks) and give the CPU reference's
+// bytes in strict mode; the kernels still past the minimum are refused with the limit named (exit 3) and run
 // with SFFD_GLES_LIMITS=device; double precision is a usage error (exit 2). docs/GLES.md.
 #include <gtest/gtest.h>
 
@@ -25,10 +25,13 @@ class Gles : public ::testing::Test {
   std::string mesh, lattice;
 };
 
-TEST_F(Gles, ClassicRunsWithinTheMinimumLimitsToTheCpuBytes) {
-  ASSERT_EQ(deform("--method classic --strict --precision float --backend gles", "gles.obj").status, 0);
-  ASSERT_EQ(deform("--method classic --strict --precision float --backend cpu", "cpu.obj").status, 0);
-  EXPECT_EQ(slurp(dir / "gles.obj"), slurp(dir / "cpu.obj"));
+TEST_F(Gles, ClassicAndAccurateRunWithinTheMinimumLimitsToTheCpuBytes) {
+  for (const char* method : {"classic", "accurate"}) {
+    const std::string options = std::string("--method ") + method + " --strict --precision float --tess 3 --backend ";
+    ASSERT_EQ(deform(options + "gles", "gles.obj").status, 0) << method;
+    ASSERT_EQ(deform(options + "cpu", "cpu.obj").status, 0) << method;
+    EXPECT_EQ(slurp(dir / "gles.obj"), slurp(dir / "cpu.obj")) << method;
+  }
 }
 
 TEST_F(Gles, KernelsPastTheMinimumAreRefusedUnlessTheDevicesLimitsAreAsked) {

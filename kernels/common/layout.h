@@ -184,19 +184,26 @@ SFFD_STRUCT_END(PnParams)
 #define SFFD_ACC_STAGE_SAMPLES 0u
 #define SFFD_ACC_STAGE_PATCHES 1u
 #define SFFD_ACC_STAGE_TESSELLATE 2u
-#define SFFD_BINDING_ACC_MATRIX SFFD_SLOT_3        // reals: A_n^{-1} transposed, entry (sample l, control point k) at l*m + k
-#define SFFD_BINDING_ACC_TESS_BASIS SFFD_SLOT_4    // reals: per tessellation vertex v, B^n_k(lambda_v) for the m control points k
-#define SFFD_BINDING_ACC_CORNERS SFFD_SLOT_5       // 4 real4 per sub-triangle: its flat corners sum_i lam_i V_i, the parent's unit face normal
+// Four storage blocks in all (the OpenGL ES 3.1 minimum): the lattice's two, and two of sections.
+// The lattice frame range also holds, from the reals AccurateParams.tables names, the constant tables:
+//   A_n^{-1} transposed, entry (sample l, control point k) at l*m + k;
+//   the tessellation basis: per tessellation vertex v, B^n_k(lambda_v) for the m control points k.
+#define SFFD_BINDING_ACC_CHUNK SFFD_SLOT_3     // real4, per sub-triangle of the chunk: nv tessellation positions
+                                               // (stage 2 writes), from element sections.x nv unit geometric normals
+                                               // of the patch, cof(J) n_face (stage 2), from element sections.y
+                                               // SFFD_ACC_CORNER_STRIDE corners: the flat corners sum_i lam_i V_i,
+                                               // the parent's unit face normal (read)
+#define SFFD_BINDING_ACC_SCRATCH SFFD_SLOT_4   // real4, per sub-triangle: m samples S_l (stage 0 writes, stage 1
+                                               // reads), from element sections.z m patch control points, linear
+                                               // index order (stage 1 writes, stage 2 reads)
 #define SFFD_ACC_CORNER_STRIDE 4u
-#define SFFD_BINDING_ACC_PATCHES SFFD_SLOT_6       // m real4 per sub-triangle: the patch control points, linear index order (stage 1 writes)
-#define SFFD_BINDING_ACC_POSITIONS SFFD_SLOT_7     // nv real4 per sub-triangle: tessellation positions (stage 2 writes)
-#define SFFD_BINDING_ACC_NORMALS SFFD_SLOT_8       // nv real4 per sub-triangle: unit geometric normals of the patch, cof(J) n_face (stage 2)
-#define SFFD_BINDING_ACC_SAMPLES SFFD_SLOT_9       // m real4 per sub-triangle: the samples S_l (stage 0 writes, stage 1 reads)
 
 SFFD_STRUCT_BEGIN(AccurateParams)
   SFFD_STRUCT_MEMBER(LatticeParams, lattice)
-  SFFD_UVEC4 range;   // x: first sub-triangle of this chunk (relative to the bound ranges), y: sub-triangle count, z: stage
-  SFFD_UVEC4 shape;   // x: patch degree n, y: control points m = (n+1)(n+2)/2, z: tessellation level L, w: vertices (L+1)(L+2)/2
+  SFFD_UVEC4 range;      // x: first sub-triangle of this chunk (relative to the bound ranges), y: sub-triangle count, z: stage
+  SFFD_UVEC4 shape;      // x: patch degree n, y: control points m = (n+1)(n+2)/2, z: tessellation level L, w: vertices (L+1)(L+2)/2
+  SFFD_UVEC4 sections;   // x: first normal, y: first corner (elements of the chunk range); z: first control point (scratch)
+  SFFD_UVEC4 tables;     // x: first real of A_n^{-1}, y: first real of the tessellation basis (lattice frame range)
 SFFD_STRUCT_END(AccurateParams)
 // ---- end of accurate_patches ----
 

@@ -29,7 +29,7 @@ const bool kSoftware = [] {
 const std::map<std::string, int> kOverStorageLimit = {
     {"pn_triangles", 5},           {"clip_count", 9},         {"clip_write", 11},      {"deform_smooth", 7},
     {"deform_step_sample", 6},     {"deform_step_fit", 7},    {"deform_step_adjust", 7},
-    {"deform_step_tessellate", 7}, {"accurate_patches", 9}};
+    {"deform_step_tessellate", 7}};
 
 std::unique_ptr<Backend> openGles(bool deviceLimits) {
   if (!providerLibraryPresent(Provider::EGLES)) return nullptr;
