@@ -45,6 +45,25 @@ TEST_F(Gles, KernelsPastTheMinimumAreRefusedUnlessTheDevicesLimitsAreAsked) {
   EXPECT_EQ(slurp(dir / "own.obj"), slurp(dir / "cpu.obj"));
 }
 
+// conform compares gles's buffers bit for bit with the CPU reference's: accurate FFD at the minimum
+// limits, smooth FFD (every kernel: PN, clipping, deform) on the device's own.
+TEST_F(Gles, ConformStrictIsBitIdenticalToTheCpu) {
+  const std::string job = "conform " + mesh + " -l " + lattice + " --strict --backends gles,cpu --require gles --tess 3";
+  for (const auto& [method, env] : {std::pair<std::string, std::string>{"accurate", ""}, {"smooth", "SFFD_GLES_LIMITS=device"}}) {
+    RunResult r = runSffd(job + " --method " + method, env);
+    EXPECT_EQ(r.status, 0) << method << ": " << r.err;
+    auto count = [&](const std::string& what) {
+      size_t n = 0;
+      for (size_t at = r.out.find(what); at != std::string::npos; at = r.out.find(what, at + 1)) ++n;
+      return n;
+    };
+    // Every buffer (smooth: PN, clip headers and records, patches, positions, normals) equal bit for bit.
+    EXPECT_EQ(count(" gles vs cpu: "), method == "smooth" ? 6u : 3u) << method << ": " << r.out;
+    EXPECT_EQ(count(" gles vs cpu: max_abs=0 max_ulp=0 mismatched=0/"), count(" gles vs cpu: ")) << r.out;
+    EXPECT_NE(r.out.find("conform: PASS"), std::string::npos) << method;
+  }
+}
+
 TEST_F(Gles, DoublePrecisionIsAUsageError) {
   RunResult r = deform("--method classic --precision double --backend gles", "d.obj");
   EXPECT_EQ(r.status, 2) << r.err;
