@@ -1,6 +1,6 @@
 // sffd on the gles backend as a user runs it: held to the OpenGL ES 3.1 minimum limits by default,
-// classic FFD runs there (its kernel fits 4 storage blocks) and gives the CPU reference's bytes in
-// strict mode; the kernels still past the minimum are refused with the limit named (exit 3) and run
+// classic and accurate FFD run there (their kernels fit 4 storage blocks) and give the CPU reference's
+// bytes in strict mode; the kernels still past the minimum are refused with the limit named (exit 3) and run
 // with SFFD_GLES_LIMITS=device; double precision is a usage error (exit 2). docs/GLES.md.
 #include <gtest/gtest.h>
 
@@ -25,10 +25,13 @@ class Gles : public ::testing::Test {
   std::string mesh, lattice;
 };
 
-TEST_F(Gles, ClassicRunsWithinTheMinimumLimitsToTheCpuBytes) {
-  ASSERT_EQ(deform("--method classic --strict --precision float --backend gles", "gles.obj").status, 0);
-  ASSERT_EQ(deform("--method classic --strict --precision float --backend cpu", "cpu.obj").status, 0);
-  EXPECT_EQ(slurp(dir / "gles.obj"), slurp(dir / "cpu.obj"));
+TEST_F(Gles, ClassicAndAccurateRunWithinTheMinimumLimitsToTheCpuBytes) {
+  for (const char* method : {"classic", "accurate"}) {
+    const std::string options = std::string("--method ") + method + " --strict --precision float --tess 3 --backend ";
+    ASSERT_EQ(deform(options + "gles", "gles.obj").status, 0) << method;
+    ASSERT_EQ(deform(options + "cpu", "cpu.obj").status, 0) << method;
+    EXPECT_EQ(slurp(dir / "gles.obj"), slurp(dir / "cpu.obj")) << method;
+  }
 }
 
 TEST_F(Gles, KernelsPastTheMinimumAreRefusedUnlessTheDevicesLimitsAreAsked) {
@@ -40,6 +43,25 @@ TEST_F(Gles, KernelsPastTheMinimumAreRefusedUnlessTheDevicesLimitsAreAsked) {
   ASSERT_EQ(deform("--method smooth --strict --backend gles", "own.obj", "SFFD_GLES_LIMITS=device").status, 0);
   ASSERT_EQ(deform("--method smooth --strict --backend cpu", "cpu.obj").status, 0);
   EXPECT_EQ(slurp(dir / "own.obj"), slurp(dir / "cpu.obj"));
+}
+
+// conform compares gles's buffers bit for bit with the CPU reference's: accurate FFD at the minimum
+// limits, smooth FFD (every kernel: PN, clipping, deform) on the device's own.
+TEST_F(Gles, ConformStrictIsBitIdenticalToTheCpu) {
+  const std::string job = "conform " + mesh + " -l " + lattice + " --strict --backends gles,cpu --require gles --tess 3";
+  for (const auto& [method, env] : {std::pair<std::string, std::string>{"accurate", ""}, {"smooth", "SFFD_GLES_LIMITS=device"}}) {
+    RunResult r = runSffd(job + " --method " + method, env);
+    EXPECT_EQ(r.status, 0) << method << ": " << r.err;
+    auto count = [&](const std::string& what) {
+      size_t n = 0;
+      for (size_t at = r.out.find(what); at != std::string::npos; at = r.out.find(what, at + 1)) ++n;
+      return n;
+    };
+    // Every buffer (smooth: PN, clip headers and records, patches, positions, normals) equal bit for bit.
+    EXPECT_EQ(count(" gles vs cpu: "), method == "smooth" ? 6u : 3u) << method << ": " << r.out;
+    EXPECT_EQ(count(" gles vs cpu: max_abs=0 max_ulp=0 mismatched=0/"), count(" gles vs cpu: ")) << r.out;
+    EXPECT_NE(r.out.find("conform: PASS"), std::string::npos) << method;
+  }
 }
 
 TEST_F(Gles, DoublePrecisionIsAUsageError) {

@@ -25,13 +25,16 @@
 #include "../common/lattice_eval.glsl"
 
 layout(std140, SFFD_SET binding = SFFD_BINDING_PARAMS) uniform AccurateBlock { AccurateParams params; };
-layout(std430, SFFD_SET binding = SFFD_BINDING_ACC_MATRIX) readonly buffer AccMatrix { real accMatrix[]; };
-layout(std430, SFFD_SET binding = SFFD_BINDING_ACC_TESS_BASIS) readonly buffer AccTessBasis { real accTessBasis[]; };
-layout(std430, SFFD_SET binding = SFFD_BINDING_ACC_CORNERS) readonly buffer AccCorners { real4 accCorners[]; };
-layout(std430, SFFD_SET binding = SFFD_BINDING_ACC_PATCHES) buffer AccPatches { real4 accPatches[]; };
-layout(std430, SFFD_SET binding = SFFD_BINDING_ACC_POSITIONS) writeonly buffer AccPositions { real4 accPositions[]; };
-layout(std430, SFFD_SET binding = SFFD_BINDING_ACC_NORMALS) writeonly buffer AccNormals { real4 accNormals[]; };
-layout(std430, SFFD_SET binding = SFFD_BINDING_ACC_SAMPLES) buffer AccSamples { real4 accSamples[]; };
+layout(std430, SFFD_SET binding = SFFD_BINDING_ACC_CHUNK) buffer AccChunk { real4 accChunk[]; };
+layout(std430, SFFD_SET binding = SFFD_BINDING_ACC_SCRATCH) buffer AccScratch { real4 accScratch[]; };
+// The sections of layout.h's ranges, by what they hold.
+#define accCorners(i) accChunk[params.sections.y + (i)]
+#define accNormals(i) accChunk[params.sections.x + (i)]
+#define accPositions(i) accChunk[i]
+#define accSamples(i) accScratch[i]
+#define accPatches(i) accScratch[params.sections.z + (i)]
+#define accMatrix(i) latticeFrame[params.tables.x + (i)]
+#define accTessBasis(i) latticeFrame[params.tables.y + (i)]
 
 // The point (i, j, k) / d of the flat triangle (c0, c1, c2). Always precise (also in the fast
 // variant): on a shared edge one weight is 0 and the sum of the other two terms is the same bits from
@@ -61,29 +64,29 @@ void main() {
   uint e = t - local * per;
   uint s = params.range.x + local;
   uint cs = uint(SFFD_ACC_CORNER_STRIDE) * s;
-  real3 c0 = accCorners[cs].xyz, c1 = accCorners[cs + 1u].xyz, c2 = accCorners[cs + 2u].xyz;
+  real3 c0 = accCorners(cs).xyz, c1 = accCorners(cs + 1u).xyz, c2 = accCorners(cs + 2u).xyz;
 
   if (stage == SFFD_ACC_STAGE_SAMPLES) {
     uint r = accRow(e), q = e - r * (r + 1u) / 2u;
     real3 x = accFlatPoint(c0, c1, c2, n - r, r - q, q, n);
     LatticeSample S = latticeEvaluate(params.lattice, x);
     bool keep = !S.inside && params.lattice.degree.w == SFFD_OUTSIDE_KEEP;
-    accSamples[s * m + e] = real4(keep ? x : S.value, 0);
+    accSamples(s * m + e) = real4(keep ? x : S.value, 0);
     return;
   }
 
   if (stage == SFFD_ACC_STAGE_PATCHES) {
     P real3 cp = real3(0);
     for (uint l = 0u; l < m; ++l) {
-      P real3 v = cp + accSamples[s * m + l].xyz * accMatrix[l * m + e];
+      P real3 v = cp + accSamples(s * m + l).xyz * accMatrix(l * m + e);
       cp = v;
     }
-    accPatches[s * m + e] = real4(cp, 0);
+    accPatches(s * m + e) = real4(cp, 0);
     return;
   }
 
   // Tessellation vertex e: row r, position q; barycentrics (L - r, r - q, q) / L.
-  real3 nf = accCorners[cs + 3u].xyz;
+  real3 nf = accCorners(cs + 3u).xyz;
   uint r = accRow(e), q = e - r * (r + 1u) / 2u;
   uint i = L - r, j = r - q, k = q;
   real3 x = accFlatPoint(c0, c1, c2, i, j, k, L);
@@ -95,12 +98,12 @@ void main() {
   } else {
     uint b = e * m;
     for (uint kk = 0u; kk < m; ++kk) {
-      P real3 v = pos + accPatches[s * m + kk].xyz * accTessBasis[b + kk];
+      P real3 v = pos + accPatches(s * m + kk).xyz * accTessBasis(b + kk);
       pos = v;
     }
   }
   P real3 nrm = keep ? nf : latticeCofactorNormal(S, nf);
   if (!(sdot(nrm, nrm) > real(0))) nrm = nf;   // a singular point of the map
-  accPositions[s * nv + e] = real4(pos, 0);
-  accNormals[s * nv + e] = real4(snormalize(nrm), 0);
+  accPositions(s * nv + e) = real4(pos, 0);
+  accNormals(s * nv + e) = real4(snormalize(nrm), 0);
 }

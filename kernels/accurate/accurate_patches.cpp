@@ -161,11 +161,6 @@ AccurateJob makeAccurateJob(const Mesh& mesh, const Lattice& lattice, std::vecto
 namespace {
 
 template <class Real>
-std::vector<Real> kernelMatrix(int n) {
-  return convertReals<Real>(accurateKernelMatrix(n));
-}
-
-template <class Real>
 void accurateRun(Backend& backend, const AccurateJob& job, const PackedLattice& P, KernelVariant variant, size_t maxChunk,
                  AccurateOutput& out) {
   const DeviceLimits& lim = backend.info().limits;
@@ -175,10 +170,9 @@ void accurateRun(Backend& backend, const AccurateJob& job, const PackedLattice& 
   const size_t r4 = 4 * sizeof(Real);
   const size_t chunk = accurateChunkPatches(lim, job, sizeof(Real), maxChunk);
 
-  std::vector<Real> frame = convertReals<Real>(P.frame), coeffs = convertReals<Real>(P.coeffs);
-  std::vector<Real> matrix = kernelMatrix<Real>(job.degree);
-  std::vector<Real> basis = convertReals<Real>(tessellationBasis(job.degree, job.level));
-  for (const auto* v : {&coeffs, &matrix, &basis})
+  const AccurateFrame F = accurateFrame(P.frame, job.degree, job.level);
+  std::vector<Real> frame = convertReals<Real>(F.reals), coeffs = convertReals<Real>(P.coeffs);
+  for (const auto* v : {&coeffs, &frame})
     if (v->size() * sizeof(Real) > lim.maxStorageBufferRange)
       throw Error(ErrorKind::Input, "accurate FFD: a lattice or patch table does not fit one storage binding on this device");
   auto upload = [&](const std::vector<Real>& v) {
@@ -186,12 +180,12 @@ void accurateRun(Backend& backend, const AccurateJob& job, const PackedLattice& 
     if (!v.empty()) backend.upload(b, 0, v.data(), v.size() * sizeof(Real));
     return b;
   };
-  BufferId bFrame = upload(frame), bCoeffs = upload(coeffs), bMatrix = upload(matrix), bBasis = upload(basis);
-  BufferId bCorners = backend.createBuffer(chunk * SFFD_ACC_CORNER_STRIDE * r4);
-  BufferId bSamples = backend.createBuffer(chunk * m * r4);
-  BufferId bPatches = backend.createBuffer(chunk * m * r4);
-  BufferId bPos = backend.createBuffer(chunk * nv * r4);
-  BufferId bNrm = backend.createBuffer(chunk * nv * r4);
+  BufferId bFrame = upload(frame), bCoeffs = upload(coeffs);
+  // The chunk range: positions, normals from element chunk * nv, corners from 2 * chunk * nv; the
+  // scratch range: samples, control points from element chunk * m.
+  const uint32_t normalsAt = uint32_t(chunk * nv), cornersAt = 2 * normalsAt, patchesAt = uint32_t(chunk * m);
+  BufferId bChunk = backend.createBuffer((2 * chunk * nv + chunk * SFFD_ACC_CORNER_STRIDE) * r4);
+  BufferId bScratch = backend.createBuffer(2 * chunk * m * r4);
 
   out.controlPoints.resize(ns * m * 4);
   out.positions.resize(ns * nv * 4);
@@ -201,22 +195,20 @@ void accurateRun(Backend& backend, const AccurateJob& job, const PackedLattice& 
     const size_t count = std::min(chunk, ns - first);
     const size_t cw = 4 * SFFD_ACC_CORNER_STRIDE;
     for (size_t i = 0; i < cw * count; ++i) corners[i] = Real(job.corners[cw * first + i]);
-    backend.upload(bCorners, 0, corners.data(), count * SFFD_ACC_CORNER_STRIDE * r4);
-    dispatchAccurateChunk(backend, P.params, variant, job, count,
+    backend.upload(bChunk, cornersAt * r4, corners.data(), count * SFFD_ACC_CORNER_STRIDE * r4);
+    dispatchAccurateChunk(backend, P.params, variant, job, F, count,
                           {{SFFD_BINDING_LATTICE_COEFFS, bCoeffs}, {SFFD_BINDING_LATTICE_FRAME, bFrame},
-                           {SFFD_BINDING_ACC_MATRIX, bMatrix},     {SFFD_BINDING_ACC_TESS_BASIS, bBasis},
-                           {SFFD_BINDING_ACC_CORNERS, bCorners},   {SFFD_BINDING_ACC_PATCHES, bPatches},
-                           {SFFD_BINDING_ACC_POSITIONS, bPos},     {SFFD_BINDING_ACC_NORMALS, bNrm},
-                           {SFFD_BINDING_ACC_SAMPLES, bSamples}});
-    backend.download(bPatches, 0, cps.data(), count * m * r4);
-    backend.download(bPos, 0, pos.data(), count * nv * r4);
-    backend.download(bNrm, 0, nrm.data(), count * nv * r4);
+                           {SFFD_BINDING_ACC_CHUNK, bChunk}, {SFFD_BINDING_ACC_SCRATCH, bScratch},
+                           normalsAt, cornersAt, patchesAt});
+    backend.download(bScratch, patchesAt * r4, cps.data(), count * m * r4);
+    backend.download(bChunk, 0, pos.data(), count * nv * r4);
+    backend.download(bChunk, normalsAt * r4, nrm.data(), count * nv * r4);
     std::copy(cps.begin(), cps.begin() + count * m * 4, out.controlPoints.begin() + first * m * 4);
     std::copy(pos.begin(), pos.begin() + count * nv * 4, out.positions.begin() + first * nv * 4);
     std::copy(nrm.begin(), nrm.begin() + count * nv * 4, out.normals.begin() + first * nv * 4);
   }
   backend.finish();
-  for (BufferId b : {bFrame, bCoeffs, bMatrix, bBasis, bCorners, bSamples, bPatches, bPos, bNrm}) backend.destroyBuffer(b);
+  for (BufferId b : {bFrame, bCoeffs, bChunk, bScratch}) backend.destroyBuffer(b);
   out.timings = backend.takeTimings();
 }
 
@@ -231,12 +223,25 @@ std::vector<double> accurateKernelMatrix(int n) {
   return t;
 }
 
+AccurateFrame accurateFrame(const std::vector<double>& latticeFrame, int degree, int level) {
+  AccurateFrame f;
+  f.reals = latticeFrame;
+  f.matrixAt = uint32_t(f.reals.size());
+  const std::vector<double> matrix = accurateKernelMatrix(degree), basis = tessellationBasis(degree, level);
+  f.reals.insert(f.reals.end(), matrix.begin(), matrix.end());
+  f.basisAt = uint32_t(f.reals.size());
+  f.reals.insert(f.reals.end(), basis.begin(), basis.end());
+  return f;
+}
+
 size_t accurateChunkPatches(const DeviceLimits& lim, const AccurateJob& job, size_t realBytes, size_t maxChunk) {
   const size_t m = size_t(triangleControlPoints(job.degree)), nv = size_t(tessVertexCount(job.level));
   const size_t r4 = 4 * realBytes;
-  // The largest per-sub-triangle binding decides the chunk (positions and normals: nv real4 each).
-  const size_t perSub = std::max<size_t>({SFFD_ACC_CORNER_STRIDE, m, nv}) * r4;
-  size_t chunk = size_t(lim.maxStorageBufferRange / perSub);
+  // The larger per-sub-triangle binding decides the chunk: the chunk range (positions, normals at an
+  // aligned offset, corners at another) or the scratch range (samples, control points).
+  const size_t perSub = std::max<size_t>(2 * nv + SFFD_ACC_CORNER_STRIDE, 2 * m) * r4;
+  const uint64_t slack = std::min(lim.maxStorageBufferRange, 2 * lim.storageOffsetAlignment);
+  size_t chunk = size_t((lim.maxStorageBufferRange - slack) / perSub);
   chunk = std::min<size_t>(chunk, size_t(lim.maxWorkGroupCount[0]) * lim.maxWorkGroupCount[1] * SFFD_LOCAL_SIZE / std::max(m, nv));
   chunk = std::min<size_t>(chunk, size_t(UINT32_MAX) / std::max(m, nv));   // thread indices are 32-bit
   if (maxChunk) chunk = std::min(chunk, maxChunk);
@@ -244,7 +249,7 @@ size_t accurateChunkPatches(const DeviceLimits& lim, const AccurateJob& job, siz
 }
 
 void dispatchAccurateChunk(Backend& backend, const gpu::LatticeParams& lattice, KernelVariant variant, const AccurateJob& job,
-                           size_t count, const AccurateBindings& bindings) {
+                           const AccurateFrame& frame, size_t count, const AccurateBindings& bindings) {
   const uint32_t n = uint32_t(job.degree), m = uint32_t(triangleControlPoints(job.degree));
   const uint32_t nv = uint32_t(tessVertexCount(job.level));
   // Samples, then control points, then the tessellation: three dispatches, a barrier between each.
@@ -253,13 +258,15 @@ void dispatchAccurateChunk(Backend& backend, const gpu::LatticeParams& lattice, 
     params.lattice = lattice;
     params.range = {0, uint32_t(count), stage, 0};
     params.shape = {n, m, uint32_t(job.level), nv};
+    params.sections = {bindings.normalsAt, bindings.cornersAt, bindings.patchesAt, 0};
+    params.tables = {frame.matrixAt, frame.basisAt, 0, 0};
     Dispatch d;
     d.kernel = "accurate_patches";
     d.variant = variant;
     d.params = &params;
     d.paramsSize = sizeof(params);
     d.label = stage == SFFD_ACC_STAGE_SAMPLES ? "accurate_samples" : stage == SFFD_ACC_STAGE_PATCHES ? "accurate_patches" : "accurate_tessellate";
-    d.buffers = bindings;
+    d.buffers = {bindings.coeffs, bindings.frame, bindings.chunk, bindings.scratch};
     gridFor(uint64_t(count) * (stage == SFFD_ACC_STAGE_TESSELLATE ? nv : m), backend.info().limits, d.groups);
     backend.dispatch(d);
     backend.barrier();

@@ -81,16 +81,27 @@ struct AccurateOutput {
 AccurateOutput accurateFfd(Backend& backend, const AccurateJob& job, const PackedLattice& lattice, KernelVariant variant,
                            size_t maxChunk = 0);
 
-// A_n^{-1} transposed (sample-major), as the kernel reads it (SFFD_BINDING_ACC_MATRIX).
+// A_n^{-1} transposed (sample-major), as the kernel reads it (after the frame in the lattice frame range).
 std::vector<double> accurateKernelMatrix(int n);
+// What the kernel reads from the lattice frame binding: the frame's reals, A_n^{-1} (accurateKernelMatrix)
+// and the tessellation basis (tessellationBasis), and where the two tables begin (AccurateParams.tables).
+struct AccurateFrame {
+  std::vector<double> reals;
+  uint32_t matrixAt = 0, basisAt = 0;
+};
+AccurateFrame accurateFrame(const std::vector<double>& latticeFrame, int degree, int level);
 // Sub-triangles one chunk may hold on the device with reals of `realBytes`; `maxChunk` caps it when not 0.
 size_t accurateChunkPatches(const DeviceLimits& limits, const AccurateJob& job, size_t realBytes, size_t maxChunk);
 // The three dispatches (samples, control points, tessellation) over `count` sub-triangles, each
-// followed by a barrier. The bindings: coefficients, frame, matrix, tessellation basis
-// (tessellationBasis), corners, control points, positions, normals, samples.
-using AccurateBindings = std::vector<BufferBinding>;
+// followed by a barrier. The bindings: coefficients, the accurateFrame, the chunk range (positions,
+// normals from element `normalsAt`, corners from `cornersAt`) and the scratch range (samples, control
+// points from element `patchesAt`); layout.h, AccurateParams.
+struct AccurateBindings {
+  BufferBinding coeffs, frame, chunk, scratch;
+  uint32_t normalsAt = 0, cornersAt = 0, patchesAt = 0;
+};
 void dispatchAccurateChunk(Backend& backend, const gpu::LatticeParams& lattice, KernelVariant variant, const AccurateJob& job,
-                           size_t count, const AccurateBindings& bindings);
+                           const AccurateFrame& frame, size_t count, const AccurateBindings& bindings);
 
 // Per patch its parent, per tessellation vertex its pre-image barycentrics in the parent
 // (sum_i lambda_i lam_i), its position and normal.

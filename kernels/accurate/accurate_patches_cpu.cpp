@@ -37,11 +37,16 @@ void accurateThreads(const CpuKernelArgs& a, uint64_t first, uint64_t last) {
   a.check(m <= SFFD_ACC_MAX_CP && m == uint32_t(triangleControlPoints(int(n))) && nv == uint32_t(tessVertexCount(int(L))),
           "accurate: patch shape out of range");
   const uint64_t subs = uint64_t(p.range.x) + p.range.y, per = stage == SFFD_ACC_STAGE_TESSELLATE ? nv : m;
-  const Real* corners = a.array<const Real>(SFFD_BINDING_ACC_CORNERS, 4 * SFFD_ACC_CORNER_STRIDE * subs).data();
+  // The sections of the chunk and scratch ranges and the tables in the frame range (layout.h).
+  const uint64_t normalsAt = 4 * uint64_t(p.sections.x), cornersAt = 4 * uint64_t(p.sections.y),
+                 patchesAt = 4 * uint64_t(p.sections.z);
+  Real* chunk = a.array<Real>(SFFD_BINDING_ACC_CHUNK, std::max(normalsAt + 4 * nv * subs, cornersAt + 4 * SFFD_ACC_CORNER_STRIDE * subs)).data();
+  Real* scratch = a.array<Real>(SFFD_BINDING_ACC_SCRATCH, std::max(4 * m * subs, patchesAt + 4 * m * subs)).data();
+  const Real* corners = chunk + cornersAt;
   const uint64_t end = std::min<uint64_t>(last, per * p.range.y);
   if (stage == SFFD_ACC_STAGE_SAMPLES) {
     LatticeEvaluator<Real> eval = boundLattice<Real>(a, p.lattice);
-    Real* samples = a.array<Real>(SFFD_BINDING_ACC_SAMPLES, 4 * m * subs).data();
+    Real* samples = scratch;
     for (uint64_t t = first; t < end; ++t) {
       const uint32_t local = uint32_t(t / per), e = uint32_t(t - uint64_t(local) * per), s = p.range.x + local;
       const Real* c = &corners[4 * SFFD_ACC_CORNER_STRIDE * size_t(s)];
@@ -52,9 +57,9 @@ void accurateThreads(const CpuKernelArgs& a, uint64_t first, uint64_t last) {
       put(&samples[4 * (size_t(s) * m + e)], keep ? x : S.value);
     }
   } else if (stage == SFFD_ACC_STAGE_PATCHES) {
-    const Real* matrix = a.array<const Real>(SFFD_BINDING_ACC_MATRIX, uint64_t(m) * m).data();
-    const Real* samples = a.array<const Real>(SFFD_BINDING_ACC_SAMPLES, 4 * m * subs).data();
-    Real* patches = a.array<Real>(SFFD_BINDING_ACC_PATCHES, 4 * m * subs).data();
+    const Real* matrix = a.array<const Real>(SFFD_BINDING_LATTICE_FRAME, uint64_t(p.tables.x) + uint64_t(m) * m).data() + p.tables.x;
+    const Real* samples = scratch;
+    Real* patches = scratch + patchesAt;
     for (uint64_t t = first; t < end; ++t) {
       const uint32_t local = uint32_t(t / per), e = uint32_t(t - uint64_t(local) * per), s = p.range.x + local;
       RVec3<Real> cp{};
@@ -63,10 +68,10 @@ void accurateThreads(const CpuKernelArgs& a, uint64_t first, uint64_t last) {
     }
   } else if (stage == SFFD_ACC_STAGE_TESSELLATE) {
     LatticeEvaluator<Real> eval = boundLattice<Real>(a, p.lattice);
-    const Real* basis = a.array<const Real>(SFFD_BINDING_ACC_TESS_BASIS, uint64_t(nv) * m).data();
-    const Real* patches = a.array<const Real>(SFFD_BINDING_ACC_PATCHES, 4 * m * subs).data();
-    Real* positions = a.array<Real>(SFFD_BINDING_ACC_POSITIONS, 4 * nv * subs).data();
-    Real* normals = a.array<Real>(SFFD_BINDING_ACC_NORMALS, 4 * nv * subs).data();
+    const Real* basis = a.array<const Real>(SFFD_BINDING_LATTICE_FRAME, uint64_t(p.tables.y) + uint64_t(nv) * m).data() + p.tables.y;
+    const Real* patches = scratch + patchesAt;
+    Real* positions = chunk;
+    Real* normals = chunk + normalsAt;
     for (uint64_t t = first; t < end; ++t) {
       const uint32_t local = uint32_t(t / per), e = uint32_t(t - uint64_t(local) * per), s = p.range.x + local;
       const Real* c = &corners[4 * SFFD_ACC_CORNER_STRIDE * size_t(s)];

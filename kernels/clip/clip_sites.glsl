@@ -12,8 +12,9 @@
 
 layout(std140, SFFD_SET binding = SFFD_BINDING_PARAMS) uniform ClipBlock { ClipParams params; };
 layout(std430, SFFD_SET binding = SFFD_BINDING_SPLIT_TABLE) readonly buffer SplitTable { uint splitTable[]; };
-layout(std430, SFFD_SET binding = SFFD_BINDING_MESH_POSITIONS) readonly buffer Positions { real4 positions[]; };
-layout(std430, SFFD_SET binding = SFFD_BINDING_MESH_NORMALS) readonly buffer Normals { real4 normals[]; };
+layout(std430, SFFD_SET binding = SFFD_BINDING_MESH_VERTICES) readonly buffer Vertices { real4 vertices[]; };
+#define positions(i) vertices[i]
+#define normals(i) vertices[params.range.z + (i)]
 layout(std430, SFFD_SET binding = SFFD_BINDING_MESH_TRIANGLES) readonly buffer Triangles { uvec4 triangles[]; };
 layout(std430, SFFD_SET binding = SFFD_BINDING_MESH_SLOT_NORMALS) readonly buffer SlotNormals { real4 slotNormals[]; };
 layout(std430, SFFD_SET binding = SFFD_BINDING_PN_OUT) readonly buffer PnRecords { real4 pn[]; };
@@ -96,8 +97,8 @@ Parent loadParent(uint id) {
   p.verts = triangles[SFFD_MESH_TRIANGLE_STRIDE * id];
   p.welds = triangles[SFFD_MESH_TRIANGLE_STRIDE * id + 1u];
   for (uint c = 0u; c < 3u; ++c) {
-    p.V[c] = positions[p.verts[c]].xyz;
-    p.N[c] = normals[p.verts[c]].xyz;
+    p.V[c] = positions(p.verts[c]).xyz;
+    p.N[c] = normals(p.verts[c]).xyz;
   }
   return p;
 }

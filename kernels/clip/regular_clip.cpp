@@ -184,8 +184,8 @@ SubTriangleRecords clipRun(Backend& backend, const PreparedMesh& M, const PnOutp
   const PackedTable& T = packedTable();
   PackedClip pc = packClip(clip);
   const size_t n = clip.triangles.size();
-  std::vector<Real> pos = convertReals<Real>(M.positions), nrm = convertReals<Real>(M.normals),
-                    slots = convertReals<Real>(M.slotNormals), rec = convertReals<Real>(pn.records),
+  std::vector<Real> verts = convertReals<Real>(meshVertexRange(M)), slots = convertReals<Real>(M.slotNormals),
+                    rec = convertReals<Real>(pn.records),
                     reals = convertReals<Real>(pc.reals);
   auto fits = [&](size_t bytes, const char* what) {
     if (bytes > lim.maxStorageBufferRange)
@@ -193,7 +193,7 @@ SubTriangleRecords clipRun(Backend& backend, const PreparedMesh& M, const PnOutp
                                         " MiB) exceed one storage binding on this device (" +
                                         std::to_string(lim.maxStorageBufferRange >> 20) + " MiB); use a coarser mesh");
   };
-  fits(pos.size() * sizeof(Real), "vertices");
+  fits(verts.size() * sizeof(Real), "vertices");
   fits(rec.size() * sizeof(Real), "PN records");
   fits(reals.size() * sizeof(Real), "clip triangles");
   auto make = [&](const void* data, size_t bytes) {
@@ -202,7 +202,7 @@ SubTriangleRecords clipRun(Backend& backend, const PreparedMesh& M, const PnOutp
     return b;
   };
   BufferId bTable = make(T.words.data(), T.words.size() * 4);
-  BufferId bPos = make(pos.data(), pos.size() * sizeof(Real)), bNrm = make(nrm.data(), nrm.size() * sizeof(Real));
+  BufferId bVerts = make(verts.data(), verts.size() * sizeof(Real));
   BufferId bTri = make(M.triangles.data(), M.triangles.size() * 4);
   BufferId bSlot = make(slots.data(), slots.size() * sizeof(Real)), bPn = make(rec.data(), rec.size() * sizeof(Real));
   BufferId bHdr = make(pc.headers.data(), pc.headers.size() * 4), bReal = make(reals.data(), reals.size() * sizeof(Real));
@@ -212,14 +212,14 @@ SubTriangleRecords clipRun(Backend& backend, const PreparedMesh& M, const PnOutp
   params.table = {T.nmax, T.vertexWord, T.triangleWord, 0};
   params.target = {float(l), 0, 0, 0};
   auto dispatch = [&](const char* kernel, const char* label, size_t first, size_t count, std::vector<BufferBinding> extra) {
-    params.range = {uint32_t(first), uint32_t(count), 0, 0};
+    params.range = {uint32_t(first), uint32_t(count), uint32_t(M.positions.size() / 4), 0};
     Dispatch d;
     d.kernel = kernel;
     d.label = label;
     d.variant = variant;
     d.params = &params;
     d.paramsSize = sizeof(params);
-    d.buffers = {{SFFD_BINDING_SPLIT_TABLE, bTable}, {SFFD_BINDING_MESH_POSITIONS, bPos}, {SFFD_BINDING_MESH_NORMALS, bNrm},
+    d.buffers = {{SFFD_BINDING_SPLIT_TABLE, bTable}, {SFFD_BINDING_MESH_VERTICES, bVerts},
                  {SFFD_BINDING_MESH_TRIANGLES, bTri}, {SFFD_BINDING_MESH_SLOT_NORMALS, bSlot}, {SFFD_BINDING_PN_OUT, bPn},
                  {SFFD_BINDING_CLIP_HEADERS, bHdr}, {SFFD_BINDING_CLIP_REALS, bReal}};
     d.buffers.insert(d.buffers.end(), extra.begin(), extra.end());
@@ -269,7 +269,7 @@ SubTriangleRecords clipRun(Backend& backend, const PreparedMesh& M, const PnOutp
     first = last;
   }
   backend.finish();
-  for (BufferId b : {bTable, bPos, bNrm, bTri, bSlot, bPn, bHdr, bReal, bCounts, bSubHdr, bSubRec}) backend.destroyBuffer(b);
+  for (BufferId b : {bTable, bVerts, bTri, bSlot, bPn, bHdr, bReal, bCounts, bSubHdr, bSubRec}) backend.destroyBuffer(b);
   R.timings = backend.takeTimings();
   return R;
 }

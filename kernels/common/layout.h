@@ -88,14 +88,15 @@ SFFD_STRUCT_BEGIN(ClassicParams)
 SFFD_STRUCT_END(ClassicParams)
 
 // ---- kernel pn_triangles: one thread per original triangle (METHOD.md 3.2) ----
-// Mesh buffers shared by the pre-compute kernels.
-#define SFFD_BINDING_MESH_POSITIONS SFFD_SLOT_3      // real4 per vertex (w unused)
-#define SFFD_BINDING_MESH_NORMALS SFFD_SLOT_4        // real4 per vertex, unit (w unused)
-#define SFFD_BINDING_MESH_TRIANGLES SFFD_SLOT_5      // 2 uvec4 per triangle: vertex ids (w unused), weld ids (w unused)
-#define SFFD_BINDING_MESH_SLOT_NORMALS SFFD_SLOT_6   // 12 real4 per triangle: per corner slot, the first then the second
+// Mesh buffers shared by the pre-compute kernels, in slots 1..4 (ES 3.1 guarantees 4 storage blocks at
+// bindings 0..3). The vertices' range holds the positions and, from the element range.z of PnParams and
+// ClipParams names, the normals.
+#define SFFD_BINDING_MESH_VERTICES SFFD_SLOT_1       // real4 per vertex: positions (w unused), then unit normals (w unused)
+#define SFFD_BINDING_MESH_TRIANGLES SFFD_SLOT_2      // 2 uvec4 per triangle: vertex ids (w unused), weld ids (w unused)
+#define SFFD_BINDING_MESH_SLOT_NORMALS SFFD_SLOT_3   // 12 real4 per triangle: per corner slot, the first then the second
                                            // normal of the slot (w of the first: 1 crease, 0 smooth;
                                            // w of the second: 1 when the first is the triangle's own)
-#define SFFD_BINDING_PN_OUT SFFD_SLOT_7              // SFFD_PN_STRIDE real4 per triangle
+#define SFFD_BINDING_PN_OUT SFFD_SLOT_4              // SFFD_PN_STRIDE real4 per triangle
 #define SFFD_MESH_TRIANGLE_STRIDE 2u
 #define SFFD_SLOT_NORMAL_STRIDE 12u
 // PN record: the 10 cubic geometry control points (linear index order 300,210,201,120,111,102,030,021,012,003)
@@ -105,9 +106,9 @@ SFFD_STRUCT_END(ClassicParams)
 
 // ---- kernels clip_count and clip_write: regular clipping by the split-pattern table (METHOD.md 4.2) ----
 // One thread per clip triangle (an original triangle, or a piece of one after the pre-split of
-// triangles whose edges need more than Nmax segments). Buffers 3..7 are the mesh and PN buffers above.
-#define SFFD_BINDING_SPLIT_TABLE SFFD_SLOT_1     // uint: pattern entries (4 each), then vertices (4 each: lambda bits, edge | step << 16), then packed uint16 triangle indices
-#define SFFD_BINDING_CLIP_COUNTS SFFD_SLOT_2     // uint per clip triangle: sub-triangle count (clip_count), exclusive offset (clip_write)
+// triangles whose edges need more than Nmax segments). Buffers 1..4 are the mesh and PN buffers above.
+#define SFFD_BINDING_SPLIT_TABLE SFFD_SLOT_5     // uint: pattern entries (4 each), then vertices (4 each: lambda bits, edge | step << 16), then packed uint16 triangle indices
+#define SFFD_BINDING_CLIP_COUNTS SFFD_SLOT_6     // uint per clip triangle: sub-triangle count (clip_count), exclusive offset (clip_write)
 #define SFFD_BINDING_CLIP_HEADERS SFFD_SLOT_8    // 2 uvec4 per clip triangle: (parent, corner kinds, 0, 0), corner weld ids
 #define SFFD_BINDING_CLIP_REALS SFFD_SLOT_9      // 9 real4 per clip triangle: lam[3], flat[3], edge params[3]
 #define SFFD_BINDING_SUB_HEADERS SFFD_SLOT_10    // uvec4 per sub-triangle: parent, crease slot bits, 0, 0
@@ -130,7 +131,7 @@ SFFD_STRUCT_END(ClassicParams)
 #define SFFD_SUB_NNBR 15u
 
 SFFD_STRUCT_BEGIN(ClipParams)
-  SFFD_UVEC4 range;    // x: first clip triangle, y: clip triangle count
+  SFFD_UVEC4 range;    // x: first clip triangle, y: clip triangle count, z: the first normal of the vertices' range
   SFFD_UVEC4 table;    // x: Nmax, y: first vertex word, z: first triangle word
   SFFD_VEC4 target;    // x: target edge length l
 SFFD_STRUCT_END(ClipParams)
@@ -170,7 +171,7 @@ SFFD_STRUCT_BEGIN(DeformParams)
 SFFD_STRUCT_END(DeformParams)
 
 SFFD_STRUCT_BEGIN(PnParams)
-  SFFD_UVEC4 range;   // x: first triangle, y: triangle count
+  SFFD_UVEC4 range;   // x: first triangle, y: triangle count, z: the first normal of the vertices' range
 SFFD_STRUCT_END(PnParams)
 
 // ---- kernel accurate_patches (accurate FFD, METHOD.md 2; owner: accurate FFD) ----
@@ -184,19 +185,26 @@ SFFD_STRUCT_END(PnParams)
 #define SFFD_ACC_STAGE_SAMPLES 0u
 #define SFFD_ACC_STAGE_PATCHES 1u
 #define SFFD_ACC_STAGE_TESSELLATE 2u
-#define SFFD_BINDING_ACC_MATRIX SFFD_SLOT_3        // reals: A_n^{-1} transposed, entry (sample l, control point k) at l*m + k
-#define SFFD_BINDING_ACC_TESS_BASIS SFFD_SLOT_4    // reals: per tessellation vertex v, B^n_k(lambda_v) for the m control points k
-#define SFFD_BINDING_ACC_CORNERS SFFD_SLOT_5       // 4 real4 per sub-triangle: its flat corners sum_i lam_i V_i, the parent's unit face normal
+// Four storage blocks in all (the OpenGL ES 3.1 minimum): the lattice's two, and two of sections.
+// The lattice frame range also holds, from the reals AccurateParams.tables names, the constant tables:
+//   A_n^{-1} transposed, entry (sample l, control point k) at l*m + k;
+//   the tessellation basis: per tessellation vertex v, B^n_k(lambda_v) for the m control points k.
+#define SFFD_BINDING_ACC_CHUNK SFFD_SLOT_3     // real4, per sub-triangle of the chunk: nv tessellation positions
+                                               // (stage 2 writes), from element sections.x nv unit geometric normals
+                                               // of the patch, cof(J) n_face (stage 2), from element sections.y
+                                               // SFFD_ACC_CORNER_STRIDE corners: the flat corners sum_i lam_i V_i,
+                                               // the parent's unit face normal (read)
+#define SFFD_BINDING_ACC_SCRATCH SFFD_SLOT_4   // real4, per sub-triangle: m samples S_l (stage 0 writes, stage 1
+                                               // reads), from element sections.z m patch control points, linear
+                                               // index order (stage 1 writes, stage 2 reads)
 #define SFFD_ACC_CORNER_STRIDE 4u
-#define SFFD_BINDING_ACC_PATCHES SFFD_SLOT_6       // m real4 per sub-triangle: the patch control points, linear index order (stage 1 writes)
-#define SFFD_BINDING_ACC_POSITIONS SFFD_SLOT_7     // nv real4 per sub-triangle: tessellation positions (stage 2 writes)
-#define SFFD_BINDING_ACC_NORMALS SFFD_SLOT_8       // nv real4 per sub-triangle: unit geometric normals of the patch, cof(J) n_face (stage 2)
-#define SFFD_BINDING_ACC_SAMPLES SFFD_SLOT_9       // m real4 per sub-triangle: the samples S_l (stage 0 writes, stage 1 reads)
 
 SFFD_STRUCT_BEGIN(AccurateParams)
   SFFD_STRUCT_MEMBER(LatticeParams, lattice)
-  SFFD_UVEC4 range;   // x: first sub-triangle of this chunk (relative to the bound ranges), y: sub-triangle count, z: stage
-  SFFD_UVEC4 shape;   // x: patch degree n, y: control points m = (n+1)(n+2)/2, z: tessellation level L, w: vertices (L+1)(L+2)/2
+  SFFD_UVEC4 range;      // x: first sub-triangle of this chunk (relative to the bound ranges), y: sub-triangle count, z: stage
+  SFFD_UVEC4 shape;      // x: patch degree n, y: control points m = (n+1)(n+2)/2, z: tessellation level L, w: vertices (L+1)(L+2)/2
+  SFFD_UVEC4 sections;   // x: first normal, y: first corner (elements of the chunk range); z: first control point (scratch)
+  SFFD_UVEC4 tables;     // x: first real of A_n^{-1}, y: first real of the tessellation basis (lattice frame range)
 SFFD_STRUCT_END(AccurateParams)
 // ---- end of accurate_patches ----
 

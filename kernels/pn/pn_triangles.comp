@@ -6,8 +6,9 @@
 #include "pn_eval.glsl"
 
 layout(std140, SFFD_SET binding = SFFD_BINDING_PARAMS) uniform PnBlock { PnParams params; };
-layout(std430, SFFD_SET binding = SFFD_BINDING_MESH_POSITIONS) readonly buffer Positions { real4 positions[]; };
-layout(std430, SFFD_SET binding = SFFD_BINDING_MESH_NORMALS) readonly buffer Normals { real4 normals[]; };
+layout(std430, SFFD_SET binding = SFFD_BINDING_MESH_VERTICES) readonly buffer Vertices { real4 vertices[]; };
+#define positions(i) vertices[i]
+#define normals(i) vertices[params.range.z + (i)]
 layout(std430, SFFD_SET binding = SFFD_BINDING_MESH_TRIANGLES) readonly buffer Triangles { uvec4 triangles[]; };
 layout(std430, SFFD_SET binding = SFFD_BINDING_MESH_SLOT_NORMALS) readonly buffer SlotNormals { real4 slotNormals[]; };
 layout(std430, SFFD_SET binding = SFFD_BINDING_PN_OUT) writeonly buffer PnOut { real4 pn[]; };
@@ -23,8 +24,8 @@ void main() {
   uvec4 welds = triangles[SFFD_MESH_TRIANGLE_STRIDE * tri + 1u];
   real3 V[3], N[3];
   for (uint c = 0u; c < 3u; ++c) {
-    V[c] = positions[ids[c]].xyz;
-    N[c] = normals[ids[c]].xyz;
+    V[c] = positions(ids[c]).xyz;
+    N[c] = normals(ids[c]).xyz;
   }
   real3 cp[10];
   cp[0] = V[0];

@@ -19,7 +19,9 @@ template <class Real>
 void pnThreads(const CpuKernelArgs& a, uint64_t first, uint64_t last) {
   const auto& p = a.paramsAs<gpu::PnParams>();
   const uint64_t nt = uint64_t(p.range.x) + p.range.y;
-  std::span<const Real> pos = a.array<const Real>(SFFD_BINDING_MESH_POSITIONS), nrm = a.array<const Real>(SFFD_BINDING_MESH_NORMALS);
+  // The vertices' range: positions, then the normals from element range.z (layout.h).
+  std::span<const Real> pos = a.array<const Real>(SFFD_BINDING_MESH_VERTICES);
+  std::span<const Real> nrm = pos.subspan(std::min<size_t>(pos.size(), 4 * size_t(p.range.z)));
   const uint32_t* tri = a.array<const uint32_t>(SFFD_BINDING_MESH_TRIANGLES, 4 * SFFD_MESH_TRIANGLE_STRIDE * nt).data();
   const Real* slots = a.array<const Real>(SFFD_BINDING_MESH_SLOT_NORMALS, 4 * SFFD_SLOT_NORMAL_STRIDE * nt).data();
   Real* out = a.array<Real>(SFFD_BINDING_PN_OUT, 4 * SFFD_PN_STRIDE * nt).data();
@@ -57,7 +59,7 @@ void pnRun(Backend& backend, const PreparedMesh& M, KernelVariant variant, size_
   const DeviceLimits& lim = backend.info().limits;
   const size_t nt = M.triangleCount(), nv = M.positions.size() / 4;
   const uint64_t vertexBytes = nv * 4 * sizeof(Real);
-  if (vertexBytes > lim.maxStorageBufferRange)
+  if (2 * vertexBytes > lim.maxStorageBufferRange)   // positions, then normals, in one range
     throw Error(ErrorKind::Input, "mesh has too many vertices for one storage binding on this device (" +
                                       std::to_string(nv) + " vertices)");
   // Per-triangle arrays go in chunks that fit one binding each; the largest is the PN record.
@@ -67,11 +69,9 @@ void pnRun(Backend& backend, const PreparedMesh& M, KernelVariant variant, size_
   if (maxChunk) chunk = std::min(chunk, maxChunk);
   chunk = std::max<size_t>(1, std::min(chunk, std::max<size_t>(nt, 1)));
 
-  std::vector<Real> pos = convertReals<Real>(M.positions), nrm = convertReals<Real>(M.normals);
-  BufferId bPos = backend.createBuffer(std::max<uint64_t>(vertexBytes, 16));
-  BufferId bNrm = backend.createBuffer(std::max<uint64_t>(vertexBytes, 16));
-  backend.upload(bPos, 0, pos.data(), vertexBytes);
-  backend.upload(bNrm, 0, nrm.data(), vertexBytes);
+  const std::vector<Real> verts = convertReals<Real>(meshVertexRange(M));
+  BufferId bVerts = backend.createBuffer(std::max<uint64_t>(2 * vertexBytes, 16));
+  backend.upload(bVerts, 0, verts.data(), 2 * vertexBytes);
   BufferId bTri = backend.createBuffer(chunk * 8 * sizeof(uint32_t));
   BufferId bSlot = backend.createBuffer(chunk * 48 * sizeof(Real));
   BufferId bOut = backend.createBuffer(chunk * perTriangle);
@@ -83,15 +83,14 @@ void pnRun(Backend& backend, const PreparedMesh& M, KernelVariant variant, size_
     backend.upload(bTri, 0, &M.triangles[8 * first], count * 8 * sizeof(uint32_t));
     backend.upload(bSlot, 0, slot.data(), count * 48 * sizeof(Real));
     gpu::PnParams params;
-    params.range = {0, uint32_t(count), 0, 0};
+    params.range = {0, uint32_t(count), uint32_t(nv), 0};
     Dispatch d;
     d.kernel = "pn_triangles";
     d.label = "pn";
     d.variant = variant;
     d.params = &params;
     d.paramsSize = sizeof(params);
-    d.buffers = {{SFFD_BINDING_MESH_POSITIONS, bPos}, {SFFD_BINDING_MESH_NORMALS, bNrm},
-                 {SFFD_BINDING_MESH_TRIANGLES, bTri}, {SFFD_BINDING_MESH_SLOT_NORMALS, bSlot},
+    d.buffers = {{SFFD_BINDING_MESH_VERTICES, bVerts}, {SFFD_BINDING_MESH_TRIANGLES, bTri}, {SFFD_BINDING_MESH_SLOT_NORMALS, bSlot},
                  {SFFD_BINDING_PN_OUT, bOut}};
     gridFor(count, lim, d.groups);
     backend.dispatch(d);
@@ -100,11 +99,17 @@ void pnRun(Backend& backend, const PreparedMesh& M, KernelVariant variant, size_
     std::copy(rec.begin(), rec.begin() + count * SFFD_PN_STRIDE * 4, out.records.begin() + first * SFFD_PN_STRIDE * 4);
   }
   backend.finish();
-  for (BufferId b : {bPos, bNrm, bTri, bSlot, bOut}) backend.destroyBuffer(b);
+  for (BufferId b : {bVerts, bTri, bSlot, bOut}) backend.destroyBuffer(b);
   out.timings = backend.takeTimings();
 }
 
 }  // namespace
+
+std::vector<double> meshVertexRange(const PreparedMesh& mesh) {
+  std::vector<double> v = mesh.positions;
+  v.insert(v.end(), mesh.normals.begin(), mesh.normals.end());
+  return v;
+}
 
 PnOutput pnTriangles(Backend& backend, const PreparedMesh& mesh, KernelVariant variant, size_t maxChunk) {
   if (variant.f64 && !backend.info().limits.float64)

@@ -15,6 +15,10 @@ struct PnOutput {
   double wallMs = 0;
 };
 
+// The mesh vertices' range as the pre-compute kernels read it (SFFD_BINDING_MESH_VERTICES): the
+// positions, then the normals from element mesh.positions.size() / 4 (PnParams/ClipParams range.z).
+std::vector<double> meshVertexRange(const PreparedMesh& mesh);
+
 // `maxChunk` (not 0) caps the triangles of one dispatch, to test chunking.
 PnOutput pnTriangles(Backend& backend, const PreparedMesh& mesh, KernelVariant variant, size_t maxChunk = 0);
 

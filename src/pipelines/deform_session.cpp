@@ -30,7 +30,7 @@ struct DeformSession::Impl {
   FitTable fit;
   size_t realSize = 4;
   std::vector<BufferId> owned;   // every buffer, destroyed with the session
-  BufferId table = 0, pos = 0, nrm = 0, tri = 0, slot = 0, pn = 0, clipHdr = 0, clipReal = 0, counts = 0;
+  BufferId table = 0, vertices = 0, tri = 0, slot = 0, pn = 0, clipHdr = 0, clipReal = 0, counts = 0;
   BufferId frame = 0, coeffs = 0, fitBuf = 0, samples = 0;
   size_t samplesCapacity = 0;
   struct ChunkBuffers { BufferId headers = 0, records = 0; size_t firstClip = 0, clipCount = 0; };
@@ -88,15 +88,14 @@ void DeformSession::prepare(const Mesh& input, const Lattice& lattice, const Sta
                                         std::to_string(lim.maxStorageBufferRange >> 20) + " MiB); use a coarser mesh");
   };
   const size_t nt = I.mesh.triangleCount();
-  fits(I.mesh.positions.size() * I.realSize, "vertices");
+  fits(2 * I.mesh.positions.size() * I.realSize, "vertices");
   fits(nt * SFFD_PN_STRIDE * 4 * I.realSize, "PN records");
   fits(I.mesh.slotNormals.size() * I.realSize, "slot normals");
   auto up = [&](const std::vector<double>& v) {
     std::vector<unsigned char> b = realBytes(v, f64);
     return I.upload(backend, b.data(), b.size());
   };
-  I.pos = up(I.mesh.positions);
-  I.nrm = up(I.mesh.normals);
+  I.vertices = up(meshVertexRange(I.mesh));
   I.slot = up(I.mesh.slotNormals);
   I.tri = I.upload(backend, I.mesh.triangles.data(), I.mesh.triangles.size() * 4);
   I.pn = I.make(backend, nt * SFFD_PN_STRIDE * 16 * (I.realSize / 4));
@@ -161,13 +160,12 @@ const SessionTimings& DeformSession::precompute(const StageProgress& progress) {
     const PackedTable& T = packedTable();
     params.table = {T.nmax, T.vertexWord, T.triangleWord, 0};
     params.target = {float(options_.edgeLength), 0, 0, 0};
-    params.range = {uint32_t(first), uint32_t(count), 0, 0};
+    params.range = {uint32_t(first), uint32_t(count), uint32_t(I.mesh.positions.size() / 4), 0};
     return params;
   };
   auto clipBindings = [&](std::vector<BufferBinding> extra) {
     std::vector<BufferBinding> b = {
-        {SFFD_BINDING_SPLIT_TABLE, I.table}, {SFFD_BINDING_MESH_POSITIONS, I.pos}, {SFFD_BINDING_MESH_NORMALS, I.nrm},
-        {SFFD_BINDING_MESH_TRIANGLES, I.tri}, {SFFD_BINDING_MESH_SLOT_NORMALS, I.slot}, {SFFD_BINDING_PN_OUT, I.pn},
+        {SFFD_BINDING_SPLIT_TABLE, I.table}, {SFFD_BINDING_MESH_VERTICES, I.vertices}, {SFFD_BINDING_MESH_TRIANGLES, I.tri}, {SFFD_BINDING_MESH_SLOT_NORMALS, I.slot}, {SFFD_BINDING_PN_OUT, I.pn},
         {SFFD_BINDING_CLIP_HEADERS, I.clipHdr}, {SFFD_BINDING_CLIP_REALS, I.clipReal}, {SFFD_BINDING_CLIP_COUNTS, I.counts}};
     b.insert(b.end(), extra.begin(), extra.end());
     return b;
@@ -175,9 +173,9 @@ const SessionTimings& DeformSession::precompute(const StageProgress& progress) {
   if (progress) progress("pn", 0.1);
   if (nt) {
     gpu::PnParams params;
-    params.range = {0, uint32_t(nt), 0, 0};
+    params.range = {0, uint32_t(nt), uint32_t(I.mesh.positions.size() / 4), 0};
     dispatch("pn_triangles", "pn", &params, sizeof(params), nt,
-             {{SFFD_BINDING_MESH_POSITIONS, I.pos}, {SFFD_BINDING_MESH_NORMALS, I.nrm}, {SFFD_BINDING_MESH_TRIANGLES, I.tri},
+             {{SFFD_BINDING_MESH_VERTICES, I.vertices}, {SFFD_BINDING_MESH_TRIANGLES, I.tri},
               {SFFD_BINDING_MESH_SLOT_NORMALS, I.slot}, {SFFD_BINDING_PN_OUT, I.pn}});
   }
   // Sub-triangle counts per chunk, and the chunk layout (a clip triangle's sub-triangles stay in one chunk).

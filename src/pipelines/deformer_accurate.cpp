@@ -1,7 +1,8 @@
 // Deformer, Method::Accurate: knot-box clipping on the host (once), the sub-triangles' flat corners
 // uploaded once in chunks; each deform() uploads the lattice's coefficients and runs kernels/accurate
 // (samples, control points, tessellation) into per-chunk output buffers that stay on the device
-// (per patch nv positions, all of the chunk's, then the normals from half the buffer).
+// (per patch nv positions, all of the chunk's, then the normals from half the buffer, then the
+// chunk's corners: one storage range for the kernel, layout.h).
 #include <algorithm>
 #include <chrono>
 
@@ -37,15 +38,14 @@ class AccurateRun final : public MethodRun {
     checkJobFits(est, packed, realBytes, &lim, r.memoryLimit, "DeformOptions::memoryLimit");
 
     params_ = packed.params;
-    frame_ = uploadReals(owned_, packed.frame, variant_.f64);
+    frame_ = accurateFrame(packed.frame, job_.degree, job_.level);   // the frame, then the patch tables
+    frameBuffer_ = uploadReals(owned_, frame_.reals, variant_.f64);
     coeffs_ = uploadReals(owned_, packed.coeffs, variant_.f64);
-    matrix_ = uploadReals(owned_, accurateKernelMatrix(job_.degree), variant_.f64);
-    basis_ = uploadReals(owned_, tessellationBasis(job_.degree, job_.level), variant_.f64);
     const size_t ns = job_.count(), chunk = accurateChunkPatches(lim, job_, realBytes, r.maxChunkElements);
     if (ns) {
-      // Scratch of one chunk, shared by all: the samples and the control points.
-      samples_ = makeBuffer(owned_, std::min(chunk, ns) * m * 4 * realBytes);
-      patches_ = makeBuffer(owned_, std::min(chunk, ns) * m * 4 * realBytes);
+      // Scratch of one chunk, shared by all: the samples, then the control points.
+      patchesAt_ = uint32_t(std::min(chunk, ns) * m);
+      scratch_ = makeBuffer(owned_, 2 * uint64_t(patchesAt_) * 4 * realBytes);
     }
     const size_t cw = 4 * SFFD_ACC_CORNER_STRIDE;
     for (size_t first = 0; first < ns; first += chunk) {
@@ -53,9 +53,10 @@ class AccurateRun final : public MethodRun {
       c.first = first;
       c.count = std::min(chunk, ns - first);
       c.half = alignUp(c.count * nv * 4 * realBytes, lim.storageOffsetAlignment);
-      c.corners = uploadReals(owned_, std::vector<double>(job_.corners.begin() + cw * first, job_.corners.begin() + cw * (first + c.count)),
-                              variant_.f64);
-      c.out = makeBuffer(owned_, 2 * c.half);
+      const std::vector<unsigned char> corners = sffd::realBytes(
+          std::vector<double>(job_.corners.begin() + cw * first, job_.corners.begin() + cw * (first + c.count)), variant_.f64);
+      c.out = makeBuffer(owned_, 2 * c.half + corners.size());
+      B_.upload(c.out, 2 * c.half, corners.data(), corners.size());
       chunks_.push_back(c);
       progress("prepare", 0.5 + 0.5 * double(first + c.count) / double(ns));
     }
@@ -66,16 +67,14 @@ class AccurateRun final : public MethodRun {
     PackedLattice packed = packLattice(lattice);
     std::vector<unsigned char> coeffs = realBytes(packed.coeffs, variant_.f64);
     B_.upload(coeffs_, 0, coeffs.data(), coeffs.size());
-    const uint64_t realBytes = variant_.f64 ? 8 : 4, nv = uint64_t(tessVertexCount(job_.level));
+    const uint32_t r4 = variant_.f64 ? 32 : 16;
     for (size_t i = 0; i < chunks_.size(); ++i) {
       const Chunk& c = chunks_[i];
-      const uint64_t bytes = c.count * nv * 4 * realBytes;
-      AccurateBindings b{{SFFD_BINDING_LATTICE_COEFFS, coeffs_}, {SFFD_BINDING_LATTICE_FRAME, frame_},
-                         {SFFD_BINDING_ACC_MATRIX, matrix_},      {SFFD_BINDING_ACC_TESS_BASIS, basis_},
-                         {SFFD_BINDING_ACC_CORNERS, c.corners},   {SFFD_BINDING_ACC_PATCHES, patches_},
-                         {SFFD_BINDING_ACC_POSITIONS, c.out, 0, bytes}, {SFFD_BINDING_ACC_NORMALS, c.out, c.half, bytes},
-                         {SFFD_BINDING_ACC_SAMPLES, samples_}};
-      dispatchAccurateChunk(B_, params_, variant_, job_, c.count, b);
+      const uint32_t normalsAt = uint32_t(c.half / r4);
+      AccurateBindings b{{SFFD_BINDING_LATTICE_COEFFS, coeffs_}, {SFFD_BINDING_LATTICE_FRAME, frameBuffer_},
+                         {SFFD_BINDING_ACC_CHUNK, c.out}, {SFFD_BINDING_ACC_SCRATCH, scratch_},
+                         normalsAt, 2 * normalsAt, patchesAt_};
+      dispatchAccurateChunk(B_, params_, variant_, job_, frame_, c.count, b);
       progress("deform", double(i + 1) / double(chunks_.size() + 1));
     }
     B_.finish();
@@ -115,8 +114,8 @@ class AccurateRun final : public MethodRun {
  private:
   struct Chunk {
     size_t first = 0, count = 0;
-    uint64_t half = 0;   // bytes from the positions to the normals
-    BufferId corners = 0, out = 0;
+    uint64_t half = 0;   // bytes from the positions to the normals, and from the normals to the corners
+    BufferId out = 0;
   };
   Backend& B_;
   OwnedBuffers owned_{B_};   // first: destroyed last, after everything that names its buffers
@@ -124,7 +123,9 @@ class AccurateRun final : public MethodRun {
   KernelVariant variant_;
   AccurateJob job_;
   gpu::LatticeParams params_;
-  BufferId frame_ = 0, coeffs_ = 0, matrix_ = 0, basis_ = 0, samples_ = 0, patches_ = 0;
+  AccurateFrame frame_;
+  BufferId frameBuffer_ = 0, coeffs_ = 0, scratch_ = 0;
+  uint32_t patchesAt_ = 0;   // the first control point in scratch_, after the samples
   std::vector<Chunk> chunks_;
 };
 

@@ -58,7 +58,7 @@ TEST(CpuBackend, KernelErrorsOnWorkerThreadsAreInternalErrors) {
   unsetenv("SFFD_CPU_THREADS");
   // 20000 triangles whose vertex ids run past the 3 vertices there are.
   const uint32_t nt = 20000;
-  std::vector<float> verts(12, 0.0f), slots(48 * size_t(nt), 0.0f);
+  std::vector<float> verts(24, 0.0f), slots(48 * size_t(nt), 0.0f);
   std::vector<uint32_t> tris(8 * size_t(nt));
   for (uint32_t t = 0; t < nt; ++t) tris[8 * t] = t, tris[8 * t + 1] = 1, tris[8 * t + 2] = 2;
   auto make = [&](const void* data, size_t bytes) {
@@ -66,16 +66,16 @@ TEST(CpuBackend, KernelErrorsOnWorkerThreadsAreInternalErrors) {
     b->upload(id, 0, data, bytes);
     return id;
   };
-  BufferId pos = make(verts.data(), verts.size() * 4), nrm = make(verts.data(), verts.size() * 4);
+  BufferId vertices = make(verts.data(), verts.size() * 4);   // 3 positions, then 3 normals
   BufferId tri = make(tris.data(), tris.size() * 4), slot = make(slots.data(), slots.size() * 4);
   BufferId out = b->createBuffer(size_t(nt) * SFFD_PN_STRIDE * 16);
   gpu::PnParams params;
-  params.range = {0, nt, 0, 0};
+  params.range = {0, nt, 3, 0};
   Dispatch d;
   d.kernel = "pn_triangles";
   d.params = &params;
   d.paramsSize = sizeof params;
-  d.buffers = {{SFFD_BINDING_MESH_POSITIONS, pos}, {SFFD_BINDING_MESH_NORMALS, nrm}, {SFFD_BINDING_MESH_TRIANGLES, tri},
+  d.buffers = {{SFFD_BINDING_MESH_VERTICES, vertices}, {SFFD_BINDING_MESH_TRIANGLES, tri},
                {SFFD_BINDING_MESH_SLOT_NORMALS, slot}, {SFFD_BINDING_PN_OUT, out}};
   gridFor(nt, b->info().limits, d.groups);
   try {
@@ -86,7 +86,7 @@ TEST(CpuBackend, KernelErrorsOnWorkerThreadsAreInternalErrors) {
     EXPECT_NE(std::string(e.what()).find("vertex id"), std::string::npos) << e.what();
   }
   // The backend still works: the first three triangles are valid.
-  params.range = {0, 3, 0, 0};
+  params.range = {0, 3, 3, 0};
   gridFor(3, b->info().limits, d.groups);
   b->dispatch(d);
   EXPECT_EQ(b->takeTimings().size(), 1u);
