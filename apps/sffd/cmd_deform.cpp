@@ -15,12 +15,18 @@
 namespace sffd::cli {
 namespace {
 
+// Round-trip digits of the results: 9 for float, 17 for double, or for float results computed
+// around a local origin away from 0 (their float bits are relative to it, docs/ROBUSTNESS.md).
+int outputDigits(const Deformer& deformer) {
+  return deformer.doublePrecision() || deformer.localOrigin() != glm::dvec3(0.0) ? 17 : 9;
+}
+
 // The patch file (docs/CLI.md "Patch files"): a header line, then per patch its parent triangle and
 // 10 geometry and 10 normal control points of the cubic triangular Bezier patch, one per line.
 void writePatchFile(const std::string& path, DeformRun& run, const std::vector<double>& controlPoints) {
   const PatchVertices patches = *run.patches();
   const size_t n = patches.patchCount();
-  const int digits = run.deformer.doublePrecision() ? 17 : 9;
+  const int digits = outputDigits(run.deformer);
   writeFileAtomically(path, [&](std::ostream& o) {
     char line[128];
     o << "sffd-patches 1 " << n << " 3\n";
@@ -50,9 +56,8 @@ int run(const ParsedArgs& args) {
   Device device = openDeviceFromArgs(args);
   DeformRun run = runDeformJob(args, job, device);
   const Timings& t = run.deformer.timings();
-  const bool f64 = run.deformer.doublePrecision();
   Mesh& deformed = run.mesh;
-  writeMesh(out, deformed, MeshWriteOptions{.significantDigits = f64 ? 17 : 9, .binary = args.has("--binary")});
+  writeMesh(out, deformed, MeshWriteOptions{.significantDigits = outputDigits(run.deformer), .binary = args.has("--binary")});
   if (args.has("--patches")) {
     std::vector<double> controlPoints = run.deformer.patchControlPoints();
     if (controlPoints.empty()) throw Error(ErrorKind::Input, "--patches needs --method smooth");
@@ -66,7 +71,7 @@ int run(const ParsedArgs& args) {
         {"device", device.info().name},
         {"method", run.method},
         {"clip", run.clip},
-        {"precision", f64 ? "double" : "float"},
+        {"precision", run.deformer.doublePrecision() ? "double" : "float"},
         {"strict", args.has("--strict")},
         {"input", {{"vertices", job.mesh.positions.size()}, {"triangles", job.mesh.triangles.size()}}},
         {"sub_triangles", run.deformer.subTriangles()},

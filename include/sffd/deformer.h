@@ -108,8 +108,14 @@ class Deformer {
   //             from offset + bytes / 2 their normals.
   //   Classic   per vertex a position (w: 1 inside the lattice box, 0 outside), then from
   //             offset + bytes / 2 the normals.
-  // Empty on a device that keeps nothing (the CPU reference).
+  // Empty on a device that keeps nothing (the CPU reference). Positions there are relative to
+  // localOrigin(): add it to place them in the world.
   std::vector<OutputChunk> deviceOutput() const;
+  // The point the devices compute around: the lattice box's centre rounded to a power of two 8 to 16
+  // times the box's size, so 0 unless the box lies several times its size away from the world origin.
+  // Mesh and lattice are moved by -localOrigin() in double before any device sees them and every
+  // result but deviceOutput() is moved back, so float precision does not depend on where a model sits.
+  glm::dvec3 localOrigin() const;
   bool doublePrecision() const;   // whether the reals above are doubles
   const DeformOptions& options() const;
   Device& device() const;

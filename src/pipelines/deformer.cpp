@@ -119,9 +119,18 @@ Deformer::Deformer(Device& device, const Mesh& mesh, const Lattice& lattice, con
     e.hostBytes += estimateLatticeBytes(lattice);
     checkHostFits(e, options.memoryLimit, kLimitName, "smooth job");
   }
-  if (r.method == Method::Smooth) I.run = makeSmoothRun(backend, I.input, lattice, r, I.timings, progress);
-  else if (r.method == Method::Classic) I.run = makeClassicRun(backend, I.input, lattice, r, I.timings, progress);
-  else I.run = makeAccurateRun(backend, I.input, lattice, r, I.timings, progress);
+  // The devices see the mesh and the lattice relative to the lattice box (deformer_local_frame.cpp).
+  I.origin = latticeLocalOrigin(lattice);
+  const bool moved = I.origin != glm::dvec3(0.0);
+  const Mesh movedMesh = moved ? translatedMesh(I.input, -I.origin) : Mesh{};
+  const Lattice movedLattice = moved ? localLattice(lattice, I.origin) : Lattice{};
+  const Mesh& localMesh = moved ? movedMesh : I.input;
+  const Lattice& localLattice = moved ? movedLattice : lattice;
+  std::unique_ptr<MethodRun> local;
+  if (r.method == Method::Smooth) local = makeSmoothRun(backend, localMesh, localLattice, r, I.timings, progress);
+  else if (r.method == Method::Classic) local = makeClassicRun(backend, localMesh, localLattice, r, I.timings, progress);
+  else local = makeAccurateRun(backend, localMesh, localLattice, r, I.timings, progress);
+  I.run = inLocalFrame(std::move(local), I.origin);
   progress("prepare", 1);
   I.timings.wallMs = msSince(t0);
 }
@@ -157,6 +166,7 @@ Mesh Deformer::result() const {
 std::vector<double> Deformer::patchControlPoints() const { return impl_->run->patchControlPoints(); }
 size_t Deformer::subTriangles() const { return impl_->run->subTriangles(); }
 std::vector<OutputChunk> Deformer::deviceOutput() const { return impl_->run->deviceOutput(); }
+glm::dvec3 Deformer::localOrigin() const { return impl_->origin; }
 bool Deformer::doublePrecision() const { return impl_->resolved.variant.f64; }
 const DeformOptions& Deformer::options() const { return impl_->options; }
 Device& Deformer::device() const { return *impl_->device; }

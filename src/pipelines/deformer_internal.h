@@ -75,6 +75,14 @@ std::unique_ptr<MethodRun> makeClassicRun(Backend& backend, const Mesh& input, c
 std::unique_ptr<MethodRun> makeAccurateRun(Backend& backend, const Mesh& input, const Lattice& lattice,
                                            const ResolvedOptions& options, Timings& timings, const ProgressReporter& progress);
 
+// Computing in coordinates local to the lattice box (deformer_local_frame.cpp): the origin of a
+// lattice's local frame (0 for a box near the world origin); a mesh moved by `by`; the lattice as the
+// devices see it around `origin` (control points and frame moved, its parameter space centred); and
+// a run on those local inputs whose results come out in world coordinates (deviceOutput() stays local).
+glm::dvec3 latticeLocalOrigin(const Lattice& lattice);
+Mesh translatedMesh(Mesh mesh, glm::dvec3 by);
+Lattice localLattice(Lattice lattice, glm::dvec3 origin);
+std::unique_ptr<MethodRun> inLocalFrame(std::unique_ptr<MethodRun> local, glm::dvec3 origin);
 
 struct Deformer::Impl {
   Device* device = nullptr;
@@ -82,6 +90,7 @@ struct Deformer::Impl {
   ResolvedOptions resolved;
   Mesh input;           // the mesh as the method uses it (smooth: creases applied); pre-images index its triangles
   Lattice structure;    // the lattice the Deformer was made for (its structure is what deform() checks)
+  glm::dvec3 origin{0.0};   // latticeLocalOrigin(structure): the devices compute relative to it
   Timings timings;
   std::unique_ptr<MethodRun> run;
 };

@@ -1,0 +1,104 @@
+// Models far from the origin (issue 12, item 2): the Deformer computes relative to the lattice box
+// (deformer_local_frame.cpp), so a mesh and its lattice moved by 1e5..1e7 units give, on every device,
+// the topology and (to float rounding of the model's size) the geometry of the untranslated run.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include <sffd/sffd.h>
+
+#include "backends/backend_test_support.h"
+#include "model/mesh_topology.h"
+#include "pipelines/deformer_internal.h"
+
+namespace {
+
+using namespace sffd;
+
+// A UV sphere of radius 1 (closed), or its part above z = -0.5 (open: one boundary loop).
+Mesh uvSphere(bool open) {
+  const int rings = 10, segments = 16;
+  std::vector<double> xyz;
+  std::vector<uint32_t> tri;
+  for (int r = 0; r <= rings; ++r)
+    for (int s = 0; s < segments; ++s) {
+      const double th = M_PI * r / rings, ph = 2 * M_PI * s / segments;
+      const double ring = r == 0 || r == rings ? 0.0 : std::sin(th);   // the poles exact, so welded
+      xyz.insert(xyz.end(), {ring * std::cos(ph), ring * std::sin(ph), r == rings ? -1.0 : std::cos(th)});
+    }
+  const int lastRing = open ? 7 : rings;
+  auto at = [&](int r, int s) { return uint32_t(r * segments + s % segments); };
+  for (int r = 0; r < lastRing; ++r)
+    for (int s = 0; s < segments; ++s) {
+      if (r > 0) tri.insert(tri.end(), {at(r, s), at(r + 1, s), at(r, s + 1)});
+      if (r + 1 < rings) tri.insert(tri.end(), {at(r, s + 1), at(r + 1, s), at(r + 1, s + 1)});
+    }
+  MeshView view;
+  view.positions = xyz.data();
+  view.vertexCount = xyz.size() / 3;
+  view.triangles = tri.data();
+  view.triangleCount = tri.size() / 3;
+  return meshFromView(view);
+}
+
+TEST(LocalFrame, OriginIsZeroNearTheWorldOriginAndTheBoxCentreFarFromIt) {
+  const Mesh sphere = uvSphere(false);
+  EXPECT_EQ(latticeLocalOrigin(fitLattice(sphere)), glm::dvec3(0.0));
+  const glm::dvec3 far = latticeLocalOrigin(fitLattice(translatedMesh(sphere, glm::dvec3(1e6, -3e5, 0.25))));
+  EXPECT_EQ(far, glm::dvec3(1e6, -3e5, 0.0));   // the nearest multiples of 32 (the box is about 2 wide)
+}
+
+TEST(LocalFrame, MeshesFarFromTheOriginKeepTheirTopologyAndGeometryOnEveryDevice) {
+  std::vector<std::string> devices = sffd::testing::requiredBackends();
+  if (std::find(devices.begin(), devices.end(), "cpu") == devices.end()) devices.push_back("cpu");
+  for (bool open : {false, true}) {
+    const Mesh mesh = uvSphere(open);
+    DeformOptions o;   // smooth, float, fast: the variant that lost the most far out
+    o.tess = 3;
+    o.edgeLength = 0.3;
+    for (const std::string& name : devices) {
+      DeviceRequest request;
+      request.name = name;
+      Device device = Device::open(request);
+      Mesh reference;
+      MeshTopology referenceTopology;
+      for (double t : {0.0, 1e5, 1e6, 1e7}) {
+        const glm::dvec3 by(t, -t, t);
+        const Mesh moved = translatedMesh(mesh, by);
+        Lattice lattice = fitLattice(moved, {4, 4, 4}, {2, 2, 2});
+        applyLatticePreset(lattice, "twist", 0.3);
+        Deformer deformer(device, moved, lattice, o);
+        deformer.deform(lattice);
+        const Mesh out = translatedMesh(deformer.result(), -by);
+        const MeshTopology topology = buildTopology(out);
+        const std::string what = name + (open ? " open" : " closed") + " at " + std::to_string(t);
+        if (t == 0) {
+          reference = out, referenceTopology = topology;
+          EXPECT_EQ(topology.nonManifoldEdges, 0u) << what;
+          EXPECT_EQ(topology.boundaryEdges == 0, !open) << what;
+          continue;
+        }
+        ASSERT_EQ(out.triangles.size(), reference.triangles.size()) << what;
+        EXPECT_EQ(topology.boundaryEdges, referenceTopology.boundaryEdges) << what;
+        EXPECT_EQ(topology.nonManifoldEdges, 0u) << what;
+        // Same vertices in the same order, within float rounding of the model's size (2): the
+        // untranslated run's error relative to the model is what the far ones have.
+        ASSERT_EQ(out.positions.size(), reference.positions.size()) << what;
+        double worst = 0;
+        for (size_t v = 0; v < out.positions.size(); ++v)
+          worst = std::max(worst, glm::length(out.positions[v] - reference.positions[v]));
+        EXPECT_LT(worst, 2e-5) << what;
+        // Consistently oriented: the enclosed volume keeps its sign (and size).
+        auto volume = [](const Mesh& m) {
+          double v = 0;
+          for (const auto& tr : m.triangles) v += glm::dot(m.positions[tr[0]], glm::cross(m.positions[tr[1]], m.positions[tr[2]]));
+          return v / 6;
+        };
+        EXPECT_NEAR(volume(out), volume(reference), 1e-4 * std::abs(volume(reference))) << what;
+      }
+    }
+  }
+}
+
+}  // namespace
