@@ -15,12 +15,6 @@
 namespace sffd::cli {
 namespace {
 
-// Round-trip digits of the results: 9 for float, 17 for double, or for float results computed
-// around a local origin away from 0 (their float bits are relative to it, docs/ROBUSTNESS.md).
-int outputDigits(const Deformer& deformer) {
-  return deformer.doublePrecision() || deformer.localOrigin() != glm::dvec3(0.0) ? 17 : 9;
-}
-
 // The patch file (docs/CLI.md "Patch files"): a header line, then per patch its parent triangle and
 // 10 geometry and 10 normal control points of the cubic triangular Bezier patch, one per line.
 void writePatchFile(const std::string& path, DeformRun& run, const std::vector<double>& controlPoints) {

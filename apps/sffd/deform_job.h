@@ -35,6 +35,11 @@ struct DeformRun {
 // method used it (creases split): the pre-images index its triangles. A progress line on stderr shows
 // how far it is (progress_line.h).
 DeformRun runMethod(const ParsedArgs& args, Job& job, Device& device, Method method);
+// Round-trip digits of the results when written as text: 9 for float, 17 for double, or for float
+// results computed around a local origin away from 0 (their float bits are relative to it,
+// docs/ROBUSTNESS.md).
+int outputDigits(const Deformer& deformer);
+
 // runMethod for --method, then the lattice's fold warning (after the work, so a job that fails prints
 // its one error line only; shown even with --quiet: it is about the result).
 DeformRun runDeformJob(const ParsedArgs& args, Job& job, Device& device);
