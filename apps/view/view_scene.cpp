@@ -74,7 +74,9 @@ void Scene::update(const Lattice& lattice, const SceneSettings& settings,
   times_.clipMs = t.clipMs;
   times_.deformMs = t.deformMs;
   subTriangles_ = deformer_->subTriangles();
-  if (smooth && zeroCopy_ && !settings.heatmap) {
+  // The device buffers hold positions relative to the Deformer's local origin (a model far from the
+  // world origin): those are drawn from the host copy, moved back, and the rest straight from the buffers.
+  if (smooth && zeroCopy_ && !settings.heatmap && deformer_->localOrigin() == glm::dvec3(0.0)) {
     drawSession({});
     path_ = "zero-copy";
   } else {
