@@ -389,6 +389,7 @@ class GlBackend final : public Backend {
     std::string what = std::string(kernel.name) + " (" + variantName(variant) + ")";
     if (variant.f64 && !info_.limits.float64) throw deviceError("gl: the device has no float64 for " + what);
 
+    CompileTrace trace("gl", kernel.name, variant);
     std::string src = glslForVariant(kernel, variant);
     fitVersion(src, ctx_->glVersion());
     GLuint shader = glCreateShader(GL_COMPUTE_SHADER);
