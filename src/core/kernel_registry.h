@@ -28,9 +28,10 @@ const EmbeddedKernel* findKernel(std::string_view name);
 // GLSL source of a variant for an OpenGL driver: the variant defines follow the #version line.
 std::string glslForVariant(const EmbeddedKernel& kernel, KernelVariant variant);
 
-// With SFFD_TRACE_COMPILE=1 in the environment, a backend's compilation of one kernel variant prints one
-// line `sffd: compile BACKEND KERNEL VARIANT: MS ms` to stderr when this goes out of scope, so a cold
-// start can be taken apart kernel by kernel (docs/PERFORMANCE.md "Cold start").
+// With SFFD_TRACE_COMPILE=1 in the environment, a backend's creation of one kernel variant (Vulkan
+// pipeline, GL program) prints one line `sffd: compile BACKEND KERNEL VARIANT: MS ms` to stderr when this
+// goes out of scope: which variants a run compiles and what creating each costs. llvmpipe and lavapipe
+// generate the machine code later, at the first dispatch (docs/PERFORMANCE.md "Cold start").
 class CompileTrace {
  public:
   CompileTrace(std::string_view backend, std::string_view kernel, KernelVariant variant);
