@@ -27,6 +27,8 @@ case "$MESA" in
   *) echo "sffd: error: MESA must be system, 25.0 or both" >&2; exit 2 ;;
 esac
 [ "$MESA" = system ] || { scripts/mesa.sh fetch >/dev/null; mkdir -p "$OUT/mesa-25.0"; }
+# A cold shader cache makes the first dispatch of a deform kernel long on lavapipe 25.0 (docs "Cold start").
+export SFFD_DEVICE_TIMEOUT=${SFFD_DEVICE_TIMEOUT:-600}
 want() { [ -z "$ONLY" ] || [ "$ONLY" = "$1" ]; }
 bench() {  # name mesh lattice normalize l tess [extra...]
   local name=$1 mesh=$2 lat=$3 norm=$4 l=$5 tess=$6 gen
