@@ -6,6 +6,8 @@
 #   scripts/performance.sh            all of it (about 10 minutes on 2 cores)
 #   REPEAT=5 BACKENDS=vulkan,gl,cpu   the defaults
 #   ONLY=tess                         rerun one group (models, faces, l, tess), then redo the tables and plots
+#   MESA=system|25.0|both             which Mesa generation: the system's (22.3 on Debian 12), the pinned 25.0
+#                                     of scripts/mesa.sh (JSON under out/perf/mesa-25.0/), or both side by side
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SFFD=${SFFD:-build/sffd}
@@ -17,12 +19,26 @@ OUT=out/perf
 mkdir -p "$OUT" docs/figures
 
 ONLY=${ONLY:-}
+MESA=${MESA:-system}
+case "$MESA" in
+  system) gens=(system) ;;
+  25.0) gens=(25.0) ;;
+  both) gens=(system 25.0) ;;
+  *) echo "sffd: error: MESA must be system, 25.0 or both" >&2; exit 2 ;;
+esac
+[ "$MESA" = system ] || { scripts/mesa.sh fetch >/dev/null; mkdir -p "$OUT/mesa-25.0"; }
+# A cold shader cache makes the first dispatch of a deform kernel long on lavapipe 25.0 (docs "Cold start").
+export SFFD_DEVICE_TIMEOUT=${SFFD_DEVICE_TIMEOUT:-600}
 want() { [ -z "$ONLY" ] || [ "$ONLY" = "$1" ]; }
 bench() {  # name mesh lattice normalize l tess [extra...]
-  local name=$1 mesh=$2 lat=$3 norm=$4 l=$5 tess=$6
+  local name=$1 mesh=$2 lat=$3 norm=$4 l=$5 tess=$6 gen
   shift 6
-  "$SFFD" bench "$D/$mesh" -l "$D/lattices/$lat" --normalize "$norm" --edge-length "$l" --tess "$tess" \
-    --backends "$BACKENDS" --repeat "$REPEAT" --json --quiet "$@" > "$OUT/$name.json"
+  local args=(bench "$D/$mesh" -l "$D/lattices/$lat" --normalize "$norm" --edge-length "$l" --tess "$tess"
+              --backends "$BACKENDS" --repeat "$REPEAT" --json --quiet "$@")
+  for gen in "${gens[@]}"; do
+    if [ "$gen" = system ]; then "$SFFD" "${args[@]}" > "$OUT/$name.json"
+    else scripts/mesa.sh run -- "$SFFD" "${args[@]}" > "$OUT/mesa-$gen/$name.json"; fi
+  done
 }
 
 # The benchmark model set (docs/PERFORMANCE.md "Models"): 5x5x5 degree-2 lattices, level 10.
@@ -39,24 +55,36 @@ want faces && for r in 4 8 16 26 53 80; do bench faces_$r "$TEAPOT" "$TEAPOT_L" 
 want l && for l in 0.4 0.2 0.1 0.05; do bench l_$l "$TEAPOT" "$TEAPOT_L" 0.9090909090909091 $l 10; done
 want tess && for n in 1 2 5 10 20 40; do bench tess_$n "$TEAPOT" "$TEAPOT_L" 0.9090909090909091 0.2 $n; done
 
-/usr/bin/python3 - "$OUT" <<'PY'
+/usr/bin/python3 - "$OUT" "${gens[@]}" <<'PY'
 import json, os, sys
 import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
-out = sys.argv[1]
-load = lambda n: json.load(open(os.path.join(out, n + ".json")))
+out, gens = sys.argv[1], sys.argv[2:]
+gen_dir = lambda g: out if g == "system" else os.path.join(out, "mesa-" + g)
+load_gen = lambda g, n: json.load(open(os.path.join(gen_dir(g), n + ".json")))
+load = lambda n: load_gen(gens[0], n)
 med = lambda run, k: run["stages_ms"][k]["median"]
 
-print("| model | input tris | sub-tris | output tris | backend | PN ms | clip ms | deform ms | cold first run ms | peak RSS MiB |")
-print("|---|---|---|---|---|---|---|---|---|---|")
-for n in ["teapot", os.environ["BIG"], "sphere", "teapot47k"]:
-    j = load(n)
-    for r in j["runs"]:
-        print("| %s | %d | %d | %d | %s | %.2f | %.2f | %.2f | %.0f | %.0f |" % (
-            n, j["input_triangles"], j["sub_triangles"], j["output_triangles"], r["backend"], med(r, "pn"),
-            med(r, "clip"), med(r, "deform"), r["cold_first_dispatch_ms"], r["peak_rss_mb"]))
-print()
+for g in gens:
+    print("Mesa: %s" % g)
+    print("| model | input tris | sub-tris | output tris | backend | driver | PN ms | clip ms | deform ms | cold first run ms | peak RSS MiB |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    for n in ["teapot", os.environ["BIG"], "sphere", "teapot47k"]:
+        j = load_gen(g, n)
+        for r in j["runs"]:
+            print("| %s | %d | %d | %d | %s | %s | %.2f | %.2f | %.2f | %.0f | %.0f |" % (
+                n, j["input_triangles"], j["sub_triangles"], j["output_triangles"], r["backend"], r.get("driver", ""),
+                med(r, "pn"), med(r, "clip"), med(r, "deform"), r["cold_first_dispatch_ms"], r["peak_rss_mb"]))
+    print()
+if len(gens) == 2:   # the teapot on both generations, side by side (same binary, same run of this script)
+    print("| backend | PN ms %s / %s | clip ms | deform ms | cold first run ms |" % tuple(gens))
+    print("|---|---|---|---|---|")
+    a, b = load_gen(gens[0], "teapot"), load_gen(gens[1], "teapot")
+    for ra, rb in zip(a["runs"], b["runs"]):
+        print("| %s | %s |" % (ra["backend"], " | ".join("%.2f / %.2f" % (med(ra, k), med(rb, k)) for k in ["pn", "clip", "deform"]))
+              + " %.0f / %.0f |" % (ra["cold_first_dispatch_ms"], rb["cold_first_dispatch_ms"]))
+    print()
 j = load("teapot_split")
 print("| backend | deform.sample | deform.fit | deform.adjust | deform.tessellate | sum |")
 print("|---|---|---|---|---|---|")

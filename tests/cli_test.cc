@@ -268,6 +268,7 @@ TEST(Cli, BenchJsonHasTheContractKeysOnEveryBackend) {
   for (const auto& run : j["runs"]) {
     backends.push_back(run["backend"]);
     EXPECT_EQ(run["repeat"], 3);
+    EXPECT_FALSE(run["driver"].get<std::string>().empty()) << run["backend"];
     EXPECT_GT(run["cold_first_dispatch_ms"].get<double>(), 0.0);
     EXPECT_GT(run["peak_rss_mb"].get<double>(), 1.0);
     for (const char* stage : {"pn", "clip", "deform", "total"}) {

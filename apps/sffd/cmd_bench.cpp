@@ -53,7 +53,7 @@ struct BenchSettings {
 };
 
 struct BackendResult {
-  std::string label, device;
+  std::string label, device, driver;   // driver: the version string, so figures name the Mesa generation
   double coldMs = 0;          // first pre-compute + deform, compilation included
   Series stages, host;        // GPU (or CPU) stage times; host wall times
   size_t subTriangles = 0;
@@ -77,6 +77,7 @@ BackendResult benchDevice(Device& device, const Job& job, const BenchSettings& S
   BackendResult r;
   r.label = device.label();
   r.device = device.info().name;
+  r.driver = device.info().driver;
   auto t0 = std::chrono::steady_clock::now();
   Deformer deformer(device, job.mesh, job.lattice, S.options);
   deformer.deform(job.lattice);
@@ -152,7 +153,8 @@ int run(const ParsedArgs& args) {
                                 {"output_triangles", subs * size_t(tessTriangleCount(o.tess))},
                                 {"runs", nlohmann::ordered_json::array()}};
     for (const BackendResult& r : results) {
-      nlohmann::ordered_json run = {{"backend", r.label}, {"device", r.device}, {"repeat", S.repeat},
+      nlohmann::ordered_json run = {{"backend", r.label}, {"device", r.device}, {"driver", r.driver},
+                                    {"repeat", S.repeat},
                                     {"cold_first_dispatch_ms", r.coldMs}};
       nlohmann::ordered_json stages = nlohmann::ordered_json::object(), host = nlohmann::ordered_json::object();
       for (const std::string& k : r.stages.order) stages[k] = summary(r.stages.values.at(k));
@@ -170,7 +172,7 @@ int run(const ParsedArgs& args) {
               subs * size_t(tessTriangleCount(o.tess)), o.tess);
   std::printf("median of %d runs after %d warm-up, min..max in brackets; GPU timestamps (cpu: wall clock)\n", S.repeat, S.warmup);
   for (const BackendResult& r : results) {
-    std::printf("%-10s %s\n", r.label.c_str(), r.device.c_str());
+    std::printf("%-10s %s, %s\n", r.label.c_str(), r.device.c_str(), r.driver.c_str());
     auto line = [&](const Series& s, const std::string& k) {
       nlohmann::ordered_json m = summary(s.values.at(k));
       std::printf("  %-20s %9.3f ms  [%.3f .. %.3f]\n", k.c_str(), m["median"].get<double>(), m["min"].get<double>(),

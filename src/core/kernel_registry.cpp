@@ -1,6 +1,8 @@
 #include "core/kernel_registry.h"
 
 #include <algorithm>
+#include <cstdio>
+#include <cstdlib>
 
 #include "kernels/common/shader_layout.h"
 
@@ -37,6 +39,20 @@ void gridFor(uint64_t threads, const DeviceLimits& limits, uint32_t groups[3]) {
   groups[0] = static_cast<uint32_t>(x);
   groups[1] = static_cast<uint32_t>(y);
   groups[2] = 1;
+}
+
+CompileTrace::CompileTrace(std::string_view backend, std::string_view kernel, KernelVariant variant) {
+  const char* on = std::getenv("SFFD_TRACE_COMPILE");
+  if (!on || !*on || std::string_view(on) == "0") return;
+  what_ = std::string(backend) + " " + std::string(kernel) + (variant.strict ? " strict" : " fast") +
+          (variant.f64 ? " f64" : " f32");
+  start_ = std::chrono::steady_clock::now();
+}
+
+CompileTrace::~CompileTrace() {
+  if (what_.empty()) return;
+  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start_).count();
+  std::fprintf(stderr, "sffd: compile %s: %.1f ms\n", what_.c_str(), ms);
 }
 
 }  // namespace sffd

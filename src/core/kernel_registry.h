@@ -4,6 +4,7 @@
 #pragma once
 #include <cstddef>
 #include <cstdint>
+#include <chrono>
 #include <span>
 #include <string>
 #include <string_view>
@@ -27,5 +28,21 @@ std::span<const EmbeddedKernel> embeddedKernels();
 const EmbeddedKernel* findKernel(std::string_view name);
 // GLSL source of a variant for an OpenGL (es: OpenGL ES) driver: the variant defines follow the #version line.
 std::string glslForVariant(const EmbeddedKernel& kernel, KernelVariant variant, bool es = false);
+
+// With SFFD_TRACE_COMPILE=1 in the environment, a backend's creation of one kernel variant (Vulkan
+// pipeline, GL program) prints one line `sffd: compile BACKEND KERNEL VARIANT: MS ms` to stderr when this
+// goes out of scope: which variants a run compiles and what creating each costs. llvmpipe and lavapipe
+// generate the machine code later, at the first dispatch (docs/PERFORMANCE.md "Cold start").
+class CompileTrace {
+ public:
+  CompileTrace(std::string_view backend, std::string_view kernel, KernelVariant variant);
+  ~CompileTrace();
+  CompileTrace(const CompileTrace&) = delete;
+  CompileTrace& operator=(const CompileTrace&) = delete;
+
+ private:
+  std::string what_;   // empty: tracing is off
+  std::chrono::steady_clock::time_point start_;
+};
 
 }  // namespace sffd

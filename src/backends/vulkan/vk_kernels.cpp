@@ -66,6 +66,7 @@ VkPipeline Kernels::pipeline(std::string_view kernel, KernelVariant variant) {
 
   const Api& api = device_.api();
   VkDevice dev = device_.handle();
+  CompileTrace trace("vulkan", kernel, variant);
   auto mi = vkStruct<VkShaderModuleCreateInfo>(VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO);
   mi.codeSize = k->spirvWords[v] * sizeof(uint32_t);
   mi.pCode = k->spirv[v];
