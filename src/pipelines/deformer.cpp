@@ -122,9 +122,9 @@ Deformer::Deformer(Device& device, const Mesh& mesh, const Lattice& lattice, con
   // The devices see the mesh and the lattice relative to the lattice box (deformer_local_frame.cpp).
   I.origin = latticeLocalOrigin(lattice);
   const bool moved = I.origin != glm::dvec3(0.0);
-  const Mesh movedMesh = moved ? translatedMesh(I.input, -I.origin) : Mesh{};
+  if (moved) I.localInput = translatedMesh(I.input, -I.origin);
   const Lattice movedLattice = moved ? localLattice(lattice, I.origin) : Lattice{};
-  const Mesh& localMesh = moved ? movedMesh : I.input;
+  const Mesh& localMesh = moved ? I.localInput : I.input;
   const Lattice& localLattice = moved ? movedLattice : lattice;
   std::unique_ptr<MethodRun> local;
   if (r.method == Method::Smooth) local = makeSmoothRun(backend, localMesh, localLattice, r, I.timings, progress);

@@ -91,6 +91,9 @@ struct Deformer::Impl {
   Mesh input;           // the mesh as the method uses it (smooth: creases applied); pre-images index its triangles
   Lattice structure;    // the lattice the Deformer was made for (its structure is what deform() checks)
   glm::dvec3 origin{0.0};   // latticeLocalOrigin(structure): the devices compute relative to it
+  // `input` moved by -origin when the origin is not 0 (else empty): the runs keep a reference to the
+  // mesh they were made with (for its texture coordinates, colours and materials), so it lives here.
+  Mesh localInput;
   Timings timings;
   std::unique_ptr<MethodRun> run;
 };
