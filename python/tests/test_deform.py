@@ -179,7 +179,8 @@ def test_every_device_gives_the_cpu_bits_in_strict_mode(sphere, label):
     # only classic FFD's pipeline fits so far (smooth and accurate need the clipping kernels; docs/GLES.md):
     # there classic FFD's bits are compared.
     method = "classic" if label == "gles" else "smooth"
-    ref = sffd.deform(v, t, lat, backend="cpu", tess=3, strict=True, method=method)
-    got = sffd.deform(v, t, lat, backend=label, tess=3, strict=True, method=method)
+    # float on every device (classic FFD on the CPU otherwise computes in double: "auto")
+    ref = sffd.deform(v, t, lat, backend="cpu", tess=3, strict=True, method=method, precision="float")
+    got = sffd.deform(v, t, lat, backend=label, tess=3, strict=True, method=method, precision="float")
     for a, b in zip(ref, got):
         np.testing.assert_array_equal(a, b)
