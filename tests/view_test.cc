@@ -13,6 +13,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <nlohmann/json.hpp>
+
 #include "apps/render/gl_renderer.h"
 #include "tests/support/cli_runner.h"
 
@@ -83,6 +85,33 @@ Diff compare(const sffd::gl::Image& a, const sffd::gl::Image& b) {
   d.meanAbs = sum / (3.0 * n);
   d.farShare = double(far) / n;
   return d;
+}
+
+// Between press and release the moves are drafts (level --draft-tess, no multisampling); release draws
+// the full result, the same pixels as a session that never drafted.
+TEST(View, DraftsWhileDraggingThenFullQualityOnRelease) {
+  NEED_X(x);
+  fs::path dir = freshDir("draft");
+  fs::path lat = makeLattice(dir);
+  const std::string moves = "drag 1 1 3 0 0 0.1\ndrag 1 1 3 0 0 0.1\ndrag 1 1 3 0 0 0.15\n";
+  writeFile(dir / "drafts.txt", "resize 320 240\nset hud off\nset lattice off\npress\n" + moves +
+                                    "screenshot during.png\nrelease\nframe\nscreenshot after.png\n");
+  writeFile(dir / "plain.txt", "resize 320 240\nset hud off\nset lattice off\n" + moves + "screenshot plain.png\n");
+  const std::string common = "view " + kSphere + " -l " + lat.string() + " --out-dir " + dir.string() + " --width 320 --height 240 ";
+  Result r = run(common + "--replay " + (dir / "drafts.txt").string() + " --stats " + (dir / "drafts.json").string(), dir, x);
+  ASSERT_EQ(r.status, 0) << r.err;
+  Result p = run(common + "--replay " + (dir / "plain.txt").string() + " --stats " + (dir / "plain.json").string(), dir, x);
+  ASSERT_EQ(p.status, 0) << p.err;
+  const auto drafts = nlohmann::json::parse(slurp(dir / "drafts.json"));
+  const auto plain = nlohmann::json::parse(slurp(dir / "plain.json"));
+  EXPECT_EQ(drafts["draft_level"], 3);
+  EXPECT_EQ(drafts["draft_frames"], 3) << drafts.dump();   // one a drag
+  EXPECT_EQ(plain["draft_frames"], 0) << plain.dump();
+  // After release the picture is the full-quality one; during the gesture it is not.
+  auto after = sffd::gl::readPng((dir / "after.png").string()), full = sffd::gl::readPng((dir / "plain.png").string());
+  EXPECT_EQ(after.rgba, full.rgba);
+  EXPECT_GT(compare(sffd::gl::readPng((dir / "during.png").string()), full).meanAbs, 0.0);
+  EXPECT_NE(run(common + "--draft-tess 65 --replay " + (dir / "plain.txt").string(), dir, x).status, 0);
 }
 
 TEST(View, ReplayScreenshotsMatchRender) {

@@ -48,6 +48,15 @@ int run(const ParsedArgs& args) {
   cfg.quiet = args.has("--quiet");
   auto opt = [&](const char* o) { return args.has(o) ? std::optional<std::string>(args.get(o)) : std::nullopt; };
   checkSizeOptions(opt("--edge-length"), opt("--tess"));
+  if (args.has("--draft-tess")) {
+    const std::string d = args.get("--draft-tess");
+    int n = -1;
+    auto [p, ec] = std::from_chars(d.data(), d.data() + d.size(), n);
+    if (ec != std::errc() || p != d.data() + d.size() || n < 0 || n > kMaxTessLevel)
+      throw usageError("--draft-tess must be an integer 0.." + std::to_string(kMaxTessLevel) + ", not '" + d +
+                       "' (0: full quality while dragging too)");
+    cfg.draftLevel = n;
+  }
 
   // The job: the mesh and its lattice, or an identity 5x5x5 quadratic lattice around the mesh.
   Job job;
@@ -124,6 +133,7 @@ CommandSpec viewCommand() {
       {"--wireframe", nullptr, "start with the triangle edges drawn"},
       {"--replay", "SCRIPT", "run the commands of SCRIPT (one a line, see docs/CLI.md), then exit"},
       {"--out-dir", "DIR", "where screenshots and saved files go, and relative script paths point (default .)"},
+      {"--draft-tess", "N", "tessellation level while dragging lattice points, drawn without multisampling; full quality on release (default 3; 0: always full)"},
   };
   for (const OptionSpec& o : jobOptions()) {
     std::string n = o.name;

@@ -64,6 +64,13 @@ class App {
   enum class Mouse { None, Orbit, Pan, DragPoints, Box };
   void redeform();
   void drawFrame(bool present);
+  // A gesture is in progress (a mouse button held, or a script's press before its release): frames are
+  // drafts, so that dragging stays interactive on a CPU device.
+  bool interacting() const { return mouse_ != Mouse::None || scriptPress_; }
+  // What is drawn is not what should be: the lattice or the settings changed, or a draft outlived its gesture.
+  bool stale() const {
+    return deformedVersion_ != edit_.version() || settingsDirty_ || (scene_->drawingDraft() && !interacting());
+  }
   void fit();
   void progress(const std::string& what);
   void status(const std::string& what, bool toStderr = true);
@@ -96,14 +103,15 @@ class App {
   int fbW_ = 0, fbH_ = 0;
   bool showEdges_ = false, showNormals_ = false, showLattice_ = true, showHud_ = true;
   size_t deformedVersion_ = size_t(-1);
-  bool settingsDirty_ = true, quit_ = false;
+  bool settingsDirty_ = true, quit_ = false, scriptPress_ = false;
   std::string foldText_, statusText_;
   Clock::time_point statusAt_{};
   int screenshotCount_ = 0;
   // timing
   double lastFrameMs_ = 0, lastDrawMs_ = 0, pendingUpdateMs_ = 0;
   bool deformedThisFrame_ = false;
-  std::vector<double> frameMs_, drawMs_, deformMs_, updateMs_;
+  std::vector<double> frameMs_, drawMs_, deformMs_, updateMs_;   // full-quality frames that re-deformed
+  std::vector<double> draftFrameMs_;                                 // draft frames that re-deformed
   // mouse
   Mouse mouse_ = Mouse::None;
   glm::dvec2 mouseAt_{0}, boxFrom_{0};
@@ -120,7 +128,7 @@ App::App(ViewConfig& c)
   renderer_ = std::make_unique<gl::Renderer>(c.window);
   c.window->activate();
   overlays_ = std::make_unique<Overlays>();
-  scene_ = std::make_unique<Scene>(*renderer_, *c.device, c.zeroCopy, c.sessionMesh, c.options);
+  scene_ = std::make_unique<Scene>(*renderer_, *c.device, c.zeroCopy, c.sessionMesh, c.options, c.draftLevel);
   glfwGetFramebufferSize(window_, &fbW_, &fbH_);
   if (fbW_ <= 0 || fbH_ <= 0) fbW_ = ro_.width, fbH_ = ro_.height;
   glfwSetWindowUserPointer(window_, this);
@@ -188,6 +196,8 @@ void App::checkFold() {
 
 void App::redeform() {
   const bool first = deformedVersion_ == size_t(-1);
+  // Only a move of the lattice during a gesture is drawn as a draft: orbiting keeps the full result.
+  settings_.draft = interacting() && (deformedVersion_ != edit_.version() || scene_->drawingDraft());
   try {
     scene_->update(edit_.lattice(), settings_, [this](const std::string& s) { progress(s); });
   } catch (const Error& e) {
@@ -221,7 +231,8 @@ void App::drawFrame(bool present) {
   const auto t0 = Clock::now();
   renderer_->context().activate();
   camera_.apply(ro_);
-  target_.bind(fbW_, fbH_);
+  const bool draft = interacting();
+  target_.bind(fbW_, fbH_, draft && cfg_.draftLevel > 0 ? 1 : 4);   // no multisampling while dragging
   std::vector<gl::SlotCamera> cams = renderer_->draw(ro_, fbW_, fbH_);
   if (!cams.empty()) lastCam_ = cams[0], haveCam_ = true;
   if (haveCam_) {
@@ -235,7 +246,8 @@ void App::drawFrame(bool present) {
     std::vector<std::string> lines = {
         "FRAME " + fmt("%.1f", lastFrameMs_) + " MS  (DRAW " + fmt("%.1f", lastDrawMs_) + ")",
         "PN " + fmt("%.2f", t.pnMs) + "  CLIP " + fmt("%.2f", t.clipMs) + "  DEFORM " + fmt("%.2f", t.deformMs) + " MS",
-        upper(settings_.method + " / " + settings_.clip + " / " + scene_->path() + " / " + cfg_.backendLabel),
+        upper(settings_.method + " / " + settings_.clip + " / " + scene_->path() + " / " + cfg_.backendLabel) +
+            (scene_->drawingDraft() ? "  DRAFT LEVEL " + std::to_string(scene_->level()) : ""),
         std::to_string(scene_->subTriangles()) + " SUB-TRIANGLES, " + std::to_string(scene_->outputTriangles()) +
             " TRIANGLES",
         "SELECTED " + std::to_string(edit_.selection().size()) + (settings_.heatmap ? "  HEAT MAP: GEOMETRY ERROR" : ""),
@@ -253,7 +265,9 @@ void App::drawFrame(bool present) {
   glFinish();   // frame time includes the GPU's work (llvmpipe and lavapipe draw asynchronously too)
   lastDrawMs_ = msSince(t0);
   lastFrameMs_ = lastDrawMs_ + (deformedThisFrame_ ? pendingUpdateMs_ : 0);
-  if (deformedThisFrame_) {
+  if (deformedThisFrame_ && scene_->drawingDraft()) {
+    draftFrameMs_.push_back(lastFrameMs_);
+  } else if (deformedThisFrame_) {
     frameMs_.push_back(lastFrameMs_);
     drawMs_.push_back(lastDrawMs_);
     deformMs_.push_back(scene_->times().deformMs);
@@ -281,18 +295,22 @@ int App::run() {
       glfwPollEvents();
     } else {
       if (glfwWindowShouldClose(window_)) break;
-      const bool busy = mouse_ != Mouse::None || deformedVersion_ != edit_.version() || settingsDirty_;
+      const bool busy = mouse_ != Mouse::None || stale();
       if (busy) glfwPollEvents();
       else glfwWaitEventsTimeout(0.25);
     }
-    if (deformedVersion_ != edit_.version() || settingsDirty_) redeform();
+    if (stale()) redeform();
     drawFrame(true);
   }
   // Statistics of the frames that re-deformed (a move, a setting).
   Summary f = summarize(frameMs_), d = summarize(deformMs_), g = summarize(drawMs_), u = summarize(updateMs_);
+  Summary df = summarize(draftFrameMs_);
   if (!cfg_.quiet && !frameMs_.empty())
     std::fprintf(stderr, "sffd: view: %zu frames with a deformation: median frame %.1f ms (update %.1f ms, deform stage %.2f ms, draw %.1f ms), %s path\n",
                  frameMs_.size(), f.median, u.median, d.median, g.median, scene_->path().c_str());
+  if (!cfg_.quiet && !draftFrameMs_.empty())
+    std::fprintf(stderr, "sffd: view: %zu draft frames while dragging (level %d, no multisampling): median frame %.1f ms\n",
+                 draftFrameMs_.size(), cfg_.draftLevel, df.median);
   if (!cfg_.statsPath.empty()) {
     auto stat = [](const Summary& s) {
       return "{\"median\": " + fmt("%.3f", s.median) + ", \"min\": " + fmt("%.3f", s.min) + ", \"max\": " + fmt("%.3f", s.max) + "}";
@@ -303,7 +321,8 @@ int App::run() {
         << ", \"sub_triangles\": " << scene_->subTriangles() << ", \"output_triangles\": " << scene_->outputTriangles()
         << ", \"frames\": " << frameMs_.size() << ", \"frame_ms\": " << stat(f) << ", \"update_ms\": " << stat(u)
         << ", \"deform_ms\": " << stat(d) << ", \"draw_ms\": " << stat(g) << ", \"pn_ms\": " << fmt("%.3f", scene_->times().pnMs)
-        << ", \"clip_ms\": " << fmt("%.3f", scene_->times().clipMs) << "}\n";
+        << ", \"clip_ms\": " << fmt("%.3f", scene_->times().clipMs) << ", \"draft_level\": " << cfg_.draftLevel
+        << ", \"draft_frames\": " << draftFrameMs_.size() << ", \"draft_frame_ms\": " << stat(df) << "}\n";
     if (!out) throw inputError(cfg_.statsPath, 0, "cannot write the statistics");
   }
   return 0;
@@ -419,7 +438,7 @@ void App::execute(const Command& c) {
   } else if (v == "zoom") {
     camera_.zoom(c.numbers[0]);
   } else if (v == "fit") {
-    if (deformedVersion_ != edit_.version() || settingsDirty_) redeform();
+    if (stale()) redeform();
     fit();
   } else if (v == "resize") {
     const int w = int(c.numbers[0]), h = int(c.numbers[1]);
@@ -437,7 +456,7 @@ void App::execute(const Command& c) {
       std::fprintf(stderr, "sffd: warning: %s: the window has no pixels (minimised); no screenshot\n", path.c_str());
       return;
     }
-    if (deformedVersion_ != edit_.version() || settingsDirty_) redeform();
+    if (stale()) redeform();
     drawFrame(false);
     renderer_->context().activate();
     gl::writePng(path, target_.read());
@@ -456,13 +475,19 @@ void App::execute(const Command& c) {
     status("loaded " + path);
   } else if (v == "save-mesh") {
     const std::string path = resolve(c.words[0], "sffd-view-mesh.obj");
-    if (deformedVersion_ != edit_.version() || settingsDirty_) redeform();
+    if (stale()) redeform();
     writeMesh(path, scene_->resultMesh(), 9);
     status("wrote " + path);
   } else if (v == "key") {
     auto k = keyCommand(c.words[0]);
     need(k.has_value(), "'" + c.words[0] + "' is not a bound key");
     execute(*k);
+  } else if (v == "press") {
+    scriptPress_ = true;   // as a mouse button held: the frames until release are drafts
+    edit_.beginGesture();
+  } else if (v == "release") {
+    scriptPress_ = false;
+    edit_.endGesture();
   } else if (v == "quit") {
     quit_ = true;
   }

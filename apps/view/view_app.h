@@ -23,6 +23,7 @@ struct ViewConfig {
   std::string meshName, latticeName;
   gl::RenderOptions render;               // window size, view direction, up axis, wireframe
   SceneSettings settings;
+  int draftLevel = 3;                     // tessellation level while dragging (no multisampling); 0: full quality
   std::string replayPath;                 // run this script, then exit
   std::string outDir = ".";               // where S, Ctrl+S, O and relative script paths write
   std::string statsPath;                  // frame-time statistics (JSON) at exit

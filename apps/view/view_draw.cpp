@@ -113,15 +113,16 @@ void FrameTarget::release() {
   for (unsigned rb : {msColor_, msDepth_, color_})
     if (rb) glDeleteRenderbuffers(1, &rb);
   msFbo_ = msColor_ = msDepth_ = fbo_ = color_ = 0;
-  width_ = height_ = 0;
+  width_ = height_ = samples_ = 0;
 }
 
-void FrameTarget::bind(int width, int height) {
-  if (width != width_ || height != height_ || !msFbo_) {
+void FrameTarget::bind(int width, int height, int wanted) {
+  if (width != width_ || height != height_ || wanted != samples_ || !msFbo_) {
     release();
     GLint maxSamples = 1;
     glGetIntegerv(GL_MAX_SAMPLES, &maxSamples);
-    const int samples = std::clamp(4, 1, std::max(maxSamples, 1));   // as `sffd render` (RenderOptions::samples)
+    // 1 asks for no multisampling at all (0 samples: a plain buffer, the resolve a copy).
+    const int samples = wanted > 1 && maxSamples > 1 ? std::min(wanted, int(maxSamples)) : 0;
     glGenFramebuffers(1, &msFbo_);
     glGenRenderbuffers(1, &msColor_);
     glGenRenderbuffers(1, &msDepth_);
@@ -147,6 +148,7 @@ void FrameTarget::bind(int width, int height) {
     }
     width_ = width;
     height_ = height;
+    samples_ = wanted;
   }
   glBindFramebuffer(GL_FRAMEBUFFER, msFbo_);
 }

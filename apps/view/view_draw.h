@@ -1,7 +1,7 @@
 // The viewer's own GL drawing, on the window's context next to the Renderer (gl_renderer.h):
 //  - FrameTarget: each frame is drawn into a 4x multisampled framebuffer (as `sffd render` draws its
-//    pictures), resolved, then copied to the window; screenshots read the resolved pixels, so they are
-//    what the window shows;
+//    pictures; a draft frame while dragging into a single-sampled one), resolved, then copied to the
+//    window; screenshots read the resolved pixels, so they are what the window shows;
 //  - Overlays: lattice points and edges, the box-selection rectangle, and, from tessellation buffers
 //    (DeformSession's layout: per patch nv float4 positions, then nv float4 normals), the sub-triangle
 //    edges and the vertex normals.
@@ -23,8 +23,9 @@ class FrameTarget {
   ~FrameTarget();
   FrameTarget(const FrameTarget&) = delete;
   FrameTarget& operator=(const FrameTarget&) = delete;
-  // Binds a width x height multisampled target (recreated on a size change; sizes must be >= 1).
-  void bind(int width, int height);
+  // Binds a width x height target of `samples` samples a pixel (clamped to GL_MAX_SAMPLES; recreated
+  // when either changes; sizes must be >= 1).
+  void bind(int width, int height, int samples = 4);
   // Resolves the samples; then copies to the window's framebuffer (0) when `toWindow`.
   void resolve(bool toWindow);
   gl::Image read() const;   // the resolved pixels, rows from the top
@@ -33,7 +34,7 @@ class FrameTarget {
 
  private:
   void release();
-  int width_ = 0, height_ = 0;
+  int width_ = 0, height_ = 0, samples_ = 0;
   unsigned msFbo_ = 0, msColor_ = 0, msDepth_ = 0, fbo_ = 0, color_ = 0;
 };
 

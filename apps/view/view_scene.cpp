@@ -31,14 +31,23 @@ std::vector<float> geometryErrors(const Mesh& input, const Lattice& lattice, con
   return out;
 }
 
-Scene::Scene(gl::Renderer& renderer, Device& device, bool zeroCopy, Mesh mesh, DeformOptions options)
-    : renderer_(renderer), device_(device), zeroCopy_(zeroCopy), mesh_(std::move(mesh)), options_(std::move(options)), level_(options_.tess) {
+Scene::Scene(gl::Renderer& renderer, Device& device, bool zeroCopy, Mesh mesh, DeformOptions options, int draftLevel)
+    : renderer_(renderer),
+      device_(device),
+      zeroCopy_(zeroCopy),
+      mesh_(std::move(mesh)),
+      options_(std::move(options)),
+      level_(options_.tess),
+      draftLevel_(draftLevel > 0 && draftLevel < level_ ? draftLevel : 0),
+      activeLevel_(level_) {
   glm::dvec3 lo(1e300), hi(-1e300);
   for (const auto& p : mesh_.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
   if (!mesh_.positions.empty()) normalLength_ = float(0.03 * glm::length(hi - lo));
 }
 
 Scene::~Scene() {
+  active_ = nullptr;
+  draft_.reset();
   deformer_.reset();
   try {
     renderer_.context().activate();
@@ -61,32 +70,49 @@ void Scene::update(const Lattice& lattice, const SceneSettings& settings,
                std::to_string(mesh_.triangles.size()) + " TRIANGLES");
     else if (progress && !drawn_.positions.size())
       progress("PREPARING: " + settings.method + " FFD");
+    active_ = nullptr;
+    draft_.reset();
     deformer_.reset();
-    DeformOptions o = options_;
-    o.method = smooth ? Method::Smooth : settings.method == "accurate" ? Method::Accurate : Method::Classic;
-    o.clip = knotBox ? Clip::KnotBox : Clip::Regular;
-    deformer_ = std::make_unique<Deformer>(device_, mesh_, lattice, o);
+    deformer_ = makeDeformer(lattice, settings, level_);
     deformerLattice_ = lattice;
     deformerSettings_ = settings;
   }
-  const Timings& t = deformer_->deform(lattice);
+  // A draft: the same method at a lower level, so that a frame while dragging draws a tenth of the
+  // triangles (classic FFD has no level).
+  const bool draft = settings.draft && draftLevel_ > 0 && settings.method != "classic";
+  if (draft && !draft_) {
+    if (progress) progress("PREPARING THE DRAFT (LEVEL " + std::to_string(draftLevel_) + ") SHOWN WHILE DRAGGING");
+    draft_ = makeDeformer(lattice, settings, draftLevel_);
+  }
+  active_ = draft ? draft_.get() : deformer_.get();
+  activeLevel_ = draft ? draftLevel_ : level_;
+  Deformer& deformer = *active_;
+  const Timings& t = deformer.deform(lattice);
   times_.pnMs = t.pnMs;
   times_.clipMs = t.clipMs;
   times_.deformMs = t.deformMs;
-  subTriangles_ = deformer_->subTriangles();
+  subTriangles_ = deformer.subTriangles();
   // The device buffers hold positions relative to the Deformer's local origin (a model far from the
   // world origin): those are drawn from the host copy, moved back, and the rest straight from the buffers.
-  if (smooth && zeroCopy_ && !settings.heatmap && deformer_->localOrigin() == glm::dvec3(0.0)) {
+  if (smooth && zeroCopy_ && !settings.heatmap && deformer.localOrigin() == glm::dvec3(0.0)) {
     drawSession({});
     path_ = "zero-copy";
   } else {
-    std::optional<PatchVertices> pv = deformer_->internal().run->patchVertices();
-    Mesh mesh = settings.heatmap && pv ? Mesh{} : pv ? weldPatchVertices(*pv) : deformer_->result();
-    drawHost(deformer_->internal().input, lattice, std::move(mesh), pv, settings);
+    std::optional<PatchVertices> pv = deformer.internal().run->patchVertices();
+    Mesh mesh = settings.heatmap && pv ? Mesh{} : pv ? weldPatchVertices(*pv) : deformer.result();
+    drawHost(deformer.internal().input, lattice, std::move(mesh), pv, settings);
     // The names the HUD and --stats have always given: smooth on a device, or the others.
     path_ = smooth && device_.info().api != "cpu" ? "session+copy" : "host";
   }
   times_.updateMs = msSince(t0);
+}
+
+std::unique_ptr<Deformer> Scene::makeDeformer(const Lattice& lattice, const SceneSettings& settings, int level) {
+  DeformOptions o = options_;
+  o.method = settings.method == "smooth" ? Method::Smooth : settings.method == "accurate" ? Method::Accurate : Method::Classic;
+  o.clip = settings.clip == "knot-box" ? Clip::KnotBox : Clip::Regular;
+  o.tess = level;
+  return std::make_unique<Deformer>(device_, mesh_, lattice, o);
 }
 
 void Scene::drawHost(const Mesh& input, const Lattice& lattice, Mesh mesh, const std::optional<PatchVertices>& patches,
@@ -131,12 +157,12 @@ void Scene::drawSession(std::vector<glm::vec3> fitPoints) {
   renderer_.context().activate();
   // The deform kernel wrote the buffers as storage; they are read as vertex attributes next.
   glMemoryBarrier(GL_VERTEX_ATTRIB_ARRAY_BARRIER_BIT | GL_ELEMENT_ARRAY_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
-  const std::vector<OutputChunk> chunks = deformer_->deviceOutput();
-  const int L = level_;
+  const std::vector<OutputChunk> chunks = active_->deviceOutput();
+  const int L = activeLevel_;
   const size_t nv = size_t(tessVertexCount(L)), nt = size_t(tessTriangleCount(L));
   size_t maxCount = 0;
   for (const auto& c : chunks) maxCount = std::max(maxCount, c.count);
-  if (maxCount > sessionIndexPatches_) {
+  if (maxCount > sessionIndexPatches_ || L != sessionIndexLevel_) {
     // One index list for every chunk: patch p's triangles at vertex offset 2 * nv * p.
     std::vector<uint32_t> local = tessTriangles(L), all;
     all.reserve(maxCount * local.size());
@@ -147,6 +173,7 @@ void Scene::drawSession(std::vector<glm::vec3> fitPoints) {
     glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(all.size() * 4), all.data(), GL_STATIC_DRAW);
     glBindBuffer(GL_ARRAY_BUFFER, 0);
     sessionIndexPatches_ = maxCount;
+    sessionIndexLevel_ = L;
   }
   gl::BufferItem item;
   item.fitPoints = std::move(fitPoints);
@@ -166,7 +193,7 @@ void Scene::drawSession(std::vector<glm::vec3> fitPoints) {
 std::vector<glm::vec3> Scene::resultPoints() {
   std::vector<glm::vec3> pts;
   if (drawingSession_) {
-    PatchVertices pv = *deformer_->internal().run->patchVertices();
+    PatchVertices pv = *active_->internal().run->patchVertices();
     pts.reserve(pv.vertexCount());
     for (size_t v = 0; v < pv.vertexCount(); ++v)
       pts.push_back(glm::vec3(float(pv.position[3 * v]), float(pv.position[3 * v + 1]), float(pv.position[3 * v + 2])));
@@ -182,7 +209,7 @@ void Scene::prepareFit() {
 }
 
 Mesh Scene::resultMesh() {
-  if (drawingSession_) return deformer_->result();
+  if (drawingSession_) return active_->result();
   return result_;
 }
 

@@ -22,6 +22,7 @@ namespace sffd::view {
 struct SceneSettings {
   std::string method = "smooth", clip = "regular";
   bool heatmap = false;
+  bool draft = false;   // this update is a frame while dragging: smooth and accurate at the Scene's draft level
 };
 
 struct StageTimes {
@@ -33,8 +34,10 @@ class Scene {
  public:
   // `zeroCopy`: the device is a GL backend on the renderer's context. `mesh` is the input as loaded
   // (the Deformer applies the crease angle of `options` itself); `options` as for `sffd deform`, the
-  // method and clipping coming from each update's settings.
-  Scene(gl::Renderer& renderer, Device& device, bool zeroCopy, Mesh mesh, DeformOptions options);
+  // method and clipping coming from each update's settings. `draftLevel`: the tessellation level of
+  // draft updates (a second Deformer, prepared at the first one and kept; 0, or not below
+  // options.tess: drafts are full updates).
+  Scene(gl::Renderer& renderer, Device& device, bool zeroCopy, Mesh mesh, DeformOptions options, int draftLevel = 0);
   ~Scene();
 
   // Deforms with the lattice and settings and sets up the drawing. `progress` is told before slow
@@ -43,6 +46,8 @@ class Scene {
               const std::function<void(const std::string&)>& progress = {});
 
   const StageTimes& times() const { return times_; }
+  bool drawingDraft() const { return activeLevel_ != level_; }   // the last update was a draft
+  int level() const { return activeLevel_; }                     // the tessellation level drawn
   std::string path() const;                      // "zero-copy", "session+copy" (smooth, downloaded) or "host" (others), for the HUD
   const std::vector<TessSource>& tessSources() const { return tess_; }
   size_t subTriangles() const { return subTriangles_; }
@@ -60,6 +65,7 @@ class Scene {
                 const SceneSettings& settings);
   void uploadTess(const PatchVertices& pv);
   void drawSession(std::vector<glm::vec3> fitPoints);
+  std::unique_ptr<Deformer> makeDeformer(const Lattice& lattice, const SceneSettings& settings, int level);
 
   gl::Renderer& renderer_;
   Device& device_;
@@ -67,7 +73,9 @@ class Scene {
   Mesh mesh_;                       // as loaded: what the Deformer prepares
   DeformOptions options_;
   int level_;
-  std::unique_ptr<Deformer> deformer_;
+  int draftLevel_, activeLevel_;
+  std::unique_ptr<Deformer> deformer_, draft_;   // at level_, at draftLevel_ (made at the first draft)
+  Deformer* active_ = nullptr;                   // the one the last update used
   Lattice deformerLattice_;         // the structure the Deformer was made for
   SceneSettings deformerSettings_;  // the method and clipping it was made for
   bool drawingSession_ = false;     // the renderer draws the Deformer's buffers
@@ -75,6 +83,7 @@ class Scene {
   Mesh result_;                     // host path: the result as deform writes it
   unsigned hostTess_ = 0, sessionIndex_ = 0;
   size_t sessionIndexPatches_ = 0;
+  int sessionIndexLevel_ = 0;
   std::vector<TessSource> tess_;
   StageTimes times_;
   size_t subTriangles_ = 0, outputTriangles_ = 0;

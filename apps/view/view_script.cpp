@@ -47,6 +47,8 @@ const std::vector<Verb>& verbs() {
       {"load-lattice", "f", {}, "load-lattice FILE"},
       {"save-mesh", "f", {}, "save-mesh FILE (.obj .ply .off .stl)"},
       {"frame", "", {}, "frame (draw one more frame)"},
+      {"press", "", {}, "press (a mouse button goes down: until release, moves are drawn as drafts)"},
+      {"release", "", {}, "release (the button goes up: the full-quality result is drawn)"},
       {"key", "f", {}, "key NAME (a key press: w, ctrl+z, f1 ...)"},
       {"quit", "", {}, "quit"},
   };
