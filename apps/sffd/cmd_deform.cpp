@@ -2,6 +2,7 @@
 #include <chrono>
 #include <cstdio>
 #include <optional>
+#include <utility>
 
 #include <nlohmann/json.hpp>
 
@@ -45,13 +46,21 @@ int run(const ParsedArgs& args) {
   if (args.has("--stats")) checkOutputPath(args.get("--stats"), {args.positional[0], args.get("--lattice"), out});
   if (args.has("--patches")) checkOutputPath(args.get("--patches"), {args.positional[0], args.get("--lattice"), out});
 
-  auto t0 = std::chrono::steady_clock::now();
+  auto t0 = std::chrono::steady_clock::now(), lapStart = t0;
+  auto lap = [&lapStart] {
+    auto t = std::chrono::steady_clock::now();
+    return std::chrono::duration<double, std::milli>(t - std::exchange(lapStart, t)).count();
+  };
   Job job = loadJob(args);
+  const double readMs = lap();
   Device device = openDeviceFromArgs(args);
+  const double openMs = lap();
   DeformRun run = runDeformJob(args, job, device);
+  const double checksMs = lap() - run.prepareMs - run.deformMs - run.resultMs;   // the lattice's fold, knot and coverage checks
   const Timings& t = run.deformer.timings();
   Mesh& deformed = run.mesh;
   writeMesh(out, deformed, MeshWriteOptions{.significantDigits = outputDigits(run.deformer), .binary = args.has("--binary")});
+  const double writeMs = lap();
   if (args.has("--patches")) {
     std::vector<double> controlPoints = run.deformer.patchControlPoints();
     if (controlPoints.empty()) throw Error(ErrorKind::Input, "--patches needs --method smooth");
@@ -71,6 +80,17 @@ int run(const ParsedArgs& args) {
         {"sub_triangles", run.deformer.subTriangles()},
         {"output", {{"vertices", deformed.positions.size()}, {"triangles", deformed.triangles.size()}}},
         {"timings_ms", {{"pn", t.pnMs}, {"clip", t.clipMs}, {"deform", t.deformMs}, {"total", totalMs}}},
+        // Where the whole run's wall time goes (docs/PERFORMANCE.md "The whole process"): the inputs read,
+        // the device opened, the lattice checked, the Deformer made (pre-compute), deformed, its result taken (download,
+        // weld), the output written.
+        {"host_ms",
+         {{"read", readMs},
+          {"open_device", openMs},
+          {"checks", checksMs},
+          {"prepare", run.prepareMs},
+          {"deform", run.deformMs},
+          {"result", run.resultMs},
+          {"write", writeMs}}},
     };
     // Smooth: the target edge length used (given, or a tenth of the mesh's largest extent); others: null.
     j["edge_length"] = run.method == "smooth" ? nlohmann::ordered_json(edgeLengthOf(args, job.mesh)) : nlohmann::ordered_json();

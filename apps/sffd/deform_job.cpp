@@ -1,8 +1,10 @@
 #include "apps/sffd/deform_job.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <utility>
 
 #include <sffd/error.h>
 
@@ -68,9 +70,17 @@ DeformRun runMethod(const ParsedArgs& args, Job& job, Device& device, Method met
   o.progress = line->callback();
   auto make = [&] { return withToolLimitName([&] { return Deformer(device, job.mesh, job.lattice, o); }); };
   const char* name = method == Method::Smooth ? "smooth" : method == Method::Accurate ? "accurate" : "classic";
+  auto t0 = std::chrono::steady_clock::now();
+  auto lap = [&t0] {
+    auto t = std::chrono::steady_clock::now();
+    return std::chrono::duration<double, std::milli>(t - std::exchange(t0, t)).count();
+  };
   DeformRun run{name, method == Method::Accurate ? "knot-box" : args.get("--clip", "regular"), line, make(), {}};
+  run.prepareMs = lap();
   run.deformer.deform(job.lattice);
+  run.deformMs = lap();
   run.mesh = run.deformer.result();
+  run.resultMs = lap();
   line->clear();
   if (method == Method::Smooth) job.mesh = run.deformer.internal().input;
   return run;

@@ -27,6 +27,9 @@ struct DeformRun {
   std::shared_ptr<ProgressLine> line;   // what the Deformer's progress callback draws on
   Deformer deformer;
   Mesh mesh;                  // the result as `deform` writes it
+  // Wall times of the host phases: the Deformer made (pre-compute included), deform() (the kernels and
+  // their waits), result() (download, weld, the move back from local coordinates).
+  double prepareMs = 0, deformMs = 0, resultMs = 0;
   // Smooth and accurate: the tessellation with the pre-images of its vertices (downloaded again).
   std::optional<PatchVertices> patches();
 };
