@@ -113,6 +113,14 @@ TEST(Cli, LatticeThenDeformWritesStats) {
   EXPECT_EQ(j["input"]["triangles"], j["output"]["triangles"]);
   EXPECT_TRUE(j["timings_ms"].contains("deform"));
   EXPECT_TRUE(j.contains("backend") && j.contains("device"));
+  // The host phases account for the whole run: each non-negative, together within its total.
+  double phases = 0;
+  for (const char* k : {"read", "open_device", "checks", "prepare", "deform", "result", "write"}) {
+    ASSERT_TRUE(j["host_ms"].contains(k)) << k;
+    EXPECT_GE(j["host_ms"][k].get<double>(), -1e-6) << k;
+    phases += j["host_ms"][k].get<double>();
+  }
+  EXPECT_LE(phases, j["timings_ms"]["total"].get<double>() + 1e-6);
 }
 
 TEST(Cli, DevicesListsLavapipeAndLlvmpipe) {
