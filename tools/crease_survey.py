@@ -3,6 +3,9 @@
 candidate crease rule marks, to choose and document the default for meshes without normals.
 
 usage: tools/crease_survey.py [--write-gen DIR] [--hist] MESH...
+Prints a Markdown table: triangles, edges, edges where the winding flips, the median and 90th percentile
+dihedral angle (degrees between face normals), and the creases under a fixed --crease-angle of 40, 60,
+70 and 80 and under the default rule (auto), counted as sffd does (edges that split a vertex).
 MESH: an OBJ or OFF file (normals ignored: the rule is for meshes without them), or a generated shape
 gen:box, gen:prism, gen:cylinder:N, gen:uvsphere:N, gen:icosphere:L, gen:torus:N, gen:tetra, gen:octa.
 Vertices are welded by exact position, as sffd does. Python 3, standard library only.
@@ -207,7 +210,26 @@ def dihedrals(V, F):
     # Edges both triangles run the same way: the winding flips there, and so does one face normal (the
     # angle reads 180 minus the true one: a crease under any rule).
     flipped = sum(1 for e in angle if forward[e][0] == forward[e][1])
-    return len(tris), len(edges), angle, crossing, flipped
+    return len(tris), len(edges), angle, crossing, flipped, (tris, edges)
+
+
+def effective(marked, topo):
+    """The marked edges that split a vertex, as sffd counts creases (`sffd clip --stats`: crease_edges):
+    an edge marked inside one smoothing fan (its endpoints joined around it by unmarked edges) has no
+    effect."""
+    tris, edges = topo
+    parent = {}
+    def find(x):
+        while parent.setdefault(x, x) != x:
+            parent[x] = parent[parent[x]]
+            x = parent[x]
+        return x
+    for e, ts in edges.items():
+        if len(ts) == 2 and e not in marked:
+            for v in e:
+                parent[find((ts[0], v))] = find((ts[1], v))
+    return sum(1 for e, ts in edges.items() if len(ts) == 2 and e in marked and
+               any(find((ts[0], v)) != find((ts[1], v)) for v in e))
 
 
 def relative_rule(angle, crossing, loose=LOOSE, sharp=SHARP, ratio=RATIO):
@@ -253,13 +275,13 @@ def main(argv):
         else:
             V, F = read_mesh(p)
             name = p.rsplit("/", 1)[-1]
-        T, E, angle, crossing, flipped = dihedrals(V, F)
+        T, E, angle, crossing, flipped, topo = dihedrals(V, F)
         a = sorted(angle.values())
         q = lambda f: a[min(len(a) - 1, int(f * len(a)))] if a else 0.0
         cells = [name, str(T), str(E), str(flipped), "%.0f" % q(0.5), "%.0f" % q(0.9)]
         for t in fixed:
-            cells.append(str(sum(1 for x in a if x > t)))
-        cells.append(str(len(relative_rule(angle, crossing))))
+            cells.append(str(effective({e for e, x in angle.items() if x > t}, topo)))
+        cells.append(str(effective(relative_rule(angle, crossing), topo)))
         print("| " + " | ".join(cells) + " |")
         if hist:
             bins = [0] * 18
