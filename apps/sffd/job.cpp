@@ -157,10 +157,16 @@ Device openDeviceFromArgs(const ParsedArgs& args) {
 
 double creaseAngleOf(const ParsedArgs& args) {
   if (args.get("--crease-angle", "auto") == "auto") return kCreaseAngleAuto;
-  const double deg = args.getDouble("--crease-angle", 0);
+  const Error refused(ErrorKind::Input, "option --crease-angle needs auto or an angle of 0..180 degrees, not '" +
+                                           args.get("--crease-angle", "") + "'");
+  double deg = 0;
+  try {
+    deg = args.getDouble("--crease-angle", 0);
+  } catch (const Error&) {
+    throw refused;
+  }
   // Negative numbers would read as kCreaseAngleAuto; past 180 no edge bends.
-  if (deg < 0 || deg > 180)
-    throw Error(ErrorKind::Input, "option --crease-angle needs auto or an angle of 0..180 degrees, not '" + args.get("--crease-angle", "") + "'");
+  if (deg < 0 || deg > 180) throw refused;
   return deg;
 }
 
