@@ -229,6 +229,31 @@ TEST(Cli, ClipWritesACrackFreeSubTriangleMeshAndStats) {
   }
 }
 
+TEST(Cli, CreaseAngleAutoIsTheDefaultAndANumberIsAFixedThreshold) {
+  // teapot_8x8.obj has no normals: 149 edges bend by more than 40 degrees and split a vertex; the
+  // relative rule keeps 131 of them (the lid rim, the patch seams; docs/METHOD.md 3.1's table).
+  fs::path dir = tempDir("crease_angle");
+  auto creases = [&](const std::string& option) {
+    const std::string stats = (dir / "s.json").string();
+    RunResult r = runSffd("clip " + kData + "/teapot_8x8.obj -l " + kData + "/lattices/teapot_identity.npy --edge-length 1 -o " +
+                          (dir / "sub.obj").string() + " --stats " + stats + " --quiet " + option);
+    EXPECT_EQ(r.status, 0) << option << r.err;
+    std::ifstream sf(stats);
+    return nlohmann::json::parse(sf)["topology"]["crease_edges"].get<int>();
+  };
+  EXPECT_EQ(creases(""), 131);
+  EXPECT_EQ(creases("--crease-angle auto"), 131);
+  EXPECT_EQ(creases("--crease-angle 40"), 149);
+  EXPECT_EQ(creases("--crease-angle 180"), 0);
+  for (const char* bad : {"-1", "181", "sharp"}) {
+    RunResult r = runSffd("clip " + kData + "/teapot_8x8.obj -l " + kData + "/lattices/teapot_identity.npy -o " +
+                          (dir / "never.obj").string() + " --crease-angle " + bad);
+    EXPECT_EQ(r.status, 2) << bad;
+    EXPECT_NE(r.err.find("--crease-angle"), std::string::npos) << r.err;
+  }
+  EXPECT_FALSE(fs::exists(dir / "never.obj"));
+}
+
 TEST(Cli, ClipRefusesAnAbsurdEdgeLength) {
   RunResult r = runSffd("clip " + kData + "/torus.obj -l " + kData + "/lattices/torus_twist.npy --edge-length 1e-6 -o /tmp/never_clip.obj");
   EXPECT_EQ(r.status, 2);

@@ -102,6 +102,10 @@ std::string toolLimitMessage(std::string what);
 // least 1; 0 when it is not set (no limit).
 size_t chunkFromEnvironment(const char* name);
 
+// --crease-angle DEG|auto: the threshold for meshes without normals, kCreaseAngleAuto when the option
+// is absent or auto; a number must be 0..180 degrees (an input Error otherwise).
+double creaseAngleOf(const ParsedArgs& args);
+
 // Refuses a target edge length that is not positive, or so small that the sub-triangles would
 // exceed kMaxSubTriangles (job_budget.h; the message gives the estimate).
 void checkEdgeLength(const Mesh& mesh, double l);

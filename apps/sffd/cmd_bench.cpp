@@ -117,7 +117,7 @@ int run(const ParsedArgs& args) {
   o.samples = std::max(3, args.getInt("--samples", job.lattice.degree[0] + job.lattice.degree[1] + job.lattice.degree[2]));
   o.clip = clipName == "knot-box" ? Clip::KnotBox : Clip::Regular;
   o.split = args.has("--split");
-  o.creaseAngleDeg = args.getDouble("--crease-angle", 40.0);
+  o.creaseAngleDeg = creaseAngleOf(args);
   o.maxChunkElements = chunkFromEnvironment("SFFD_MAX_CHUNK_SUBTRIANGLES");
   if (args.get("--precision", "float") == "double") o.precision = Precision::Double;
   else if (args.get("--precision", "float") != "float") throw Error(ErrorKind::Input, "--precision must be float or double");

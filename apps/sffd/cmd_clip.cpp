@@ -70,7 +70,7 @@ int run(const ParsedArgs& args) {
 
   auto t0 = std::chrono::steady_clock::now();
   Job job = loadJob(args);
-  if (!job.mesh.normalsFromFile) applyCreaseAngle(job.mesh, args.getDouble("--crease-angle", 40.0));
+  if (!job.mesh.normalsFromFile) applyCreaseAngle(job.mesh, creaseAngleOf(args));
   double l = edgeLengthOf(args, job.mesh);
   checkEdgeLength(job.mesh, l);
   Device device = openDeviceFromArgs(args);

@@ -174,7 +174,7 @@ CaseOutput runCase(Device& device, const Case& c) {
   }
   // Smooth: the PN records, the clipping (regular on the device, or knot-box from this backend's PN
   // records), the deform kernels fused or split; each stage reads this backend's previous output.
-  if (!job.mesh.normalsFromFile) applyCreaseAngle(job.mesh, args.getDouble("--crease-angle", 40.0));
+  if (!job.mesh.normalsFromFile) applyCreaseAngle(job.mesh, creaseAngleOf(args));
   PreparedMesh prepared = prepareMesh(job.mesh);
   PnOutput pn = pnTriangles(backend, prepared, variant, chunkFromEnvironment("SFFD_MAX_CHUNK_TRIANGLES"));
   SubTriangleRecords subs;

@@ -110,7 +110,7 @@ int run(const ParsedArgs& args) {
   o.tess = args.getInt("--tess", 10);
   o.samples = args.getInt("--samples", 0);
   o.split = args.has("--split");
-  o.creaseAngleDeg = args.getDouble("--crease-angle", 40.0);
+  o.creaseAngleDeg = creaseAngleOf(args);
   o.memoryLimit = memoryLimitFromEnvironment();   // each Deformer the viewer makes is checked against it
   const std::string precision = args.get("--precision", "auto");
   if (precision != "auto" && precision != "float" && precision != "double")

@@ -44,7 +44,7 @@ DeformOptions deformOptionsOf(const ParsedArgs& args, const Job& job, Device& de
   o.strict = args.has("--strict");
   o.clip = args.get("--clip", "regular") == "knot-box" ? Clip::KnotBox : Clip::Regular;
   o.tess = args.getInt("--tess", 10);
-  o.creaseAngleDeg = args.getDouble("--crease-angle", 40.0);
+  o.creaseAngleDeg = creaseAngleOf(args);
   o.split = args.has("--split");
   const Lattice& L = job.lattice;
   o.samples = std::max(3, args.getInt("--samples", L.degree[0] + L.degree[1] + L.degree[2]));

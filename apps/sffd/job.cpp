@@ -25,7 +25,7 @@ std::vector<OptionSpec> jobOptions() {
       {"--tess", "N", "tessellation level of each patch (default 10)"},
       {"--split", nullptr, "smooth: run the deform steps as separate dispatches (per-step timings in --stats)"},
       {"--samples", "S", "smooth: sampling density s of the fit (default nu+nv+nw; 6 is the reference implementation's)"},
-      {"--crease-angle", "DEG", "crease threshold for meshes without normals (default 40)"},
+      {"--crease-angle", "DEG|auto", "meshes without normals: creases where the dihedral angle exceeds DEG (default auto: above 80, or above 40 and 3 times its neighbours')"},
       {"--ignore-normals", nullptr, "recompute the normals from the winding instead of reading them from the file"},
       {"--bpt-resolution", "N", ".bpt input: grid segments per patch side (default 10: 200 triangles a patch)"},
       {"--normalize", "S", "center the mesh on its box and scale its largest half-extent to S (.npy: 0.99)"},
@@ -153,6 +153,21 @@ Device openDeviceFromArgs(const ParsedArgs& args) {
   Device d = Device::open(r, &notes);
   for (const std::string& n : notes) note(args, n);
   return d;
+}
+
+double creaseAngleOf(const ParsedArgs& args) {
+  if (args.get("--crease-angle", "auto") == "auto") return kCreaseAngleAuto;
+  const Error refused(ErrorKind::Input, "option --crease-angle needs auto or an angle of 0..180 degrees, not '" +
+                                           args.get("--crease-angle", "") + "'");
+  double deg = 0;
+  try {
+    deg = args.getDouble("--crease-angle", 0);
+  } catch (const Error&) {
+    throw refused;
+  }
+  // Negative numbers would read as kCreaseAngleAuto; past 180 no edge bends.
+  if (deg < 0 || deg > 180) throw refused;
+  return deg;
 }
 
 void checkEdgeLength(const Mesh& mesh, double l) { checkSubTriangleCount(mesh, l, "--edge-length"); }

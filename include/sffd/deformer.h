@@ -54,7 +54,8 @@ struct DeformOptions {
   bool strict = false;           // strict kernels: bit-identical on every device, the CPU included
   Precision precision = Precision::Auto;
   bool split = false;            // smooth: the deform step as four dispatches (per-step timings)
-  double creaseAngleDeg = 40;    // smooth, meshes without normals: dihedral angle above which an edge is a crease
+  double creaseAngleDeg = kCreaseAngleAuto;  // smooth, meshes without normals: dihedral angle above which an
+                                             // edge is a crease, or kCreaseAngleAuto (<sffd/mesh.h>)
   uint64_t memoryLimit = 0;      // bytes of host memory a job may plan for (every method); 0: physical memory
   size_t maxChunkElements = 0;   // 0: chunks as large as the device allows (smaller only to test chunking)
   ProgressCallback progress;     // called during long work; may be empty

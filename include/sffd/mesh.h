@@ -59,6 +59,12 @@ struct Mesh {
   std::vector<std::string> materialLibraries;  // OBJ `mtllib` file names, written back as they were read
 };
 
+// The crease rule for meshes without normals when none is given (DeformOptions::creaseAngleDeg's
+// default, `--crease-angle auto`): an edge is a crease where it bends by 80 degrees or more, or by more
+// than 40 and at least 3 times as much as the edges around it (docs/METHOD.md 3.1). A creaseAngleDeg of
+// 0 or more marks instead every edge whose dihedral angle exceeds it.
+inline constexpr double kCreaseAngleAuto = -1;
+
 // A triangle mesh in the caller's memory (float or double xyz, 32-bit indices), read once when a
 // Deformer is made; nothing is kept. Strides are in elements of the pointed-to type (0: packed, 3).
 struct MeshView {
@@ -67,7 +73,7 @@ struct MeshView {
   size_t vertexCount = 0;
   size_t positionStride = 0;
   const double* normals = nullptr;      // optional, unit length; or normalsF32. None: computed, with
-  const float* normalsF32 = nullptr;    // creases above DeformOptions::creaseAngleDeg
+  const float* normalsF32 = nullptr;    // creases by DeformOptions::creaseAngleDeg
   size_t normalStride = 0;
   const uint32_t* triangles = nullptr;  // 3 per triangle, counter-clockwise
   size_t triangleCount = 0;

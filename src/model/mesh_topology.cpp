@@ -221,18 +221,39 @@ void applyCreaseAngle(Mesh& mesh, double creaseAngleDeg) {
     }
   }
 
+  // Dihedral angle per triangle edge; -1 where no fan crosses: boundaries, non-manifold edges and
+  // triangles without a normal (0 as a crossing edge of the relative rule).
+  Adjacency adj = weldedAdjacency(mesh);
+  std::vector<double> dihedral(3 * T, -1.0);
+  for (size_t t = 0; t < T; ++t) {
+    if (flat[t]) continue;
+    for (int e = 0; e < 3; ++e) {
+      const int32_t u = adj.neighbour[t][e];
+      if (u < 0 || flat[size_t(u)]) continue;
+      const glm::dvec3 &a = faceNormal[t], &b = faceNormal[size_t(u)];
+      dihedral[3 * t + e] = std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b)) * (180.0 / std::numbers::pi);
+    }
+  }
+  const bool relative = creaseAngleDeg < 0;
+  auto isCrease = [&](size_t t, int e) {
+    const double angle = dihedral[3 * t + e];
+    if (!relative) return angle > creaseAngleDeg;
+    const size_t u = size_t(adj.neighbour[t][e]);
+    const int ue = adj.neighbourEdge[t][e];
+    const double crossing[4] = {std::max(0.0, dihedral[3 * t + (e + 1) % 3]), std::max(0.0, dihedral[3 * t + (e + 2) % 3]),
+                                std::max(0.0, dihedral[3 * u + (ue + 1) % 3]), std::max(0.0, dihedral[3 * u + (ue + 2) % 3])};
+    return autoCrease(angle, crossing);
+  };
+
   // Smoothing fans: corners of one welded position joined across every smooth manifold edge. Creases,
   // boundaries, non-manifold edges and triangles without a normal end a fan.
-  Adjacency adj = weldedAdjacency(mesh);
   CornerSets fans(3 * T);
   for (size_t t = 0; t < T; ++t) {
     if (flat[t]) continue;
     for (int e = 0; e < 3; ++e) {
       const int32_t u = adj.neighbour[t][e];
       if (u < 0 || size_t(u) < t || flat[size_t(u)]) continue;
-      const glm::dvec3 &a = faceNormal[t], &b = faceNormal[size_t(u)];
-      double dihedral = std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b)) * (180.0 / std::numbers::pi);
-      if (dihedral > creaseAngleDeg) continue;
+      if (isCrease(t, e)) continue;
       const auto& tri = mesh.triangles[t];
       const auto& ut = mesh.triangles[size_t(u)];
       for (int k : {e, (e + 1) % 3}) {

@@ -40,9 +40,27 @@ inline int slotCorner(int slot) { return slot / 2; }
 MeshTopology buildTopology(const Mesh& mesh);
 
 // For meshes whose normals were computed on load (mesh.normalsFromFile == false): marks edges whose
-// dihedral angle exceeds `creaseAngleDeg` as creases and gives each vertex one angle-weighted normal
-// per smoothing fan (the faces around it between creases), splitting vertices as needed. The result
-// is the split-normal input the method expects.
+// dihedral angle (between the face normals) exceeds `creaseAngleDeg` as creases, or with
+// kCreaseAngleAuto (any negative value) those of the relative rule below, and gives each vertex one
+// angle-weighted normal per smoothing fan (the faces around it between creases), splitting vertices as
+// needed. The result is the split-normal input the method expects.
 void applyCreaseAngle(Mesh& mesh, double creaseAngleDeg);
+
+// The relative rule (kCreaseAngleAuto; chosen by tools/crease_survey.py, docs/METHOD.md 3.1): an edge
+// is a crease when its dihedral angle is at least kAutoCreaseSharpDeg, or above kAutoCreaseLooseDeg and
+// at least kAutoCreaseRatio times the angle of each of its crossing edges (the other two edges of its
+// two triangles) that is below kAutoCreaseSharpDeg; boundary and non-manifold crossing edges count as 0.
+// A crease between flat faces, or meeting other creases, passes; a coarse tessellation of a curved
+// surface, whose every edge bends about as much as its neighbours, does not.
+constexpr double kAutoCreaseLooseDeg = 40;
+constexpr double kAutoCreaseSharpDeg = 80;
+constexpr double kAutoCreaseRatio = 3;
+inline bool autoCrease(double angleDeg, const double crossingDeg[4]) {
+  if (angleDeg >= kAutoCreaseSharpDeg) return true;
+  if (!(angleDeg > kAutoCreaseLooseDeg)) return false;
+  for (int k = 0; k < 4; ++k)
+    if (crossingDeg[k] < kAutoCreaseSharpDeg && kAutoCreaseRatio * crossingDeg[k] > angleDeg) return false;
+  return true;
+}
 
 }  // namespace sffd

@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
+#include <numbers>
 #include <map>
 #include <set>
 
@@ -429,3 +431,89 @@ TEST(MeshTopology, CreaseAngleCopiesPatchData) {
 }
 
 }  // namespace
+
+// ---- the default rule, kCreaseAngleAuto (tools/crease_survey.py measures it on real meshes) ----
+
+namespace {
+
+// A closed ring-by-ring grid: `rows` x `cols` quads of positions p(i, j), two triangles each.
+Mesh makeGrid(int rows, int cols, bool wrapRows, const std::function<glm::dvec3(int, int)>& p) {
+  std::vector<glm::dvec3> positions;
+  const int ringRows = wrapRows ? rows : rows + 1;
+  for (int i = 0; i < ringRows; ++i)
+    for (int j = 0; j < cols; ++j) positions.push_back(p(i, j));
+  std::vector<std::array<uint32_t, 3>> triangles;
+  auto id = [&](int i, int j) { return uint32_t((i % ringRows) * cols + j % cols); };
+  for (int i = 0; i < rows; ++i)
+    for (int j = 0; j < cols; ++j) {
+      triangles.push_back({id(i, j), id(i, j + 1), id(i + 1, j + 1)});
+      triangles.push_back({id(i, j), id(i + 1, j + 1), id(i + 1, j)});
+    }
+  return makeMesh(positions, triangles);
+}
+
+// The demo's hexagonal prism (tools/make_test_data.py) without its normals: 6 sides of 3 segments,
+// flat caps; 18 side edges of 60 degrees, 12 rim edges of 90, everything else flat.
+Mesh makePrism() {
+  const double pi = std::numbers::pi;
+  Mesh side = makeGrid(3, 6, false, [&](int s, int k) {
+    return glm::dvec3(0.5 * std::cos(2 * pi * k / 6), 0.5 * std::sin(2 * pi * k / 6), -1.5 + s);
+  });
+  std::vector<glm::dvec3> positions = side.positions;
+  std::vector<std::array<uint32_t, 3>> triangles = side.triangles;
+  positions.push_back({0, 0, 1.5});
+  positions.push_back({0, 0, -1.5});
+  const uint32_t top = 24, bottom = 25;
+  for (uint32_t k = 0; k < 6; ++k) {
+    triangles.push_back({top, 18 + k, 18 + (k + 1) % 6});
+    triangles.push_back({bottom, (k + 1) % 6, k});
+  }
+  return makeMesh(positions, triangles);
+}
+
+// A torus of n x n quads (R = 1, r = 0.4): at n = 8 its edges bend by 18 to 48 degrees, all smooth.
+Mesh makeTorus(int n) {
+  const double pi = std::numbers::pi;
+  return makeGrid(n, n, true, [&](int i, int j) {
+    const double a = 2 * pi * i / n, b = 2 * pi * j / n;
+    return glm::dvec3((1 + 0.4 * std::cos(b)) * std::cos(a), (1 + 0.4 * std::cos(b)) * std::sin(a), 0.4 * std::sin(b));
+  });
+}
+
+size_t creasesOf(Mesh m, double creaseAngleDeg) {
+  applyCreaseAngle(m, creaseAngleDeg);
+  MeshTopology topo = buildTopology(m);
+  expectConsistent(m, topo);
+  return topo.creaseEdges;
+}
+
+}  // namespace
+
+TEST(MeshTopology, AutoCreaseRule) {
+  const double flat[4] = {0, 0, 0, 0}, bent[4] = {0, 0, 18, 18}, creased[4] = {90, 0, 90, 0};
+  EXPECT_FALSE(autoCrease(40, flat));     // at most the old default's 40: never
+  EXPECT_TRUE(autoCrease(40.5, flat));    // between flat faces
+  EXPECT_FALSE(autoCrease(48, bent));     // its neighbours bend too (the coarse torus)
+  EXPECT_TRUE(autoCrease(60, bent));      // 3 times theirs or more
+  EXPECT_TRUE(autoCrease(60, creased));   // next to other creases (the prism's side edges by its rim)
+  const double tube[4] = {70, 70, 70, 70};
+  EXPECT_FALSE(autoCrease(70, tube));
+  EXPECT_TRUE(autoCrease(80, tube));      // sharp whatever its neighbours do
+}
+
+TEST(MeshTopology, AutoCreaseKeepsCadEdgesSharp) {
+  EXPECT_EQ(creasesOf(makeCube(), kCreaseAngleAuto), 12u);
+  EXPECT_EQ(creasesOf(makePrism(), kCreaseAngleAuto), 30u);   // every side and rim edge
+  EXPECT_EQ(creasesOf(makePrism(), 70), 12u);   // a fixed 70 loses the 60-degree side edges
+}
+
+TEST(MeshTopology, AutoCreaseKeepsCoarseCurvedSurfacesSmooth) {
+  Mesh torus = makeTorus(8);
+  EXPECT_EQ(creasesOf(torus, kCreaseAngleAuto), 0u);
+  EXPECT_EQ(creasesOf(torus, 40), 96u);   // explicit 40: as before, the 45-degree edges are creases
+  Mesh m = torus;
+  applyCreaseAngle(m, kCreaseAngleAuto);
+  EXPECT_EQ(m.positions, torus.positions);   // nothing split, normals bit for bit the computed ones
+  EXPECT_EQ(m.normals, torus.normals);
+  EXPECT_EQ(creasesOf(makeTorus(6), kCreaseAngleAuto), 0u);
+}

@@ -29,7 +29,7 @@ struct DeformSessionOptions {
   int samples = 0;             // sampling density s; 0: nu + nv + nw of the lattice (at least 3)
   bool knotBoxClip = false;    // the 2015 clipping (computed on the CPU, records uploaded once)
   bool split = false;          // deform as four dispatches (per-step timings) instead of the fused kernel
-  double creaseAngleDeg = 40;  // for a mesh without normals: dihedral angle above which an edge is a crease
+  double creaseAngleDeg = kCreaseAngleAuto;  // for a mesh without normals: applyCreaseAngle's threshold
   size_t maxChunkSubTriangles = 0;   // 0: chunks as large as the device allows (smaller only to test chunking)
 };
 

@@ -43,7 +43,7 @@ struct ResolvedOptions {
   int samples = 3;         // >= 3
   bool knotBoxClip = false;
   bool split = false;
-  double creaseAngleDeg = 40;
+  double creaseAngleDeg = kCreaseAngleAuto;
   uint64_t memoryLimit = 0;
   size_t maxChunkElements = 0;
 };
