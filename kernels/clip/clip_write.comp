@@ -66,6 +66,7 @@ void main() {
         subRecords[rec + SFFD_SUB_NNBR + 2u * c + h] = nn;
       }
     }
+    subRecords[rec + SFFD_SUB_CREASE_BITS] = real4(val[0].lam, real(creaseBits));
     subHeaders[o] = uvec4(par.id, creaseBits, 0u, 0u);
   }
 }

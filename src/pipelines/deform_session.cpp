@@ -31,8 +31,7 @@ struct DeformSession::Impl {
   size_t realSize = 4;
   std::vector<BufferId> owned;   // every buffer, destroyed with the session
   BufferId table = 0, vertices = 0, tri = 0, slot = 0, pn = 0, clipHdr = 0, clipReal = 0, counts = 0;
-  BufferId frame = 0, coeffs = 0, fitBuf = 0, samples = 0;
-  size_t samplesCapacity = 0;
+  BufferId frame = 0, coeffs = 0;
   struct ChunkBuffers { BufferId headers = 0, records = 0; size_t firstClip = 0, clipCount = 0; };
   std::vector<ChunkBuffers> chunkBuffers;
 
@@ -109,9 +108,8 @@ void DeformSession::prepare(const Mesh& input, const Lattice& lattice, const Sta
     I.counts = I.make(backend, I.clip.triangles.size() * 4);
   }
   PackedLattice packed = packLattice(lattice);
-  I.frame = up(packed.frame);
+  I.frame = up(deformFrameRange(packed, I.fit.data));
   I.coeffs = up(packed.coeffs);
-  I.fitBuf = up(I.fit.data);
   precompute(progress);
 }
 
@@ -183,7 +181,9 @@ const SessionTimings& DeformSession::precompute(const StageProgress& progress) {
   const uint64_t recordBytes = SFFD_SUB_STRIDE * 16 * (I.realSize / 4), tessBytes = 2 * nv * 16 * (I.realSize / 4),
                  patchBytes = SFFD_PATCH_STRIDE * 16 * (I.realSize / 4),
                  sampleBytes = (SFFD_SAMPLE_FIXED + uint64_t(I.fit.points)) * 16 * (I.realSize / 4);
-  uint64_t maxSubs = lim.maxStorageBufferRange / std::max({recordBytes, tessBytes, patchBytes, sampleBytes});
+  // The output range holds the patches, the tessellation and (split) the samples of a sub-triangle.
+  const uint64_t outBytes = patchBytes + tessBytes + (options_.split ? sampleBytes : 0);
+  uint64_t maxSubs = lim.maxStorageBufferRange / std::max(recordBytes, outBytes);
   if (options_.maxChunkSubTriangles) maxSubs = std::min<uint64_t>(maxSubs, options_.maxChunkSubTriangles);
   maxSubs = std::max<uint64_t>(maxSubs, 1);
 
@@ -235,7 +235,7 @@ const SessionTimings& DeformSession::precompute(const StageProgress& progress) {
       B.destroyBuffer(b);
       I.owned.erase(std::find(I.owned.begin(), I.owned.end(), b));
     };
-    for (Chunk& c : chunks_) drop(c.tess), drop(c.patches);
+    for (Chunk& c : chunks_) drop(c.output);
     for (Impl::ChunkBuffers& c : I.chunkBuffers) drop(c.headers), drop(c.records);
     chunks_.clear();
     I.chunkBuffers.clear();
@@ -243,8 +243,8 @@ const SessionTimings& DeformSession::precompute(const StageProgress& progress) {
       Chunk c;
       c.first = p.first;
       c.count = p.count;
-      c.tess = I.make(B, p.count * tessBytes);
-      c.patches = I.make(B, p.count * patchBytes);
+      c.output = I.make(B, p.count * outBytes);
+      c.patchesOffset = p.count * tessBytes;
       Impl::ChunkBuffers cb;
       cb.headers = I.make(B, p.count * 16);
       cb.records = I.make(B, p.count * recordBytes);
@@ -275,15 +275,6 @@ const SessionTimings& DeformSession::precompute(const StageProgress& progress) {
     }
     if (progress) progress("clip", 0.2 + 0.8 * double(ci + 1) / double(plan.size() + 1));
   }
-  if (options_.split && !chunks_.empty()) {
-    size_t largest = 0;
-    for (const Chunk& c : chunks_) largest = std::max(largest, c.count);
-    if (largest > I.samplesCapacity) {
-      if (I.samples) B.destroyBuffer(I.samples), I.owned.erase(std::find(I.owned.begin(), I.owned.end(), I.samples));
-      I.samples = I.make(B, largest * sampleBytes);
-      I.samplesCapacity = largest;
-    }
-  }
   B.finish();
   timings_.dispatches = B.takeTimings();
   if (options_.knotBoxClip) timings_.dispatches.push_back({"clip", knotRecords.wallMs});
@@ -307,10 +298,8 @@ const SessionTimings& DeformSession::deform(const Lattice& lattice, const StageP
     const Chunk& c = chunks_[ci];
     if (!c.count) continue;
     params.range = {0, uint32_t(c.count), uint32_t(I.fit.points), uint32_t(options_.level)};
-    dispatchDeform(B, params,
-                   {I.coeffs, I.frame, I.fitBuf, I.chunkBuffers[ci].headers, I.chunkBuffers[ci].records, c.patches, c.tess,
-                    options_.split ? I.samples : 0},
-                   c.count, options_.variant, options_.split);
+    deformOutSections(params, c.count, options_.level, I.fit.points, options_.split);
+    dispatchDeform(B, params, {I.coeffs, I.frame, I.chunkBuffers[ci].records, c.output}, c.count, options_.variant, options_.split);
     if (progress) progress("deform", double(ci + 1) / double(chunks_.size() + 1));
   }
   B.finish();
@@ -349,11 +338,11 @@ SmoothOutput DeformSession::output() {
     if (!c.count) continue;
     // Each download into a buffer of its own size: below level 3 a patch has more reals than its tessellation.
     std::vector<unsigned char> b(c.count * patchReals * rs);
-    backend_.download(c.patches, 0, b.data(), b.size());
+    backend_.download(c.output, c.patchesOffset, b.data(), b.size());
     std::vector<double> d = doublesOf(b, options_.variant.f64);
     std::copy(d.begin(), d.end(), out.patches.begin() + c.first * patchReals);
     b.resize(c.count * tessReals * rs);
-    backend_.download(c.tess, 0, b.data(), b.size());
+    backend_.download(c.output, 0, b.data(), b.size());
     d = doublesOf(b, options_.variant.f64);
     std::copy(d.begin(), d.end(), out.tess.begin() + c.first * tessReals);
   }
