@@ -106,13 +106,25 @@ SFFD_STRUCT_END(ClassicParams)
 
 // ---- kernels clip_count and clip_write: regular clipping by the split-pattern table (METHOD.md 4.2) ----
 // One thread per clip triangle (an original triangle, or a piece of one after the pre-split of
-// triangles whose edges need more than Nmax segments). Buffers 1..4 are the mesh and PN buffers above.
-#define SFFD_BINDING_SPLIT_TABLE SFFD_SLOT_5     // uint: pattern entries (4 each), then vertices (4 each: lambda bits, edge | step << 16), then packed uint16 triangle indices
-#define SFFD_BINDING_CLIP_COUNTS SFFD_SLOT_6     // uint per clip triangle: sub-triangle count (clip_count), exclusive offset (clip_write)
-#define SFFD_BINDING_CLIP_HEADERS SFFD_SLOT_8    // 2 uvec4 per clip triangle: (parent, corner kinds, 0, 0), corner weld ids
-#define SFFD_BINDING_CLIP_REALS SFFD_SLOT_9      // 9 real4 per clip triangle: lam[3], flat[3], edge params[3]
-#define SFFD_BINDING_SUB_HEADERS SFFD_SLOT_10    // uvec4 per sub-triangle: parent, crease slot bits, 0, 0
-#define SFFD_BINDING_SUB_RECORDS SFFD_SLOT_11    // SFFD_SUB_STRIDE real4 per sub-triangle
+// triangles whose edges need more than Nmax segments). Four storage blocks in all (the OpenGL ES 3.1
+// minimum): two input ranges of sections at the elements ClipParams names, and the two outputs. Each
+// section begins at a multiple of SFFD_SECTION_ALIGN bytes, so that pn_triangles binds the mesh's
+// sections and writes the PN records as ranges of their own.
+#define SFFD_BINDING_CLIP_REALS SFFD_SLOT_1      // real4: the mesh vertices (positions, then normals from element
+                                                 // range.z); from element sections.x the slot normals
+                                                 // (SFFD_SLOT_NORMAL_STRIDE per triangle); from sections.y the PN
+                                                 // records (SFFD_PN_STRIDE per triangle); from sections.z per clip
+                                                 // triangle SFFD_CLIP_REAL_STRIDE: lam[3], flat[3], edge params[3]
+#define SFFD_BINDING_CLIP_WORDS SFFD_SLOT_2      // uint: the split table (pattern entries, 4 each; then vertices, 4
+                                                 // each: lambda bits, edge | step << 16; then packed uint16 triangle
+                                                 // indices); from word words.x the mesh triangles (4 per uvec4 of
+                                                 // SFFD_BINDING_MESH_TRIANGLES); from words.y per clip triangle
+                                                 // 4 * SFFD_CLIP_HEADER_STRIDE: (parent, corner kinds, 0, 0), corner
+                                                 // weld ids; from words.z one per clip triangle: its sub-triangle
+                                                 // count (clip_count writes), its exclusive offset (clip_write reads)
+#define SFFD_BINDING_SUB_HEADERS SFFD_SLOT_3     // uvec4 per sub-triangle: parent, crease slot bits, 0, 0
+#define SFFD_BINDING_SUB_RECORDS SFFD_SLOT_4     // SFFD_SUB_STRIDE real4 per sub-triangle
+#define SFFD_SECTION_ALIGN 256u                  // the largest storage offset alignment GL and Vulkan allow
 #define SFFD_CLIP_HEADER_STRIDE 2u
 #define SFFD_CLIP_REAL_STRIDE 9u
 // Corner kinds of a clip triangle (packed 8 bits each in header.y): the corner is parent corner k (0..2),
@@ -134,9 +146,11 @@ SFFD_STRUCT_END(ClassicParams)
 #define SFFD_SUB_CREASE_BITS SFFD_SUB_LAM
 
 SFFD_STRUCT_BEGIN(ClipParams)
-  SFFD_UVEC4 range;    // x: first clip triangle, y: clip triangle count, z: the first normal of the vertices' range
-  SFFD_UVEC4 table;    // x: Nmax, y: first vertex word, z: first triangle word
-  SFFD_VEC4 target;    // x: target edge length l
+  SFFD_UVEC4 range;      // x: first clip triangle, y: clip triangle count, z: the first normal of the reals' range
+  SFFD_UVEC4 table;      // x: Nmax, y: first vertex word, z: first triangle word (of the split table)
+  SFFD_VEC4 target;      // x: target edge length l
+  SFFD_UVEC4 sections;   // first element in the reals' range of x: the slot normals, y: the PN records, z: the clip triangles
+  SFFD_UVEC4 words;      // first word in the words' range of x: the mesh triangles, y: the clip headers, z: the counts
 SFFD_STRUCT_END(ClipParams)
 
 // ---- kernel deform_smooth: the deform stage of smooth FFD, one thread per sub-triangle (METHOD.md 3.4) ----

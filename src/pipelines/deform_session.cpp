@@ -30,7 +30,9 @@ struct DeformSession::Impl {
   FitTable fit;
   size_t realSize = 4;
   std::vector<BufferId> owned;   // every buffer, destroyed with the session
-  BufferId table = 0, vertices = 0, tri = 0, slot = 0, pn = 0, clipHdr = 0, clipReal = 0, counts = 0;
+  // The clip kernels' two input ranges; pn_triangles reads the mesh's sections and writes the PN records' as ranges.
+  ClipRanges ranges;
+  BufferId reals = 0, words = 0;
   BufferId frame = 0, coeffs = 0;
   struct ChunkBuffers { BufferId headers = 0, records = 0; size_t firstClip = 0, clipCount = 0; };
   std::vector<ChunkBuffers> chunkBuffers;
@@ -86,27 +88,17 @@ void DeformSession::prepare(const Mesh& input, const Lattice& lattice, const Sta
                                         " MiB) exceed one storage binding on this device (" +
                                         std::to_string(lim.maxStorageBufferRange >> 20) + " MiB); use a coarser mesh");
   };
-  const size_t nt = I.mesh.triangleCount();
-  fits(2 * I.mesh.positions.size() * I.realSize, "vertices");
-  fits(nt * SFFD_PN_STRIDE * 4 * I.realSize, "PN records");
-  fits(I.mesh.slotNormals.size() * I.realSize, "slot normals");
   auto up = [&](const std::vector<double>& v) {
     std::vector<unsigned char> b = realBytes(v, f64);
     return I.upload(backend, b.data(), b.size());
   };
-  I.vertices = up(meshVertexRange(I.mesh));
-  I.slot = up(I.mesh.slotNormals);
-  I.tri = I.upload(backend, I.mesh.triangles.data(), I.mesh.triangles.size() * 4);
-  I.pn = I.make(backend, nt * SFFD_PN_STRIDE * 16 * (I.realSize / 4));
-  if (!options.knotBoxClip) {
-    const PackedTable& T = packedTable();
-    PackedClip pc = packClip(I.clip);
-    fits(pc.reals.size() * I.realSize, "clip triangles");
-    I.table = I.upload(backend, T.words.data(), T.words.size() * 4);
-    I.clipHdr = I.upload(backend, pc.headers.data(), pc.headers.size() * 4);
-    I.clipReal = up(pc.reals);
-    I.counts = I.make(backend, I.clip.triangles.size() * 4);
-  }
+  const PackedClip pc = options.knotBoxClip ? PackedClip{} : packClip(I.clip);
+  I.ranges = clipRanges(I.mesh, I.clip.triangles.size(), I.realSize);
+  fits(I.ranges.byteOf(I.ranges.realElements), "vertices, PN records and clip triangles");
+  fits(I.ranges.words * 4, "triangles and clip triangles");
+  I.reals = up(clipRealRange(I.ranges, I.mesh, nullptr, pc));
+  const std::vector<uint32_t> words = clipWordRange(I.ranges, I.mesh, pc);
+  I.words = I.upload(backend, words.data(), words.size() * 4);
   PackedLattice packed = packLattice(lattice);
   I.frame = up(deformFrameRange(packed, I.fit.data));
   I.coeffs = up(packed.coeffs);
@@ -158,23 +150,25 @@ const SessionTimings& DeformSession::precompute(const StageProgress& progress) {
     const PackedTable& T = packedTable();
     params.table = {T.nmax, T.vertexWord, T.triangleWord, 0};
     params.target = {float(options_.edgeLength), 0, 0, 0};
-    params.range = {uint32_t(first), uint32_t(count), uint32_t(I.mesh.positions.size() / 4), 0};
+    params.range = {uint32_t(first), uint32_t(count), 0, 0};
+    I.ranges.name(params);
     return params;
   };
   auto clipBindings = [&](std::vector<BufferBinding> extra) {
-    std::vector<BufferBinding> b = {
-        {SFFD_BINDING_SPLIT_TABLE, I.table}, {SFFD_BINDING_MESH_VERTICES, I.vertices}, {SFFD_BINDING_MESH_TRIANGLES, I.tri}, {SFFD_BINDING_MESH_SLOT_NORMALS, I.slot}, {SFFD_BINDING_PN_OUT, I.pn},
-        {SFFD_BINDING_CLIP_HEADERS, I.clipHdr}, {SFFD_BINDING_CLIP_REALS, I.clipReal}, {SFFD_BINDING_CLIP_COUNTS, I.counts}};
+    std::vector<BufferBinding> b = {{SFFD_BINDING_CLIP_REALS, I.reals}, {SFFD_BINDING_CLIP_WORDS, I.words}};
     b.insert(b.end(), extra.begin(), extra.end());
     return b;
   };
   if (progress) progress("pn", 0.1);
   if (nt) {
     gpu::PnParams params;
-    params.range = {0, uint32_t(nt), uint32_t(I.mesh.positions.size() / 4), 0};
+    const ClipRanges& R = I.ranges;
+    params.range = {0, uint32_t(nt), uint32_t(R.normals), 0};
     dispatch("pn_triangles", "pn", &params, sizeof(params), nt,
-             {{SFFD_BINDING_MESH_VERTICES, I.vertices}, {SFFD_BINDING_MESH_TRIANGLES, I.tri},
-              {SFFD_BINDING_MESH_SLOT_NORMALS, I.slot}, {SFFD_BINDING_PN_OUT, I.pn}});
+             {{SFFD_BINDING_MESH_VERTICES, I.reals, 0, R.byteOf(R.slotNormals)},
+              {SFFD_BINDING_MESH_TRIANGLES, I.words, R.triangles * 4, I.mesh.triangles.size() * 4},
+              {SFFD_BINDING_MESH_SLOT_NORMALS, I.reals, R.byteOf(R.slotNormals), R.byteOf(R.pn - R.slotNormals)},
+              {SFFD_BINDING_PN_OUT, I.reals, R.byteOf(R.pn), R.byteOf(SFFD_PN_STRIDE * nt)}});
   }
   // Sub-triangle counts per chunk, and the chunk layout (a clip triangle's sub-triangles stay in one chunk).
   const size_t nv = size_t(tessVertexCount(options_.level));
@@ -197,7 +191,7 @@ const SessionTimings& DeformSession::precompute(const StageProgress& progress) {
     std::vector<uint32_t> counts(clipN);
     if (clipN) {
       dispatch("clip_count", "clip_count", &params, sizeof(params), clipN, clipBindings({}));
-      B.download(I.counts, 0, counts.data(), clipN * 4);
+      B.download(I.words, I.ranges.counts * 4, counts.data(), clipN * 4);
     }
     offsets.assign(clipN + 1, 0);
     for (size_t i = 0; i < clipN; ++i) offsets[i + 1] = offsets[i] + counts[i], maxSubs = std::max<uint64_t>(maxSubs, counts[i]);
@@ -206,7 +200,7 @@ const SessionTimings& DeformSession::precompute(const StageProgress& progress) {
     PnOutput pn;
     pn.records = doublesOf([&] {
       std::vector<unsigned char> b(nt * SFFD_PN_STRIDE * 4 * I.realSize);
-      if (nt) B.download(I.pn, 0, b.data(), b.size());
+      if (nt) B.download(I.reals, I.ranges.byteOf(I.ranges.pn), b.data(), b.size());
       return b;
     }(), options_.variant.f64);
     knotRecords = recordsFromSubTriangles(I.mesh, pn, I.knotBoxSubs, options_.variant);
@@ -262,7 +256,7 @@ const SessionTimings& DeformSession::precompute(const StageProgress& progress) {
     const size_t first = p.firstClip, last = p.firstClip + p.clipCount, subs = p.count;
     if (!options_.knotBoxClip) {
       for (size_t i = first; i < last; ++i) chunkOffsets[i] = uint32_t(offsets[i] - offsets[first]);
-      B.upload(I.counts, first * 4, chunkOffsets.data() + first, (last - first) * 4);
+      B.upload(I.words, (I.ranges.counts + first) * 4, chunkOffsets.data() + first, (last - first) * 4);
       gpu::ClipParams params = clipParams(first, last - first);
       dispatch("clip_write", "clip_write", &params, sizeof(params), last - first,
                clipBindings({{SFFD_BINDING_SUB_HEADERS, cb.headers}, {SFFD_BINDING_SUB_RECORDS, cb.records}}));
