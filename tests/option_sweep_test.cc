@@ -1,8 +1,8 @@
 // Every tessellation level at the low end, on every backend, through every variant of the smooth and
 // accurate methods: a crash at --tess 1 once survived because no test swept the options. Each run must
 // succeed with the documented triangle count (level^2 a patch), and strict runs must give the same
-// bytes on every backend. gles runs on the device's own limits (SFFD_GLES_LIMITS=device: its kernels
-// bind more storage blocks than the ES 3.1 minimum) and refuses double precision as a usage error.
+// bytes on every backend. gles runs held to the ES 3.1 minimum limits (every kernel fits them) and
+// refuses double precision as a usage error.
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
@@ -30,7 +30,6 @@ TEST_P(OptionSweep, EveryVariantSucceedsWithTheDocumentedCount) {
   if (runSffd(std::string("devices")).out.find(c.backend) == std::string::npos)
     GTEST_SKIP() << c.backend << " is not available here";
   const bool gles = std::string(c.backend) == "gles";
-  const std::string env = gles ? "SFFD_GLES_LIMITS=device" : "";
 
   const std::string level = std::to_string(c.level);
   const char* variants[] = {"--method smooth",
@@ -45,7 +44,7 @@ TEST_P(OptionSweep, EveryVariantSucceedsWithTheDocumentedCount) {
     const std::string out = (dir / ("out" + std::to_string(i) + ".obj")).string(),
                       stats = (dir / ("s" + std::to_string(i++) + ".json")).string();
     RunResult r = runSffd("deform " + box + " -l " + lattice + " --edge-length 0.7 --tess " + level + " " + v +
-                          " --backend " + c.backend + " -o " + out + " --stats " + stats + " --quiet", env);
+                          " --backend " + c.backend + " -o " + out + " --stats " + stats + " --quiet");
     if (gles && std::string(v).find("double") != std::string::npos) {
       EXPECT_EQ(r.status, 2) << v << ": " << r.err;
       EXPECT_FALSE(fs::exists(out)) << v;

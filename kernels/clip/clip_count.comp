@@ -3,13 +3,13 @@
 // counting pass before the exclusive scan; METHOD.md 4.2 step 5).
 #extension GL_GOOGLE_include_directive : require
 #include "../common/prelude.glsl"
+#define SFFD_CLIP_WRITES_COUNTS 1
 #include "clip_sites.glsl"
 
-layout(std430, SFFD_SET binding = SFFD_BINDING_CLIP_COUNTS) writeonly buffer Counts { uint counts[]; };
 
 void main() {
   uint t = sffdThreadIndex();
   if (t >= params.range.y) return;
   uint ct = params.range.x + t;
-  counts[ct] = clipSetup(ct).entry.w;
+  counts(ct) = clipSetup(ct).entry.w;
 }

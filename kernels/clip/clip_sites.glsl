@@ -11,15 +11,25 @@
 #include "../pn/pn_eval.glsl"
 
 layout(std140, SFFD_SET binding = SFFD_BINDING_PARAMS) uniform ClipBlock { ClipParams params; };
-layout(std430, SFFD_SET binding = SFFD_BINDING_SPLIT_TABLE) readonly buffer SplitTable { uint splitTable[]; };
-layout(std430, SFFD_SET binding = SFFD_BINDING_MESH_VERTICES) readonly buffer Vertices { real4 vertices[]; };
-#define positions(i) vertices[i]
-#define normals(i) vertices[params.range.z + (i)]
-layout(std430, SFFD_SET binding = SFFD_BINDING_MESH_TRIANGLES) readonly buffer Triangles { uvec4 triangles[]; };
-layout(std430, SFFD_SET binding = SFFD_BINDING_MESH_SLOT_NORMALS) readonly buffer SlotNormals { real4 slotNormals[]; };
-layout(std430, SFFD_SET binding = SFFD_BINDING_PN_OUT) readonly buffer PnRecords { real4 pn[]; };
-layout(std430, SFFD_SET binding = SFFD_BINDING_CLIP_HEADERS) readonly buffer ClipHeaders { uvec4 clipHeaders[]; };
-layout(std430, SFFD_SET binding = SFFD_BINDING_CLIP_REALS) readonly buffer ClipReals { real4 clipReals[]; };
+// Two input ranges of sections (layout.h, ClipParams.sections and .words), within ES 3.1's 4 storage
+// blocks with the two outputs; clip_count writes the counts' section, so there the uint range is not
+// read-only.
+layout(std430, SFFD_SET binding = SFFD_BINDING_CLIP_REALS) readonly buffer ClipInReals { real4 clipInReals[]; };
+#ifdef SFFD_CLIP_WRITES_COUNTS
+layout(std430, SFFD_SET binding = SFFD_BINDING_CLIP_WORDS) buffer ClipInWords { uint clipInWords[]; };
+#else
+layout(std430, SFFD_SET binding = SFFD_BINDING_CLIP_WORDS) readonly buffer ClipInWords { uint clipInWords[]; };
+#endif
+#define positions(i) clipInReals[i]
+#define normals(i) clipInReals[params.range.z + (i)]
+#define slotNormals(i) clipInReals[params.sections.x + (i)]
+#define pn(i) clipInReals[params.sections.y + (i)]
+#define clipReals(i) clipInReals[params.sections.z + (i)]
+#define splitTable(i) clipInWords[i]
+#define counts(i) clipInWords[params.words.z + (i)]
+uvec4 clipWords4(uint w) { return uvec4(clipInWords[w], clipInWords[w + 1u], clipInWords[w + 2u], clipInWords[w + 3u]); }
+#define triangles(i) clipWords4(params.words.x + 4u * (i))
+#define clipHeaders(i) clipWords4(params.words.y + 4u * (i))
 
 const uint kSlotCp[6] = uint[6](2u, 1u, 3u, 7u, 8u, 5u);
 const uint kEdgeNormalCp[3] = uint[3](1u, 4u, 2u);
@@ -35,9 +45,9 @@ struct ClipSetup {
 };
 
 ClipSetup clipSetup(uint ct) {
-  uvec4 welds = clipHeaders[SFFD_CLIP_HEADER_STRIDE * ct + 1u];
+  uvec4 welds = clipHeaders(SFFD_CLIP_HEADER_STRIDE * ct + 1u);
   real3 corner[3];
-  for (uint c = 0u; c < 3u; ++c) corner[c] = clipReals[SFFD_CLIP_REAL_STRIDE * ct + 3u + c].xyz;
+  for (uint c = 0u; c < 3u; ++c) corner[c] = clipReals(SFFD_CLIP_REAL_STRIDE * ct + 3u + c).xyz;
   uint n[3];
   uint nmax = params.table.x;
   for (uint e = 0u; e < 3u; ++e) {
@@ -69,7 +79,7 @@ ClipSetup clipSetup(uint ct) {
   // Float lengths of a flat triangle may break a + b >= c by one segment: fall back to c = a + b.
   uint cc = min(S.count[2], S.count[0] + S.count[1]);
   uint key = ((S.count[0] - 1u) * nmax + (S.count[1] - 1u)) * nmax + (cc - 1u);
-  S.entry = uvec4(splitTable[4u * key], splitTable[4u * key + 1u], splitTable[4u * key + 2u], splitTable[4u * key + 3u]);
+  S.entry = uvec4(splitTable(4u * key), splitTable(4u * key + 1u), splitTable(4u * key + 2u), splitTable(4u * key + 3u));
   return S;
 }
 
@@ -94,8 +104,8 @@ struct Parent {
 Parent loadParent(uint id) {
   Parent p;
   p.id = id;
-  p.verts = triangles[SFFD_MESH_TRIANGLE_STRIDE * id];
-  p.welds = triangles[SFFD_MESH_TRIANGLE_STRIDE * id + 1u];
+  p.verts = triangles(SFFD_MESH_TRIANGLE_STRIDE * id);
+  p.welds = triangles(SFFD_MESH_TRIANGLE_STRIDE * id + 1u);
   for (uint c = 0u; c < 3u; ++c) {
     p.V[c] = positions(p.verts[c]).xyz;
     p.N[c] = normals(p.verts[c]).xyz;
@@ -131,19 +141,19 @@ SiteValue evaluateSite(Parent p, Site s) {
     r.lam = real3(0);
     r.lam[lo] = u;
     r.lam[hi] = t;
-    real3 bLo = pn[base + kSlotCp[slotOf(lo, e)]].xyz, bHi = pn[base + kSlotCp[slotOf(hi, e)]].xyz;
+    real3 bLo = pn(base + kSlotCp[slotOf(lo, e)]).xyz, bHi = pn(base + kSlotCp[slotOf(hi, e)]).xyz;
     r.xpn = pnEdgeCurve(p.V[lo], bLo, bHi, p.V[hi], t);
     P real3 xf = p.V[lo] + (p.V[hi] - p.V[lo]) * t;
     r.xflat = xf;
     r.nlin = snormalize(p.N[lo] * u + p.N[hi] * t);
-    r.npn = pnEdgeNormalCurve(p.N[lo], pn[base + SFFD_PN_NORMALS + kEdgeNormalCp[e]].xyz, p.N[hi], t);
+    r.npn = pnEdgeNormalCurve(p.N[lo], pn(base + SFFD_PN_NORMALS + kEdgeNormalCp[e]).xyz, p.N[hi], t);
   } else {
     P real3 l = s.lam;
     r.lam = l;
     real w[10];
     pnCubicWeights(l, w);
     P real3 x = real3(0);
-    for (uint i = 0u; i < 10u; ++i) x = x + pn[base + i].xyz * w[i];
+    for (uint i = 0u; i < 10u; ++i) x = x + pn(base + i).xyz * w[i];
     r.xpn = x;
     P real3 xf = (p.V[0] * l.x + p.V[1] * l.y) + p.V[2] * l.z;
     r.xflat = xf;
@@ -152,7 +162,7 @@ SiteValue evaluateSite(Parent p, Site s) {
     real q[6];
     pnQuadraticWeights(l, q);
     P real3 nn = real3(0);
-    for (uint i = 0u; i < 6u; ++i) nn = nn + pn[base + SFFD_PN_NORMALS + i].xyz * q[i];
+    for (uint i = 0u; i < 6u; ++i) nn = nn + pn(base + SFFD_PN_NORMALS + i).xyz * q[i];
     r.npn = snormalize(nn);
   }
   return r;
@@ -173,8 +183,8 @@ real4 neighbourNormalOnEdge(Parent p, uint e, real t) {
   edgeEnds(p, e, lo, hi);
   uint sLo = SFFD_SLOT_NORMAL_STRIDE * p.id + 2u * slotOf(lo, e);
   uint sHi = SFFD_SLOT_NORMAL_STRIDE * p.id + 2u * slotOf(hi, e);
-  real4 fLo = slotNormals[sLo], gLo = slotNormals[sLo + 1u];
-  real4 fHi = slotNormals[sHi], gHi = slotNormals[sHi + 1u];
+  real4 fLo = slotNormals(sLo), gLo = slotNormals(sLo + 1u);
+  real4 fHi = slotNormals(sHi), gHi = slotNormals(sHi + 1u);
   if (fLo.w < real(0.5) && fHi.w < real(0.5)) return real4(0);
   real3 nLo = gLo.w > real(0.5) ? gLo.xyz : fLo.xyz;   // the one that is not this triangle's own
   real3 nHi = gHi.w > real(0.5) ? gHi.xyz : fHi.xyz;
@@ -188,10 +198,10 @@ real4 neighbourNormalOnEdge(Parent p, uint e, real t) {
 
 // Site of a corner of the clip triangle.
 Site clipCornerSite(uint ct, uint c) {
-  uint kinds = clipHeaders[SFFD_CLIP_HEADER_STRIDE * ct].y;
+  uint kinds = clipHeaders(SFFD_CLIP_HEADER_STRIDE * ct).y;
   Site s;
   s.kind = (kinds >> (8u * c)) & 255u;
-  real4 l = clipReals[SFFD_CLIP_REAL_STRIDE * ct + c];
+  real4 l = clipReals(SFFD_CLIP_REAL_STRIDE * ct + c);
   s.lam = l.xyz;
   s.t = l.w;
   return s;
@@ -209,11 +219,11 @@ Site patternSite(uint ct, ClipSetup S, uint edge, uint step, real3 lamCanon) {
     // On clip edge between local corners a and b: the parameter from the lower-weld end is that
     // end's partner's weight, bit-identical from both sides (the table's symmetric pairs).
     uint a = S.perm[edge], b = S.perm[(edge + 1u) % 3u];
-    uvec4 welds = clipHeaders[SFFD_CLIP_HEADER_STRIDE * ct + 1u];
+    uvec4 welds = clipHeaders(SFFD_CLIP_HEADER_STRIDE * ct + 1u);
     uint lo = welds[a] <= welds[b] ? a : b, hi = lo == a ? b : a;
     P real tl = lamLocal[hi];
     uint ce = (b == (a + 1u) % 3u) ? a : b;   // local clip edge index (corner ce -> ce+1)
-    real4 ep = clipReals[base + 6u + ce];
+    real4 ep = clipReals(base + 6u + ce);
     Site s;
     if (ep.x >= real(0)) {
       real tLo = lo == ce ? ep.y : ep.z, tHi = lo == ce ? ep.z : ep.y;
@@ -222,7 +232,7 @@ Site patternSite(uint ct, ClipSetup S, uint edge, uint step, real3 lamCanon) {
       s.t = tt;
       s.lam = real3(0);
     } else {
-      real3 lamLo = clipReals[base + lo].xyz, lamHi = clipReals[base + hi].xyz;
+      real3 lamLo = clipReals(base + lo).xyz, lamHi = clipReals(base + hi).xyz;
       s.kind = 6u;
       s.t = real(0);
       P real3 lm = lamLo + (lamHi - lamLo) * tl;
@@ -233,7 +243,7 @@ Site patternSite(uint ct, ClipSetup S, uint edge, uint step, real3 lamCanon) {
   Site s;
   s.kind = 6u;
   s.t = real(0);
-  P real3 lm = (clipReals[base].xyz * lamLocal.x + clipReals[base + 1u].xyz * lamLocal.y) + clipReals[base + 2u].xyz * lamLocal.z;
+  P real3 lm = (clipReals(base).xyz * lamLocal.x + clipReals(base + 1u).xyz * lamLocal.y) + clipReals(base + 2u).xyz * lamLocal.z;
   s.lam = lm;
   return s;
 }

@@ -108,7 +108,8 @@ struct ParentT {
 // Writes one sub-triangle record (kernels/common/layout.h, SFFD_SUB_*) and its header. Slot 2c is
 // corner c on the sub-edge towards corner c+2, slot 2c+1 towards c+1; `parentEdgeOf(c, d)` gives the
 // parent edge the sub-edge (c, d) lies on, or -1. Where that parent edge is a crease, the slot holds
-// the neighbour's PN normal (w = 1); elsewhere the corner's own PN normal (w = 0).
+// the neighbour's PN normal (w = 1); elsewhere the corner's own PN normal (w = 0). The crease bits
+// go in the header and in the record (SFFD_SUB_CREASE_BITS).
 // `Out`: the record's storage type (Real in a kernel's buffer, double on the host).
 template <class Real, class Out, class ParentEdgeOf>
 void storeSubTriangle(const ParentT<Real>& par, const SiteT<Real> site[3], const SiteValueT<Real> val[3],
@@ -139,6 +140,7 @@ void storeSubTriangle(const ParentT<Real>& par, const SiteT<Real> site[3], const
       put(SFFD_SUB_NNBR + 2 * c + h, nn, nw);
     }
   }
+  put(SFFD_SUB_CREASE_BITS, val[0].lam, Real(creaseBits));
   hdr[0] = par.id, hdr[1] = creaseBits, hdr[2] = 0, hdr[3] = 0;
 }
 

@@ -22,18 +22,24 @@ struct ClipTwin {
   const uint32_t* clipHeaders;
   Real l;
 
+  // The two input ranges' sections (layout.h, ClipParams), as clip_sites.glsl reads them.
   ClipTwin(const CpuKernelArgs& a, uint64_t clipTriangles)
       : args(a),
         params(a.paramsAs<gpu::ClipParams>()),
-        words(a.array<const uint32_t>(SFFD_BINDING_SPLIT_TABLE)),
-        meshTriangles(a.array<const uint32_t>(SFFD_BINDING_MESH_TRIANGLES)),
-        positions(a.array<const Real>(SFFD_BINDING_MESH_VERTICES)),
-        normals(positions.subspan(std::min<size_t>(positions.size(), 4 * size_t(params.range.z)))),
-        slots(a.array<const Real>(SFFD_BINDING_MESH_SLOT_NORMALS)),
-        pn(a.array<const Real>(SFFD_BINDING_PN_OUT)),
-        clipReals(a.array<const Real>(SFFD_BINDING_CLIP_REALS, 4 * SFFD_CLIP_REAL_STRIDE * clipTriangles).data()),
-        clipHeaders(a.array<const uint32_t>(SFFD_BINDING_CLIP_HEADERS, 4 * SFFD_CLIP_HEADER_STRIDE * clipTriangles).data()),
+        words(a.array<const uint32_t>(SFFD_BINDING_CLIP_WORDS)),
+        meshTriangles(from(words, params.words.x)),
+        positions(a.array<const Real>(SFFD_BINDING_CLIP_REALS)),
+        normals(from(positions, 4 * uint64_t(params.range.z))),
+        slots(from(positions, 4 * uint64_t(params.sections.x))),
+        pn(from(positions, 4 * uint64_t(params.sections.y))),
+        clipReals(a.array<const Real>(SFFD_BINDING_CLIP_REALS, 4 * (uint64_t(params.sections.z) + SFFD_CLIP_REAL_STRIDE * clipTriangles))
+                      .data() + 4 * uint64_t(params.sections.z)),
+        clipHeaders(a.array<const uint32_t>(SFFD_BINDING_CLIP_WORDS, params.words.y + 4 * SFFD_CLIP_HEADER_STRIDE * clipTriangles)
+                        .data() + params.words.y),
         l(Real(params.target.x)) {}
+
+  template <class T>
+  static std::span<const T> from(std::span<const T> s, uint64_t first) { return s.subspan(std::min<uint64_t>(s.size(), first)); }
 
   static RVec3<Real> v3(const Real* a, size_t i) { return {a[4 * i], a[4 * i + 1], a[4 * i + 2]}; }
 
@@ -190,7 +196,7 @@ void countThreads(const CpuKernelArgs& a, uint64_t first, uint64_t last) {
   const auto& p = a.paramsAs<gpu::ClipParams>();
   const uint64_t n = uint64_t(p.range.x) + p.range.y;
   ClipTwin<Real> C(a, n);
-  uint32_t* counts = a.array<uint32_t>(SFFD_BINDING_CLIP_COUNTS, n).data();
+  uint32_t* counts = a.array<uint32_t>(SFFD_BINDING_CLIP_WORDS, p.words.z + n).data() + p.words.z;
   for (uint64_t t = first; t < std::min<uint64_t>(last, p.range.y); ++t) {
     const size_t ct = p.range.x + uint32_t(t);
     counts[ct] = C.setup(ct).entry[3];
@@ -202,7 +208,7 @@ void writeThreads(const CpuKernelArgs& a, uint64_t first, uint64_t last) {
   const auto& p = a.paramsAs<gpu::ClipParams>();
   const uint64_t n = uint64_t(p.range.x) + p.range.y;
   ClipTwin<Real> C(a, n);
-  const uint32_t* offsets = a.array<const uint32_t>(SFFD_BINDING_CLIP_COUNTS, n).data();
+  const uint32_t* offsets = a.array<const uint32_t>(SFFD_BINDING_CLIP_WORDS, p.words.z + n).data() + p.words.z;
   std::span<uint32_t> headers = a.array<uint32_t>(SFFD_BINDING_SUB_HEADERS);
   std::span<Real> records = a.array<Real>(SFFD_BINDING_SUB_RECORDS);
   const uint64_t capacity = std::min<uint64_t>(headers.size() / 4, records.size() / (4 * SFFD_SUB_STRIDE));

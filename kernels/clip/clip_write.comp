@@ -5,7 +5,6 @@
 #include "../common/prelude.glsl"
 #include "clip_sites.glsl"
 
-layout(std430, SFFD_SET binding = SFFD_BINDING_CLIP_COUNTS) readonly buffer Offsets { uint offsets[]; };
 layout(std430, SFFD_SET binding = SFFD_BINDING_SUB_HEADERS) writeonly buffer SubHeaders { uvec4 subHeaders[]; };
 layout(std430, SFFD_SET binding = SFFD_BINDING_SUB_RECORDS) writeonly buffer SubRecords { real4 subRecords[]; };
 
@@ -14,13 +13,13 @@ void main() {
   if (t >= params.range.y) return;
   uint ct = params.range.x + t;
   ClipSetup S = clipSetup(ct);
-  Parent par = loadParent(clipHeaders[SFFD_CLIP_HEADER_STRIDE * ct].x);
-  uint out0 = offsets[ct];
+  Parent par = loadParent(clipHeaders(SFFD_CLIP_HEADER_STRIDE * ct).x);
+  uint out0 = counts(ct);
   for (uint k = 0u; k < S.entry.w; ++k) {
     uint idx[3], edge[3], step[3];
     for (uint c = 0u; c < 3u; ++c) {
       uint i = 3u * (S.entry.z + k) + c;
-      uint word = splitTable[params.table.z + i / 2u];
+      uint word = splitTable(params.table.z + i / 2u);
       idx[c] = (i % 2u == 0u) ? (word & 65535u) : (word >> 16u);
     }
     if (S.odd) { uint x = idx[1]; idx[1] = idx[2]; idx[2] = x; }
@@ -28,8 +27,8 @@ void main() {
     SiteValue val[3];
     for (uint c = 0u; c < 3u; ++c) {
       uint v = params.table.y + 4u * (S.entry.x + idx[c]);
-      real3 lamCanon = real3(uintBitsToFloat(splitTable[v]), uintBitsToFloat(splitTable[v + 1u]), uintBitsToFloat(splitTable[v + 2u]));
-      uint w = splitTable[v + 3u];
+      real3 lamCanon = real3(uintBitsToFloat(splitTable(v)), uintBitsToFloat(splitTable(v + 1u)), uintBitsToFloat(splitTable(v + 2u)));
+      uint w = splitTable(v + 3u);
       edge[c] = w & 255u;
       step[c] = w >> 16u;
       site[c] = patternSite(ct, S, edge[c], step[c], lamCanon);
@@ -53,7 +52,7 @@ void main() {
         if (ce < 3u) {
           uint a = S.perm[ce], b = S.perm[(ce + 1u) % 3u];
           uint le = (b == (a + 1u) % 3u) ? a : b;
-          real pe = clipReals[SFFD_CLIP_REAL_STRIDE * ct + 6u + le].x;
+          real pe = clipReals(SFFD_CLIP_REAL_STRIDE * ct + 6u + le).x;
           if (pe >= real(0)) {
             uint e = uint(pe);
             real4 nb = neighbourNormalOnEdge(par, e, siteParamOnEdge(par, site[c], e));
@@ -66,6 +65,7 @@ void main() {
         subRecords[rec + SFFD_SUB_NNBR + 2u * c + h] = nn;
       }
     }
+    subRecords[rec + SFFD_SUB_CREASE_BITS] = real4(val[0].lam, real(creaseBits));
     subHeaders[o] = uvec4(par.id, creaseBits, 0u, 0u);
   }
 }

@@ -175,6 +175,50 @@ const PackedTable& packedTable() {
   return T;
 }
 
+ClipRanges clipRanges(const PreparedMesh& mesh, size_t clipTriangles, size_t realSize) {
+  ClipRanges r;
+  r.realSize = realSize;
+  const uint64_t realAlign = SFFD_SECTION_ALIGN / (4 * realSize), wordAlign = SFFD_SECTION_ALIGN / 4;
+  auto up = [](uint64_t v, uint64_t a) { return (v + a - 1) / a * a; };
+  const uint64_t nv = mesh.positions.size() / 4, nt = mesh.triangleCount();
+  r.normals = nv;
+  r.slotNormals = up(2 * nv, realAlign);
+  r.pn = up(r.slotNormals + SFFD_SLOT_NORMAL_STRIDE * nt, realAlign);
+  r.clipReals = up(r.pn + SFFD_PN_STRIDE * nt, realAlign);
+  r.realElements = r.clipReals + SFFD_CLIP_REAL_STRIDE * clipTriangles;
+  r.triangles = up(packedTable().words.size(), wordAlign);
+  r.clipHeaders = up(r.triangles + mesh.triangles.size(), wordAlign);
+  r.counts = up(r.clipHeaders + 4 * SFFD_CLIP_HEADER_STRIDE * clipTriangles, wordAlign);
+  r.words = r.counts + clipTriangles;
+  return r;
+}
+
+void ClipRanges::name(gpu::ClipParams& p) const {
+  p.range.z = uint32_t(normals);
+  p.sections = {uint32_t(slotNormals), uint32_t(pn), uint32_t(clipReals), 0};
+  p.words = {uint32_t(triangles), uint32_t(clipHeaders), uint32_t(counts), 0};
+}
+
+std::vector<double> clipRealRange(const ClipRanges& r, const PreparedMesh& mesh, const std::vector<double>* pnRecords,
+                                  const PackedClip& clip) {
+  std::vector<double> v(4 * r.realElements, 0.0);
+  const std::vector<double> verts = meshVertexRange(mesh);
+  std::copy(verts.begin(), verts.end(), v.begin());
+  std::copy(mesh.slotNormals.begin(), mesh.slotNormals.end(), v.begin() + 4 * r.slotNormals);
+  if (pnRecords) std::copy(pnRecords->begin(), pnRecords->end(), v.begin() + 4 * r.pn);
+  std::copy(clip.reals.begin(), clip.reals.end(), v.begin() + 4 * r.clipReals);
+  return v;
+}
+
+std::vector<uint32_t> clipWordRange(const ClipRanges& r, const PreparedMesh& mesh, const PackedClip& clip) {
+  std::vector<uint32_t> w(r.words, 0);
+  const PackedTable& T = packedTable();
+  std::copy(T.words.begin(), T.words.end(), w.begin());
+  std::copy(mesh.triangles.begin(), mesh.triangles.end(), w.begin() + r.triangles);
+  std::copy(clip.headers.begin(), clip.headers.end(), w.begin() + r.clipHeaders);
+  return w;
+}
+
 namespace {
 
 template <class Real>
@@ -184,44 +228,37 @@ SubTriangleRecords clipRun(Backend& backend, const PreparedMesh& M, const PnOutp
   const PackedTable& T = packedTable();
   PackedClip pc = packClip(clip);
   const size_t n = clip.triangles.size();
-  std::vector<Real> verts = convertReals<Real>(meshVertexRange(M)), slots = convertReals<Real>(M.slotNormals),
-                    rec = convertReals<Real>(pn.records),
-                    reals = convertReals<Real>(pc.reals);
+  const ClipRanges ranges = clipRanges(M, n, sizeof(Real));
+  const std::vector<Real> reals = convertReals<Real>(clipRealRange(ranges, M, &pn.records, pc));
+  const std::vector<uint32_t> words = clipWordRange(ranges, M, pc);
   auto fits = [&](size_t bytes, const char* what) {
     if (bytes > lim.maxStorageBufferRange)
       throw Error(ErrorKind::Input, std::string("the job's ") + what + " (" + std::to_string(bytes >> 20) +
                                         " MiB) exceed one storage binding on this device (" +
                                         std::to_string(lim.maxStorageBufferRange >> 20) + " MiB); use a coarser mesh");
   };
-  fits(verts.size() * sizeof(Real), "vertices");
-  fits(rec.size() * sizeof(Real), "PN records");
-  fits(reals.size() * sizeof(Real), "clip triangles");
+  fits(reals.size() * sizeof(Real), "vertices, PN records and clip triangles");
+  fits(words.size() * 4, "triangles and clip triangles");
   auto make = [&](const void* data, size_t bytes) {
     BufferId b = backend.createBuffer(std::max<size_t>(bytes, 16));
     if (bytes) backend.upload(b, 0, data, bytes);
     return b;
   };
-  BufferId bTable = make(T.words.data(), T.words.size() * 4);
-  BufferId bVerts = make(verts.data(), verts.size() * sizeof(Real));
-  BufferId bTri = make(M.triangles.data(), M.triangles.size() * 4);
-  BufferId bSlot = make(slots.data(), slots.size() * sizeof(Real)), bPn = make(rec.data(), rec.size() * sizeof(Real));
-  BufferId bHdr = make(pc.headers.data(), pc.headers.size() * 4), bReal = make(reals.data(), reals.size() * sizeof(Real));
-  BufferId bCounts = backend.createBuffer(std::max<size_t>(n * 4, 16));
+  BufferId bReals = make(reals.data(), reals.size() * sizeof(Real)), bWords = make(words.data(), words.size() * 4);
 
   gpu::ClipParams params;
   params.table = {T.nmax, T.vertexWord, T.triangleWord, 0};
   params.target = {float(l), 0, 0, 0};
   auto dispatch = [&](const char* kernel, const char* label, size_t first, size_t count, std::vector<BufferBinding> extra) {
-    params.range = {uint32_t(first), uint32_t(count), uint32_t(M.positions.size() / 4), 0};
+    params.range = {uint32_t(first), uint32_t(count), 0, 0};
+    ranges.name(params);
     Dispatch d;
     d.kernel = kernel;
     d.label = label;
     d.variant = variant;
     d.params = &params;
     d.paramsSize = sizeof(params);
-    d.buffers = {{SFFD_BINDING_SPLIT_TABLE, bTable}, {SFFD_BINDING_MESH_VERTICES, bVerts},
-                 {SFFD_BINDING_MESH_TRIANGLES, bTri}, {SFFD_BINDING_MESH_SLOT_NORMALS, bSlot}, {SFFD_BINDING_PN_OUT, bPn},
-                 {SFFD_BINDING_CLIP_HEADERS, bHdr}, {SFFD_BINDING_CLIP_REALS, bReal}};
+    d.buffers = {{SFFD_BINDING_CLIP_REALS, bReals}, {SFFD_BINDING_CLIP_WORDS, bWords}};
     d.buffers.insert(d.buffers.end(), extra.begin(), extra.end());
     gridFor(count, lim, d.groups);
     backend.dispatch(d);
@@ -230,8 +267,8 @@ SubTriangleRecords clipRun(Backend& backend, const PreparedMesh& M, const PnOutp
   // Counting pass, exclusive scan on the host, then the writing pass in chunks whose output fits a binding.
   std::vector<uint32_t> counts(n);
   if (n) {
-    dispatch("clip_count", "clip_count", 0, n, {{SFFD_BINDING_CLIP_COUNTS, bCounts}});
-    backend.download(bCounts, 0, counts.data(), n * 4);
+    dispatch("clip_count", "clip_count", 0, n, {});
+    backend.download(bWords, ranges.counts * 4, counts.data(), n * 4);
   }
   std::vector<uint64_t> offsets(n + 1, 0);
   for (size_t i = 0; i < n; ++i) offsets[i + 1] = offsets[i] + counts[i];
@@ -257,9 +294,9 @@ SubTriangleRecords clipRun(Backend& backend, const PreparedMesh& M, const PnOutp
     while (last < n && offsets[last + 1] - offsets[first] <= maxSubs) ++last;
     for (size_t i = first; i < last; ++i) chunkOffsets[i] = uint32_t(offsets[i] - offsets[first]);
     uint64_t subs = offsets[last] - offsets[first];
-    backend.upload(bCounts, first * 4, chunkOffsets.data() + first, (last - first) * 4);
+    backend.upload(bWords, (ranges.counts + first) * 4, chunkOffsets.data() + first, (last - first) * 4);
     dispatch("clip_write", "clip_write", first, last - first,
-             {{SFFD_BINDING_CLIP_COUNTS, bCounts}, {SFFD_BINDING_SUB_HEADERS, bSubHdr}, {SFFD_BINDING_SUB_RECORDS, bSubRec}});
+             {{SFFD_BINDING_SUB_HEADERS, bSubHdr}, {SFFD_BINDING_SUB_RECORDS, bSubRec}});
     if (subs) {
       backend.download(bSubHdr, 0, &R.headers[4 * offsets[first]], subs * 16);
       recs.resize(subs * SFFD_SUB_STRIDE * 4);
@@ -269,7 +306,7 @@ SubTriangleRecords clipRun(Backend& backend, const PreparedMesh& M, const PnOutp
     first = last;
   }
   backend.finish();
-  for (BufferId b : {bTable, bVerts, bTri, bSlot, bPn, bHdr, bReal, bCounts, bSubHdr, bSubRec}) backend.destroyBuffer(b);
+  for (BufferId b : {bReals, bWords, bSubHdr, bSubRec}) backend.destroyBuffer(b);
   R.timings = backend.takeTimings();
   return R;
 }

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/backend.h"
+#include "kernels/common/shader_layout.h"
 #include "kernels/pn/pn_triangles.h"
 #include "model/prepared_mesh.h"
 #include "model/sub_triangles.h"
@@ -63,6 +64,22 @@ struct PackedTable {
   uint32_t nmax = 0, vertexWord = 0, triangleWord = 0;
 };
 const PackedTable& packedTable();
+
+// The clip kernels' two input ranges (layout.h, SFFD_BINDING_CLIP_REALS and SFFD_BINDING_CLIP_WORDS):
+// where each section begins, in real4 elements and in words, each at a multiple of SFFD_SECTION_ALIGN
+// bytes. The one place that lays them out; clipRealRange and clipWordRange fill them.
+struct ClipRanges {
+  uint64_t normals = 0, slotNormals = 0, pn = 0, clipReals = 0, realElements = 0;
+  uint64_t triangles = 0, clipHeaders = 0, counts = 0, words = 0;
+  size_t realSize = 4;
+  uint64_t byteOf(uint64_t element) const { return element * 4 * realSize; }   // of a real4 element
+  void name(gpu::ClipParams& params) const;   // range.z, sections, words
+};
+ClipRanges clipRanges(const PreparedMesh& mesh, size_t clipTriangles, size_t realSize);
+// The reals' range (the PN records' section zero without `pnRecords`: the caller's pn_triangles writes it).
+std::vector<double> clipRealRange(const ClipRanges& r, const PreparedMesh& mesh, const std::vector<double>* pnRecords,
+                                  const PackedClip& clip);
+std::vector<uint32_t> clipWordRange(const ClipRanges& r, const PreparedMesh& mesh, const PackedClip& clip);
 
 struct CpuKernelArgs;
 namespace cpu {

@@ -106,13 +106,25 @@ SFFD_STRUCT_END(ClassicParams)
 
 // ---- kernels clip_count and clip_write: regular clipping by the split-pattern table (METHOD.md 4.2) ----
 // One thread per clip triangle (an original triangle, or a piece of one after the pre-split of
-// triangles whose edges need more than Nmax segments). Buffers 1..4 are the mesh and PN buffers above.
-#define SFFD_BINDING_SPLIT_TABLE SFFD_SLOT_5     // uint: pattern entries (4 each), then vertices (4 each: lambda bits, edge | step << 16), then packed uint16 triangle indices
-#define SFFD_BINDING_CLIP_COUNTS SFFD_SLOT_6     // uint per clip triangle: sub-triangle count (clip_count), exclusive offset (clip_write)
-#define SFFD_BINDING_CLIP_HEADERS SFFD_SLOT_8    // 2 uvec4 per clip triangle: (parent, corner kinds, 0, 0), corner weld ids
-#define SFFD_BINDING_CLIP_REALS SFFD_SLOT_9      // 9 real4 per clip triangle: lam[3], flat[3], edge params[3]
-#define SFFD_BINDING_SUB_HEADERS SFFD_SLOT_10    // uvec4 per sub-triangle: parent, crease slot bits, 0, 0
-#define SFFD_BINDING_SUB_RECORDS SFFD_SLOT_11    // SFFD_SUB_STRIDE real4 per sub-triangle
+// triangles whose edges need more than Nmax segments). Four storage blocks in all (the OpenGL ES 3.1
+// minimum): two input ranges of sections at the elements ClipParams names, and the two outputs. Each
+// section begins at a multiple of SFFD_SECTION_ALIGN bytes, so that pn_triangles binds the mesh's
+// sections and writes the PN records as ranges of their own.
+#define SFFD_BINDING_CLIP_REALS SFFD_SLOT_1      // real4: the mesh vertices (positions, then normals from element
+                                                 // range.z); from element sections.x the slot normals
+                                                 // (SFFD_SLOT_NORMAL_STRIDE per triangle); from sections.y the PN
+                                                 // records (SFFD_PN_STRIDE per triangle); from sections.z per clip
+                                                 // triangle SFFD_CLIP_REAL_STRIDE: lam[3], flat[3], edge params[3]
+#define SFFD_BINDING_CLIP_WORDS SFFD_SLOT_2      // uint: the split table (pattern entries, 4 each; then vertices, 4
+                                                 // each: lambda bits, edge | step << 16; then packed uint16 triangle
+                                                 // indices); from word words.x the mesh triangles (4 per uvec4 of
+                                                 // SFFD_BINDING_MESH_TRIANGLES); from words.y per clip triangle
+                                                 // 4 * SFFD_CLIP_HEADER_STRIDE: (parent, corner kinds, 0, 0), corner
+                                                 // weld ids; from words.z one per clip triangle: its sub-triangle
+                                                 // count (clip_count writes), its exclusive offset (clip_write reads)
+#define SFFD_BINDING_SUB_HEADERS SFFD_SLOT_3     // uvec4 per sub-triangle: parent, crease slot bits, 0, 0
+#define SFFD_BINDING_SUB_RECORDS SFFD_SLOT_4     // SFFD_SUB_STRIDE real4 per sub-triangle
+#define SFFD_SECTION_ALIGN 256u                  // the largest storage offset alignment GL and Vulkan allow
 #define SFFD_CLIP_HEADER_STRIDE 2u
 #define SFFD_CLIP_REAL_STRIDE 9u
 // Corner kinds of a clip triangle (packed 8 bits each in header.y): the corner is parent corner k (0..2),
@@ -129,20 +141,28 @@ SFFD_STRUCT_END(ClassicParams)
 #define SFFD_SUB_NLIN 9u
 #define SFFD_SUB_NPN 12u
 #define SFFD_SUB_NNBR 15u
+// The crease slot bits (header.y, 6 bits) again, as the integer-valued real w of the record's first
+// element: the deform kernels read them there and bind no uint range.
+#define SFFD_SUB_CREASE_BITS SFFD_SUB_LAM
 
 SFFD_STRUCT_BEGIN(ClipParams)
-  SFFD_UVEC4 range;    // x: first clip triangle, y: clip triangle count, z: the first normal of the vertices' range
-  SFFD_UVEC4 table;    // x: Nmax, y: first vertex word, z: first triangle word
-  SFFD_VEC4 target;    // x: target edge length l
+  SFFD_UVEC4 range;      // x: first clip triangle, y: clip triangle count, z: the first normal of the reals' range
+  SFFD_UVEC4 table;      // x: Nmax, y: first vertex word, z: first triangle word (of the split table)
+  SFFD_VEC4 target;      // x: target edge length l
+  SFFD_UVEC4 sections;   // first element in the reals' range of x: the slot normals, y: the PN records, z: the clip triangles
+  SFFD_UVEC4 words;      // first word in the words' range of x: the mesh triangles, y: the clip headers, z: the counts
 SFFD_STRUCT_END(ClipParams)
 
 // ---- kernel deform_smooth: the deform stage of smooth FFD, one thread per sub-triangle (METHOD.md 3.4) ----
-// Bindings 1 and 2 are the lattice (lattice_eval.glsl).
-#define SFFD_BINDING_DEFORM_FIT SFFD_SLOT_3          // reals: per interior fitting point SFFD_FIT_STRIDE values
-#define SFFD_BINDING_DEFORM_SUB_HEADERS SFFD_SLOT_4  // uvec4 per sub-triangle (clip_write's headers)
-#define SFFD_BINDING_DEFORM_SUB_RECORDS SFFD_SLOT_5  // SFFD_SUB_STRIDE real4 per sub-triangle (clip_write's records)
-#define SFFD_BINDING_DEFORM_PATCHES SFFD_SLOT_6      // SFFD_PATCH_STRIDE real4 per patch
-#define SFFD_BINDING_DEFORM_TESS SFFD_SLOT_7         // per patch: tessellation positions, then normals (real4 each)
+// Four storage blocks in all (the OpenGL ES 3.1 minimum), the split kernels too: bindings 1 and 2 are
+// the lattice (lattice_eval.glsl), the lattice frame range holding the fit table from the real
+// DeformParams.sections.y names; the sub-triangle records; one output range of sections. The one header
+// field the kernels need, the crease slot bits, rides in the records (SFFD_SUB_CREASE_BITS).
+#define SFFD_BINDING_DEFORM_SUB_RECORDS SFFD_SLOT_3  // SFFD_SUB_STRIDE real4 per sub-triangle (clip_write's records)
+#define SFFD_BINDING_DEFORM_OUT SFFD_SLOT_4          // real4, per sub-triangle of the chunk: the tessellation (positions,
+                                                     // then normals; first, so that it can be drawn from the range);
+                                                     // from element sections.z the SFFD_PATCH_STRIDE patch control
+                                                     // points; from element sections.w (split form) the samples
 // Fitting point record: lambda (3), weight w of the centre fit, then the 10 cubic Bernstein values.
 #define SFFD_FIT_STRIDE 14u
 // Patch record: 10 geometry control points, then 10 normal control points (linear index order).
@@ -151,7 +171,6 @@ SFFD_STRUCT_END(ClipParams)
 // Split form (kernels deform_step_sample, _fit, _adjust, _tessellate): the samples of one sub-triangle,
 // SFFD_SAMPLE_FIXED + (interior fitting points) real4: Q[3], QN[3], E[6], EN[6], adj[3], adjNbr[6], then
 // the interior sample normals.
-#define SFFD_BINDING_DEFORM_SAMPLES SFFD_SLOT_8
 #define SFFD_SAMPLE_FIXED 27u
 
 // The deform kernels' parameter block also carries the lattice itself (float variants, when it fits):
@@ -160,13 +179,15 @@ SFFD_STRUCT_END(ClipParams)
 // all, the smallest uniform block every GL 4.3 and Vulkan device accepts. lattice.break_offset.w is
 // then the first vec4 of the Bezier coefficients in inline_lattice (the frame reals come first, four
 // to a vec4); 0 means the kernel reads the lattice storage buffers instead (f64, or too large).
-// The fit table follows the lattice there when it fits too (inline_fit.x: its first vec4, 0: read
-// the fit buffer).
+// The fit table follows the lattice there when it fits too (sections.x: its first vec4, 0: read
+// it from the lattice frame range).
 #define SFFD_INLINE_LATTICE_VEC4 1015
 SFFD_STRUCT_BEGIN(DeformParams)
   SFFD_STRUCT_MEMBER(LatticeParams, lattice)
   SFFD_UVEC4 range;    // x: first sub-triangle, y: count, z: interior fitting points, w: tessellation level
-  SFFD_UVEC4 inline_fit;
+  SFFD_UVEC4 sections;   // x: first vec4 of the fit table in inline_lattice (0: not there), y: its first real
+                         // in the lattice frame range; z: first patch element, w: first sample element
+                         // (SFFD_BINDING_DEFORM_OUT)
   SFFD_VEC4 inline_lattice[SFFD_INLINE_LATTICE_VEC4];
 SFFD_STRUCT_END(DeformParams)
 

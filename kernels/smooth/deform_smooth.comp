@@ -8,8 +8,7 @@
 #include "../common/prelude.glsl"
 #include "smooth_deform.glsl"
 
-layout(std430, SFFD_SET binding = SFFD_BINDING_DEFORM_PATCHES) writeonly buffer Patches { real4 patches[]; };
-layout(std430, SFFD_SET binding = SFFD_BINDING_DEFORM_TESS) writeonly buffer Tess { real4 tess[]; };
+layout(std430, SFFD_SET binding = SFFD_BINDING_DEFORM_OUT) writeonly buffer DeformOut { real4 deformOut[]; };
 
 void main() {
   uint tid = sffdThreadIndex();
@@ -24,12 +23,12 @@ void main() {
   P real3 centreN = real3(0);
   for (uint i = 0u; i < params.range.z; ++i) centreN = centreN + smoothCentreTerm(ncp, smoothInteriorNormal(corners, i), i);
   ncp[4] = centreN;
-  smoothAdjust(subHeaders[st].y, adj, adjNbr, cp);
+  smoothAdjust(smoothCreaseBits(st), adj, adjNbr, cp);
 
   uint pbase = SFFD_PATCH_STRIDE * st;
   for (uint k = 0u; k < 10u; ++k) {
-    patches[pbase + k] = real4(cp[k], 0);
-    patches[pbase + 10u + k] = real4(ncp[k], 0);
+    patches(pbase + k) = real4(cp[k], 0);
+    patches(pbase + 10u + k) = real4(ncp[k], 0);
   }
   uint L = params.range.w;
   uint nv = (L + 1u) * (L + 2u) / 2u;
@@ -39,7 +38,7 @@ void main() {
       real3 x, n;
       smoothTessVertex(cp, ncp, L, r, t, x, n);
       uint v = r * (r + 1u) / 2u + t;
-      tess[tbase + v] = real4(x, 0);
-      tess[tbase + nv + v] = real4(n, 0);
+      tess(tbase + v) = real4(x, 0);
+      tess(tbase + nv + v) = real4(n, 0);
     }
 }

@@ -3,8 +3,7 @@
 #extension GL_GOOGLE_include_directive : require
 #include "../common/prelude.glsl"
 #include "smooth_deform.glsl"
-layout(std430, SFFD_SET binding = SFFD_BINDING_DEFORM_SAMPLES) readonly buffer Samples { real4 samples[]; };
-layout(std430, SFFD_SET binding = SFFD_BINDING_DEFORM_PATCHES) buffer Patches { real4 patches[]; };
+layout(std430, SFFD_SET binding = SFFD_BINDING_DEFORM_OUT) buffer DeformOut { real4 deformOut[]; };
 
 void main() {
   uint tid = sffdThreadIndex();
@@ -12,10 +11,10 @@ void main() {
   uint st = params.range.x + tid;
   uint b = (SFFD_SAMPLE_FIXED + params.range.z) * st;
   real3 adj[3], adjNbr[6], cp[10];
-  for (uint c = 0u; c < 3u; ++c) adj[c] = samples[b + 18u + c].xyz;
-  for (uint e = 0u; e < 6u; ++e) adjNbr[e] = samples[b + 21u + e].xyz;
+  for (uint c = 0u; c < 3u; ++c) adj[c] = samples(b + 18u + c).xyz;
+  for (uint e = 0u; e < 6u; ++e) adjNbr[e] = samples(b + 21u + e).xyz;
   uint pbase = SFFD_PATCH_STRIDE * st;
-  for (uint k = 0u; k < 10u; ++k) cp[k] = patches[pbase + k].xyz;
-  smoothAdjust(subHeaders[st].y, adj, adjNbr, cp);
-  for (uint k = 0u; k < 10u; ++k) patches[pbase + k] = real4(cp[k], 0);
+  for (uint k = 0u; k < 10u; ++k) cp[k] = patches(pbase + k).xyz;
+  smoothAdjust(smoothCreaseBits(st), adj, adjNbr, cp);
+  for (uint k = 0u; k < 10u; ++k) patches(pbase + k) = real4(cp[k], 0);
 }

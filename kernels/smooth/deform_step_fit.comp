@@ -3,8 +3,7 @@
 #extension GL_GOOGLE_include_directive : require
 #include "../common/prelude.glsl"
 #include "smooth_deform.glsl"
-layout(std430, SFFD_SET binding = SFFD_BINDING_DEFORM_SAMPLES) readonly buffer Samples { real4 samples[]; };
-layout(std430, SFFD_SET binding = SFFD_BINDING_DEFORM_PATCHES) writeonly buffer Patches { real4 patches[]; };
+layout(std430, SFFD_SET binding = SFFD_BINDING_DEFORM_OUT) buffer DeformOut { real4 deformOut[]; };
 
 void main() {
   uint tid = sffdThreadIndex();
@@ -12,16 +11,16 @@ void main() {
   uint st = params.range.x + tid;
   uint b = (SFFD_SAMPLE_FIXED + params.range.z) * st;
   real3 Q[3], QN[3], E[6], EN[6];
-  for (uint c = 0u; c < 3u; ++c) { Q[c] = samples[b + c].xyz; QN[c] = samples[b + 3u + c].xyz; }
-  for (uint e = 0u; e < 6u; ++e) { E[e] = samples[b + 6u + e].xyz; EN[e] = samples[b + 12u + e].xyz; }
+  for (uint c = 0u; c < 3u; ++c) { Q[c] = samples(b + c).xyz; QN[c] = samples(b + 3u + c).xyz; }
+  for (uint e = 0u; e < 6u; ++e) { E[e] = samples(b + 6u + e).xyz; EN[e] = samples(b + 12u + e).xyz; }
   real3 cp[10], ncp[10];
   smoothBoundaryControlPoints(Q, QN, E, EN, cp, ncp);
   P real3 centreN = real3(0);
-  for (uint i = 0u; i < params.range.z; ++i) centreN = centreN + smoothCentreTerm(ncp, samples[b + SFFD_SAMPLE_FIXED + i].xyz, i);
+  for (uint i = 0u; i < params.range.z; ++i) centreN = centreN + smoothCentreTerm(ncp, samples(b + SFFD_SAMPLE_FIXED + i).xyz, i);
   ncp[4] = centreN;
   uint pbase = SFFD_PATCH_STRIDE * st;
   for (uint k = 0u; k < 10u; ++k) {
-    patches[pbase + k] = real4(cp[k], 0);
-    patches[pbase + 10u + k] = real4(ncp[k], 0);
+    patches(pbase + k) = real4(cp[k], 0);
+    patches(pbase + 10u + k) = real4(ncp[k], 0);
   }
 }

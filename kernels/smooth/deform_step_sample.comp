@@ -4,7 +4,7 @@
 #extension GL_GOOGLE_include_directive : require
 #include "../common/prelude.glsl"
 #include "smooth_deform.glsl"
-layout(std430, SFFD_SET binding = SFFD_BINDING_DEFORM_SAMPLES) writeonly buffer Samples { real4 samples[]; };
+layout(std430, SFFD_SET binding = SFFD_BINDING_DEFORM_OUT) writeonly buffer DeformOut { real4 deformOut[]; };
 
 void main() {
   uint tid = sffdThreadIndex();
@@ -16,14 +16,14 @@ void main() {
   smoothEdgeSamples(corners, E, EN);
   uint b = (SFFD_SAMPLE_FIXED + params.range.z) * st;
   for (uint c = 0u; c < 3u; ++c) {
-    samples[b + c] = real4(Q[c], 0);
-    samples[b + 3u + c] = real4(QN[c], 0);
-    samples[b + 18u + c] = real4(adj[c], 0);
+    samples(b + c) = real4(Q[c], 0);
+    samples(b + 3u + c) = real4(QN[c], 0);
+    samples(b + 18u + c) = real4(adj[c], 0);
   }
   for (uint e = 0u; e < 6u; ++e) {
-    samples[b + 6u + e] = real4(E[e], 0);
-    samples[b + 12u + e] = real4(EN[e], 0);
-    samples[b + 21u + e] = real4(adjNbr[e], 0);
+    samples(b + 6u + e) = real4(E[e], 0);
+    samples(b + 12u + e) = real4(EN[e], 0);
+    samples(b + 21u + e) = real4(adjNbr[e], 0);
   }
-  for (uint i = 0u; i < params.range.z; ++i) samples[b + SFFD_SAMPLE_FIXED + i] = real4(smoothInteriorNormal(corners, i), 0);
+  for (uint i = 0u; i < params.range.z; ++i) samples(b + SFFD_SAMPLE_FIXED + i) = real4(smoothInteriorNormal(corners, i), 0);
 }

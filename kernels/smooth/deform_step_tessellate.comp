@@ -3,8 +3,7 @@
 #extension GL_GOOGLE_include_directive : require
 #include "../common/prelude.glsl"
 #include "smooth_deform.glsl"
-layout(std430, SFFD_SET binding = SFFD_BINDING_DEFORM_PATCHES) readonly buffer Patches { real4 patches[]; };
-layout(std430, SFFD_SET binding = SFFD_BINDING_DEFORM_TESS) writeonly buffer Tess { real4 tess[]; };
+layout(std430, SFFD_SET binding = SFFD_BINDING_DEFORM_OUT) buffer DeformOut { real4 deformOut[]; };
 
 void main() {
   uint tid = sffdThreadIndex();
@@ -12,7 +11,7 @@ void main() {
   uint st = params.range.x + tid;
   uint pbase = SFFD_PATCH_STRIDE * st;
   real3 cp[10], ncp[10];
-  for (uint k = 0u; k < 10u; ++k) { cp[k] = patches[pbase + k].xyz; ncp[k] = patches[pbase + 10u + k].xyz; }
+  for (uint k = 0u; k < 10u; ++k) { cp[k] = patches(pbase + k).xyz; ncp[k] = patches(pbase + 10u + k).xyz; }
   uint L = params.range.w;
   uint nv = (L + 1u) * (L + 2u) / 2u;
   uint tbase = 2u * nv * st;
@@ -21,7 +20,7 @@ void main() {
       real3 x, n;
       smoothTessVertex(cp, ncp, L, r, t, x, n);
       uint v = r * (r + 1u) / 2u + t;
-      tess[tbase + v] = real4(x, 0);
-      tess[tbase + nv + v] = real4(n, 0);
+      tess(tbase + v) = real4(x, 0);
+      tess(tbase + nv + v) = real4(n, 0);
     }
 }

@@ -42,42 +42,40 @@ void deformRun(Backend& backend, const PackedLattice& P, const SubTriangleRecord
   const size_t n = subs.size(), nv = size_t(tessVertexCount(level));
   const size_t recReals = SFFD_SUB_STRIDE * 4, patchReals = SFFD_PATCH_STRIDE * 4, tessReals = 2 * nv * 4;
   const size_t sampleReals = (SFFD_SAMPLE_FIXED + size_t(F.points)) * 4;
-  // Chunks of sub-triangles whose every per-sub-triangle buffer fits one binding.
-  size_t chunk = size_t(lim.maxStorageBufferRange / (std::max({recReals, patchReals, tessReals, sampleReals}) * sizeof(Real)));
+  // Chunks of sub-triangles whose records and output range (patches, tessellation, samples) fit one binding each.
+  const size_t outReals = patchReals + tessReals + (split ? sampleReals : 0);
+  size_t chunk = size_t(lim.maxStorageBufferRange / (std::max(recReals, outReals) * sizeof(Real)));
   chunk = std::min<size_t>(chunk, size_t(lim.maxWorkGroupCount[0]) * lim.maxWorkGroupCount[1] * SFFD_LOCAL_SIZE);
   if (maxChunk) chunk = std::min(chunk, maxChunk);
   chunk = std::max<size_t>(1, std::min(chunk, std::max<size_t>(n, 1)));
-  std::vector<Real> frame = convertReals<Real>(P.frame), coeffs = convertReals<Real>(P.coeffs), fit = convertReals<Real>(F.data);
+  std::vector<Real> frame = convertReals<Real>(deformFrameRange(P, F.data)), coeffs = convertReals<Real>(P.coeffs);
   auto make = [&](const void* data, size_t bytes) {
     BufferId b = backend.createBuffer(std::max<size_t>(bytes, 16));
     if (data && bytes) backend.upload(b, 0, data, bytes);
     return b;
   };
   BufferId bFrame = make(frame.data(), frame.size() * sizeof(Real)), bCoeffs = make(coeffs.data(), coeffs.size() * sizeof(Real));
-  BufferId bFit = make(fit.data(), fit.size() * sizeof(Real));
-  BufferId bHdr = make(nullptr, chunk * 16), bRec = make(nullptr, chunk * recReals * sizeof(Real));
-  BufferId bPatch = make(nullptr, chunk * patchReals * sizeof(Real)), bTess = make(nullptr, chunk * tessReals * sizeof(Real));
-  BufferId bSamples = split ? make(nullptr, chunk * sampleReals * sizeof(Real)) : 0;
+  BufferId bRec = make(nullptr, chunk * recReals * sizeof(Real));
+  BufferId bOut = make(nullptr, chunk * outReals * sizeof(Real));
   out.patches.resize(n * patchReals);
   out.tess.resize(n * tessReals);
-  std::vector<Real> rec(chunk * recReals), buf(chunk * std::max(patchReals, tessReals));
+  std::vector<Real> rec(chunk * recReals), buf(chunk * (patchReals + tessReals));
   gpu::DeformParams params = deformParamsFor(P, variant.f64, &F.data);
   for (size_t first = 0; first < n; first += chunk) {
     size_t count = std::min(chunk, n - first);
     std::transform(subs.records.begin() + first * recReals, subs.records.begin() + (first + count) * recReals, rec.begin(),
                    [](double v) { return Real(v); });
-    backend.upload(bHdr, 0, &subs.headers[4 * first], count * 16);
     backend.upload(bRec, 0, rec.data(), count * recReals * sizeof(Real));
     params.range = {0, uint32_t(count), uint32_t(F.points), uint32_t(level)};
-    dispatchDeform(backend, params, {bCoeffs, bFrame, bFit, bHdr, bRec, bPatch, bTess, bSamples}, count, variant, split);
-    backend.download(bPatch, 0, buf.data(), count * patchReals * sizeof(Real));
-    std::copy(buf.begin(), buf.begin() + count * patchReals, out.patches.begin() + first * patchReals);
-    backend.download(bTess, 0, buf.data(), count * tessReals * sizeof(Real));
+    deformOutSections(params, count, level, F.points, split);
+    dispatchDeform(backend, params, {bCoeffs, bFrame, bRec, bOut}, count, variant, split);
+    // The tessellation, then the patches from element sections.z: one download.
+    backend.download(bOut, 0, buf.data(), count * (patchReals + tessReals) * sizeof(Real));
     std::copy(buf.begin(), buf.begin() + count * tessReals, out.tess.begin() + first * tessReals);
+    std::copy(buf.begin() + count * tessReals, buf.begin() + count * (tessReals + patchReals), out.patches.begin() + first * patchReals);
   }
   backend.finish();
-  for (BufferId b : {bFrame, bCoeffs, bFit, bHdr, bRec, bPatch, bTess}) backend.destroyBuffer(b);
-  if (split) backend.destroyBuffer(bSamples);
+  for (BufferId b : {bFrame, bCoeffs, bRec, bOut}) backend.destroyBuffer(b);
   out.timings = backend.takeTimings();
 }
 
@@ -98,13 +96,17 @@ SmoothOutput smoothDeform(Backend& backend, const PackedLattice& lattice, const 
   return out;
 }
 
+uint64_t deformOutSections(gpu::DeformParams& params, uint64_t count, int level, int fitPoints, bool split) {
+  const uint64_t patches = 2 * uint64_t(tessVertexCount(level)) * count, samples = patches + SFFD_PATCH_STRIDE * count;
+  params.sections.z = uint32_t(patches);
+  params.sections.w = split ? uint32_t(samples) : 0;
+  return split ? samples + (SFFD_SAMPLE_FIXED + uint64_t(fitPoints)) * count : samples;
+}
+
 void dispatchDeform(Backend& backend, const gpu::DeformParams& params, const DeformBuffers& b, size_t count,
                     KernelVariant variant, bool split) {
-  std::vector<BufferBinding> buffers = {
-      {SFFD_BINDING_LATTICE_COEFFS, b.coeffs}, {SFFD_BINDING_LATTICE_FRAME, b.frame}, {SFFD_BINDING_DEFORM_FIT, b.fit},
-      {SFFD_BINDING_DEFORM_SUB_HEADERS, b.headers}, {SFFD_BINDING_DEFORM_SUB_RECORDS, b.records},
-      {SFFD_BINDING_DEFORM_PATCHES, b.patches}, {SFFD_BINDING_DEFORM_TESS, b.tess}};
-  if (split) buffers.push_back({SFFD_BINDING_DEFORM_SAMPLES, b.samples});
+  const std::vector<BufferBinding> buffers = {{SFFD_BINDING_LATTICE_COEFFS, b.coeffs}, {SFFD_BINDING_LATTICE_FRAME, b.frame},
+                                              {SFFD_BINDING_DEFORM_SUB_RECORDS, b.records}, {SFFD_BINDING_DEFORM_OUT, b.out}};
   auto dispatch = [&](const char* kernel, const char* label) {
     Dispatch d;
     d.kernel = kernel;

@@ -14,21 +14,25 @@ layout(std140, SFFD_SET binding = SFFD_BINDING_PARAMS) uniform DeformBlock { Def
 #define SFFD_LATTICE_INLINE 1
 #include "../common/lattice_eval.glsl"
 #include "../pn/pn_eval.glsl"
-layout(std430, SFFD_SET binding = SFFD_BINDING_DEFORM_FIT) readonly buffer Fit { real fit[]; };
-
-// Fit-table reads: from the parameter block when the host put the table there (layout.h), as the lattice.
+// Fit-table reads: from the parameter block when the host put the table there (layout.h), as the
+// lattice; else from the lattice frame range, after the frame.
 #if !SFFD_F64
 real fitAt(uint i) {
   real v;
-  if (params.inline_fit.x != 0u) v = params.inline_lattice[params.inline_fit.x + (i >> 2u)][i & 3u];
-  else v = fit[i];
+  if (params.sections.x != 0u) v = params.inline_lattice[params.sections.x + (i >> 2u)][i & 3u];
+  else v = latticeFrame[params.sections.y + i];
   return v;
 }
 #else
-real fitAt(uint i) { return fit[i]; }
+real fitAt(uint i) { return latticeFrame[params.sections.y + i]; }
 #endif
-layout(std430, SFFD_SET binding = SFFD_BINDING_DEFORM_SUB_HEADERS) readonly buffer SubHeaders { uvec4 subHeaders[]; };
 layout(std430, SFFD_SET binding = SFFD_BINDING_DEFORM_SUB_RECORDS) readonly buffer SubRecords { real4 subRecords[]; };
+// The crease slot bits of sub-triangle st (layout.h: an integer-valued real).
+uint smoothCreaseBits(uint st) { return uint(subRecords[SFFD_SUB_STRIDE * st + SFFD_SUB_CREASE_BITS].w); }
+// The output range's sections (layout.h, SFFD_BINDING_DEFORM_OUT): tessellation, patches, samples.
+#define tess(i) deformOut[i]
+#define patches(i) deformOut[params.sections.z + (i)]
+#define samples(i) deformOut[params.sections.w + (i)]
 
 // Control point of corner slot s (2, 1, 3, 7, 8, 5) and of corner c (0, 6, 9), as 4-bit fields of a
 // constant: a constant array indexed by a variable is copied into local memory at every use in the
@@ -88,7 +92,7 @@ real3 subCornerN(SubCorners C, uint c) { return c == 0u ? C.n0 : (c == 1u ? C.n1
 // Loops rather than calls written out: every call inlines a whole lattice evaluation, and the
 // kernels' compile time grows with their number.
 void smoothCornerSamples(uint st, SubCorners C, out real3 Q[3], out real3 QN[3], out real3 adj[3], out real3 adjNbr[6]) {
-  uint creaseBits = subHeaders[st].y;
+  uint creaseBits = smoothCreaseBits(st);
   for (uint c = 0u; c < 3u; ++c) {
     real3 q, qn, ad, a0, a1;
     smoothCornerSample(st, c, creaseBits, subCornerX(C, c), subCornerN(C, c), q, qn, ad, a0, a1);

@@ -38,11 +38,16 @@ SmoothOutput smoothDeform(Backend& backend, const PackedLattice& lattice, const 
                           const FitTable& fit, int level, KernelVariant variant, bool split = false, size_t maxChunk = 0);
 
 // The deform stage's dispatches over `count` sub-triangles (params.range set by the caller): the
-// fused kernel, or with `split` the four step kernels (`samples` then holds their intermediate data).
+// fused kernel, or with `split` the four step kernels (the output range's samples then hold their
+// intermediate data).
 // Shared by smoothDeform and DeformSession.
+// frame: deformFrameRange (the lattice frame, then the fit table); out: the sections deformOutSections lays out.
 struct DeformBuffers {
-  BufferId coeffs = 0, frame = 0, fit = 0, headers = 0, records = 0, patches = 0, tess = 0, samples = 0;
+  BufferId coeffs = 0, frame = 0, records = 0, out = 0;
 };
+// The output range of a chunk of `count` sub-triangles (layout.h, SFFD_BINDING_DEFORM_OUT): sets
+// params.sections.z (patches) and .w (samples, with `split`); returns the range's real4 elements.
+uint64_t deformOutSections(gpu::DeformParams& params, uint64_t count, int level, int fitPoints, bool split);
 void dispatchDeform(Backend& backend, const gpu::DeformParams& params, const DeformBuffers& buffers, size_t count,
                     KernelVariant variant, bool split);
 

@@ -31,7 +31,6 @@ struct DeformTwin {
   const gpu::DeformParams& p;
   LatticeEvaluator<Real> L;
   const Real* fit;   // SFFD_FIT_STRIDE per interior fitting point
-  const uint32_t* headers;
   const Real* records;
   int fitPoints, level;
 
@@ -45,15 +44,17 @@ struct DeformTwin {
       : p(a.paramsAs<gpu::DeformParams>()),
         L(boundLattice<Real>(a, p.lattice, inlineReals(p, p.lattice.break_offset.w != 0, 0),
                              inlineReals(p, p.lattice.break_offset.w != 0, p.lattice.break_offset.w))),
-        fit(inlineReals(p, p.inline_fit.x != 0, p.inline_fit.x)),
-        headers(a.array<const uint32_t>(SFFD_BINDING_DEFORM_SUB_HEADERS, 4 * n).data()),
+        fit(inlineReals(p, p.sections.x != 0, p.sections.x)),
         records(a.array<const Real>(SFFD_BINDING_DEFORM_SUB_RECORDS, 4 * SFFD_SUB_STRIDE * n).data()),
         fitPoints(int(p.range.z)),
         level(int(p.range.w)) {
-    if (!fit) fit = a.array<const Real>(SFFD_BINDING_DEFORM_FIT, uint64_t(SFFD_FIT_STRIDE) * p.range.z).data();
+    // Else after the lattice frame, from the real sections.y (layout.h).
+    if (!fit) fit = a.array<const Real>(SFFD_BINDING_LATTICE_FRAME, uint64_t(p.sections.y) + uint64_t(SFFD_FIT_STRIDE) * p.range.z).data() + p.sections.y;
     a.check(p.range.z <= SFFD_MAX_FIT_POINTS && p.range.w >= 1, "deform: fitting points or tessellation level out of range");
   }
 
+  // The crease slot bits carried in the record (layout.h, SFFD_SUB_CREASE_BITS), as smoothCreaseBits().
+  uint32_t creaseBitsOf(size_t st) const { return uint32_t(records[4 * (SFFD_SUB_STRIDE * st + SFFD_SUB_CREASE_BITS) + 3]); }
   RVec3<Real> at(size_t st, int slot) const {
     const Real* r = &records[4 * (SFFD_SUB_STRIDE * st + slot)];
     return {r[0], r[1], r[2]};
@@ -72,7 +73,7 @@ struct DeformTwin {
   // Steps 1, 2 and 4 at the corners (smoothCornerSamples).
   void cornerSamples(size_t st, const Corners& C, RVec3<Real> Q[3], RVec3<Real> QN[3], RVec3<Real> adj[3],
                      RVec3<Real> adjNbr[6]) const {
-    const uint32_t creaseBits = headers[4 * st + 1];
+    const uint32_t creaseBits = creaseBitsOf(st);
     for (int c = 0; c < 3; ++c) {
       auto S = L.evaluate(C.x[c]);
       Q[c] = S.value;
@@ -222,10 +223,14 @@ void deformThreads(const CpuKernelArgs& a, uint64_t first, uint64_t last) {
   const uint64_t n = uint64_t(p.range.x) + p.range.y;
   const DeformTwin<Real> D(a, n);
   const uint64_t nv = (uint64_t(p.range.w) + 1) * (p.range.w + 2) / 2, sampleStride = SFFD_SAMPLE_FIXED + p.range.z;
+  // The output range's sections (layout.h): tessellation from element 0, patches from sections.z, samples from sections.w.
   std::span<Real> patches, tess, samples;
-  if constexpr (K != Step::Sample) patches = a.array<Real>(SFFD_BINDING_DEFORM_PATCHES, 4 * SFFD_PATCH_STRIDE * n);
-  if constexpr (K == Step::Fused || K == Step::Tessellate) tess = a.array<Real>(SFFD_BINDING_DEFORM_TESS, 8 * nv * n);
-  if constexpr (K != Step::Fused && K != Step::Tessellate) samples = a.array<Real>(SFFD_BINDING_DEFORM_SAMPLES, 4 * sampleStride * n);
+  auto section = [&](uint64_t firstElement, uint64_t elements) {
+    return a.array<Real>(SFFD_BINDING_DEFORM_OUT, 4 * (firstElement + elements)).subspan(4 * firstElement, 4 * elements);
+  };
+  if constexpr (K != Step::Sample) patches = section(p.sections.z, SFFD_PATCH_STRIDE * n);
+  if constexpr (K == Step::Fused || K == Step::Tessellate) tess = section(0, 2 * nv * n);
+  if constexpr (K != Step::Fused && K != Step::Tessellate) samples = section(p.sections.w, sampleStride * n);
   RVec3<Real> Q[3], QN[3], adj[3], adjNbr[6], E[6], EN[6], cp[10], ncp[10];
   for (uint64_t t = first; t < std::min<uint64_t>(last, p.range.y); ++t) {
     const size_t st = p.range.x + uint32_t(t);
@@ -240,7 +245,7 @@ void deformThreads(const CpuKernelArgs& a, uint64_t first, uint64_t last) {
       RVec3<Real> centreN{};
       for (int i = 0; i < D.fitPoints; ++i) centreN = centreN + D.centreTerm(ncp, D.interiorNormal(C, i), i);
       ncp[4] = centreN;
-      adjust(D.headers[4 * st + 1], adj, adjNbr, cp);
+      adjust(D.creaseBitsOf(st), adj, adjNbr, cp);
       putPatch(patch, cp, ncp);
     } else if constexpr (K == Step::Sample) {
       const auto C = D.corners(st);
@@ -262,7 +267,7 @@ void deformThreads(const CpuKernelArgs& a, uint64_t first, uint64_t last) {
       for (int c = 0; c < 3; ++c) adj[c] = sample(18 + c);
       for (int e = 0; e < 6; ++e) adjNbr[e] = sample(21 + e);
       for (int k = 0; k < 10; ++k) cp[k] = get(patch + 4 * k), ncp[k] = get(patch + 4 * (10 + k));
-      adjust(D.headers[4 * st + 1], adj, adjNbr, cp);
+      adjust(D.creaseBitsOf(st), adj, adjNbr, cp);
       putPatch(patch, cp, ncp);
     } else {
       for (int k = 0; k < 10; ++k) cp[k] = get(patch + 4 * k), ncp[k] = get(patch + 4 * (10 + k));

@@ -175,12 +175,9 @@ def test_lattice_files_round_trip(sphere, tmp_path):
 def test_every_device_gives_the_cpu_bits_in_strict_mode(sphere, label):
     v, t, n = sphere
     lat = sffd.Lattice.fitted(v).preset("twist", 0.6)
-    # gles holds itself to OpenGL ES 3.1's minimum limits (4 storage blocks a kernel), within which
-    # only classic FFD's pipeline fits so far (smooth and accurate need the clipping kernels; docs/GLES.md):
-    # there classic FFD's bits are compared.
-    method = "classic" if label == "gles" else "smooth"
-    # float on every device (classic FFD on the CPU otherwise computes in double: "auto")
-    ref = sffd.deform(v, t, lat, backend="cpu", tess=3, strict=True, method=method, precision="float")
-    got = sffd.deform(v, t, lat, backend=label, tess=3, strict=True, method=method, precision="float")
+    # gles too, held to OpenGL ES 3.1's minimum limits (4 storage blocks a kernel), within which every
+    # kernel fits (docs/GLES.md).
+    ref = sffd.deform(v, t, lat, backend="cpu", tess=3, strict=True)
+    got = sffd.deform(v, t, lat, backend=label, tess=3, strict=True)
     for a, b in zip(ref, got):
         np.testing.assert_array_equal(a, b)

@@ -33,6 +33,7 @@ gpu::DeformParams deformParamsFor(const PackedLattice& lattice, bool f64, const 
   gpu::DeformParams d{};
   d.lattice = lattice.params;
   d.lattice.break_offset.w = 0;
+  d.sections.y = uint32_t(lattice.frame.size());   // the fit table after the frame (deformFrameRange)
   const size_t frameVec4 = (lattice.frame.size() + 3) / 4, coeffVec4 = lattice.coeffs.size() / 4;
   if (f64 || frameVec4 == 0 || frameVec4 + coeffVec4 > SFFD_INLINE_LATTICE_VEC4) return d;
   auto put = [&](size_t i, double v) {
@@ -45,9 +46,15 @@ gpu::DeformParams deformParamsFor(const PackedLattice& lattice, bool f64, const 
   const size_t fitFirst = frameVec4 + coeffVec4;
   if (fit && !fit->empty() && fitFirst + (fit->size() + 3) / 4 <= SFFD_INLINE_LATTICE_VEC4) {
     for (size_t i = 0; i < fit->size(); ++i) put(4 * fitFirst + i, (*fit)[i]);
-    d.inline_fit.x = uint32_t(fitFirst);
+    d.sections.x = uint32_t(fitFirst);
   }
   return d;
+}
+
+std::vector<double> deformFrameRange(const PackedLattice& lattice, const std::vector<double>& fit) {
+  std::vector<double> r = lattice.frame;
+  r.insert(r.end(), fit.begin(), fit.end());
+  return r;
 }
 
 }  // namespace sffd

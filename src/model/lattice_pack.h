@@ -20,8 +20,11 @@ PackedLattice packLattice(const Lattice& lattice);
 // The deform kernels' parameter block for a lattice: its LatticeParams, and in the float variants
 // the lattice itself inline when it fits (layout.h, DeformParams), else break_offset.w = 0 and the
 // kernels read the lattice storage buffers.
-// With `fit`, the fit table follows the lattice there when both fit (inline_fit.x).
+// With `fit`, the fit table follows the lattice there when both fit (sections.x). sections.y names
+// where the fit table begins in the deform kernels' lattice frame range, deformFrameRange.
 gpu::DeformParams deformParamsFor(const PackedLattice& lattice, bool f64, const std::vector<double>* fit = nullptr);
+// The deform kernels' lattice frame range (SFFD_BINDING_LATTICE_FRAME): the frame, then the fit table.
+std::vector<double> deformFrameRange(const PackedLattice& lattice, const std::vector<double>& fit);
 
 template <class Real>
 std::vector<Real> convertReals(const std::vector<double>& v) {

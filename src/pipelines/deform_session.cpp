@@ -30,9 +30,10 @@ struct DeformSession::Impl {
   FitTable fit;
   size_t realSize = 4;
   std::vector<BufferId> owned;   // every buffer, destroyed with the session
-  BufferId table = 0, vertices = 0, tri = 0, slot = 0, pn = 0, clipHdr = 0, clipReal = 0, counts = 0;
-  BufferId frame = 0, coeffs = 0, fitBuf = 0, samples = 0;
-  size_t samplesCapacity = 0;
+  // The clip kernels' two input ranges; pn_triangles reads the mesh's sections and writes the PN records' as ranges.
+  ClipRanges ranges;
+  BufferId reals = 0, words = 0;
+  BufferId frame = 0, coeffs = 0;
   struct ChunkBuffers { BufferId headers = 0, records = 0; size_t firstClip = 0, clipCount = 0; };
   std::vector<ChunkBuffers> chunkBuffers;
 
@@ -87,31 +88,20 @@ void DeformSession::prepare(const Mesh& input, const Lattice& lattice, const Sta
                                         " MiB) exceed one storage binding on this device (" +
                                         std::to_string(lim.maxStorageBufferRange >> 20) + " MiB); use a coarser mesh");
   };
-  const size_t nt = I.mesh.triangleCount();
-  fits(2 * I.mesh.positions.size() * I.realSize, "vertices");
-  fits(nt * SFFD_PN_STRIDE * 4 * I.realSize, "PN records");
-  fits(I.mesh.slotNormals.size() * I.realSize, "slot normals");
   auto up = [&](const std::vector<double>& v) {
     std::vector<unsigned char> b = realBytes(v, f64);
     return I.upload(backend, b.data(), b.size());
   };
-  I.vertices = up(meshVertexRange(I.mesh));
-  I.slot = up(I.mesh.slotNormals);
-  I.tri = I.upload(backend, I.mesh.triangles.data(), I.mesh.triangles.size() * 4);
-  I.pn = I.make(backend, nt * SFFD_PN_STRIDE * 16 * (I.realSize / 4));
-  if (!options.knotBoxClip) {
-    const PackedTable& T = packedTable();
-    PackedClip pc = packClip(I.clip);
-    fits(pc.reals.size() * I.realSize, "clip triangles");
-    I.table = I.upload(backend, T.words.data(), T.words.size() * 4);
-    I.clipHdr = I.upload(backend, pc.headers.data(), pc.headers.size() * 4);
-    I.clipReal = up(pc.reals);
-    I.counts = I.make(backend, I.clip.triangles.size() * 4);
-  }
+  const PackedClip pc = options.knotBoxClip ? PackedClip{} : packClip(I.clip);
+  I.ranges = clipRanges(I.mesh, I.clip.triangles.size(), I.realSize);
+  fits(I.ranges.byteOf(I.ranges.realElements), "vertices, PN records and clip triangles");
+  fits(I.ranges.words * 4, "triangles and clip triangles");
+  I.reals = up(clipRealRange(I.ranges, I.mesh, nullptr, pc));
+  const std::vector<uint32_t> words = clipWordRange(I.ranges, I.mesh, pc);
+  I.words = I.upload(backend, words.data(), words.size() * 4);
   PackedLattice packed = packLattice(lattice);
-  I.frame = up(packed.frame);
+  I.frame = up(deformFrameRange(packed, I.fit.data));
   I.coeffs = up(packed.coeffs);
-  I.fitBuf = up(I.fit.data);
   precompute(progress);
 }
 
@@ -160,30 +150,34 @@ const SessionTimings& DeformSession::precompute(const StageProgress& progress) {
     const PackedTable& T = packedTable();
     params.table = {T.nmax, T.vertexWord, T.triangleWord, 0};
     params.target = {float(options_.edgeLength), 0, 0, 0};
-    params.range = {uint32_t(first), uint32_t(count), uint32_t(I.mesh.positions.size() / 4), 0};
+    params.range = {uint32_t(first), uint32_t(count), 0, 0};
+    I.ranges.name(params);
     return params;
   };
   auto clipBindings = [&](std::vector<BufferBinding> extra) {
-    std::vector<BufferBinding> b = {
-        {SFFD_BINDING_SPLIT_TABLE, I.table}, {SFFD_BINDING_MESH_VERTICES, I.vertices}, {SFFD_BINDING_MESH_TRIANGLES, I.tri}, {SFFD_BINDING_MESH_SLOT_NORMALS, I.slot}, {SFFD_BINDING_PN_OUT, I.pn},
-        {SFFD_BINDING_CLIP_HEADERS, I.clipHdr}, {SFFD_BINDING_CLIP_REALS, I.clipReal}, {SFFD_BINDING_CLIP_COUNTS, I.counts}};
+    std::vector<BufferBinding> b = {{SFFD_BINDING_CLIP_REALS, I.reals}, {SFFD_BINDING_CLIP_WORDS, I.words}};
     b.insert(b.end(), extra.begin(), extra.end());
     return b;
   };
   if (progress) progress("pn", 0.1);
   if (nt) {
     gpu::PnParams params;
-    params.range = {0, uint32_t(nt), uint32_t(I.mesh.positions.size() / 4), 0};
+    const ClipRanges& R = I.ranges;
+    params.range = {0, uint32_t(nt), uint32_t(R.normals), 0};
     dispatch("pn_triangles", "pn", &params, sizeof(params), nt,
-             {{SFFD_BINDING_MESH_VERTICES, I.vertices}, {SFFD_BINDING_MESH_TRIANGLES, I.tri},
-              {SFFD_BINDING_MESH_SLOT_NORMALS, I.slot}, {SFFD_BINDING_PN_OUT, I.pn}});
+             {{SFFD_BINDING_MESH_VERTICES, I.reals, 0, R.byteOf(R.slotNormals)},
+              {SFFD_BINDING_MESH_TRIANGLES, I.words, R.triangles * 4, I.mesh.triangles.size() * 4},
+              {SFFD_BINDING_MESH_SLOT_NORMALS, I.reals, R.byteOf(R.slotNormals), R.byteOf(R.pn - R.slotNormals)},
+              {SFFD_BINDING_PN_OUT, I.reals, R.byteOf(R.pn), R.byteOf(SFFD_PN_STRIDE * nt)}});
   }
   // Sub-triangle counts per chunk, and the chunk layout (a clip triangle's sub-triangles stay in one chunk).
   const size_t nv = size_t(tessVertexCount(options_.level));
   const uint64_t recordBytes = SFFD_SUB_STRIDE * 16 * (I.realSize / 4), tessBytes = 2 * nv * 16 * (I.realSize / 4),
                  patchBytes = SFFD_PATCH_STRIDE * 16 * (I.realSize / 4),
                  sampleBytes = (SFFD_SAMPLE_FIXED + uint64_t(I.fit.points)) * 16 * (I.realSize / 4);
-  uint64_t maxSubs = lim.maxStorageBufferRange / std::max({recordBytes, tessBytes, patchBytes, sampleBytes});
+  // The output range holds the patches, the tessellation and (split) the samples of a sub-triangle.
+  const uint64_t outBytes = patchBytes + tessBytes + (options_.split ? sampleBytes : 0);
+  uint64_t maxSubs = lim.maxStorageBufferRange / std::max(recordBytes, outBytes);
   if (options_.maxChunkSubTriangles) maxSubs = std::min<uint64_t>(maxSubs, options_.maxChunkSubTriangles);
   maxSubs = std::max<uint64_t>(maxSubs, 1);
 
@@ -197,7 +191,7 @@ const SessionTimings& DeformSession::precompute(const StageProgress& progress) {
     std::vector<uint32_t> counts(clipN);
     if (clipN) {
       dispatch("clip_count", "clip_count", &params, sizeof(params), clipN, clipBindings({}));
-      B.download(I.counts, 0, counts.data(), clipN * 4);
+      B.download(I.words, I.ranges.counts * 4, counts.data(), clipN * 4);
     }
     offsets.assign(clipN + 1, 0);
     for (size_t i = 0; i < clipN; ++i) offsets[i + 1] = offsets[i] + counts[i], maxSubs = std::max<uint64_t>(maxSubs, counts[i]);
@@ -206,7 +200,7 @@ const SessionTimings& DeformSession::precompute(const StageProgress& progress) {
     PnOutput pn;
     pn.records = doublesOf([&] {
       std::vector<unsigned char> b(nt * SFFD_PN_STRIDE * 4 * I.realSize);
-      if (nt) B.download(I.pn, 0, b.data(), b.size());
+      if (nt) B.download(I.reals, I.ranges.byteOf(I.ranges.pn), b.data(), b.size());
       return b;
     }(), options_.variant.f64);
     knotRecords = recordsFromSubTriangles(I.mesh, pn, I.knotBoxSubs, options_.variant);
@@ -235,7 +229,7 @@ const SessionTimings& DeformSession::precompute(const StageProgress& progress) {
       B.destroyBuffer(b);
       I.owned.erase(std::find(I.owned.begin(), I.owned.end(), b));
     };
-    for (Chunk& c : chunks_) drop(c.tess), drop(c.patches);
+    for (Chunk& c : chunks_) drop(c.output);
     for (Impl::ChunkBuffers& c : I.chunkBuffers) drop(c.headers), drop(c.records);
     chunks_.clear();
     I.chunkBuffers.clear();
@@ -243,8 +237,8 @@ const SessionTimings& DeformSession::precompute(const StageProgress& progress) {
       Chunk c;
       c.first = p.first;
       c.count = p.count;
-      c.tess = I.make(B, p.count * tessBytes);
-      c.patches = I.make(B, p.count * patchBytes);
+      c.output = I.make(B, p.count * outBytes);
+      c.patchesOffset = p.count * tessBytes;
       Impl::ChunkBuffers cb;
       cb.headers = I.make(B, p.count * 16);
       cb.records = I.make(B, p.count * recordBytes);
@@ -262,7 +256,7 @@ const SessionTimings& DeformSession::precompute(const StageProgress& progress) {
     const size_t first = p.firstClip, last = p.firstClip + p.clipCount, subs = p.count;
     if (!options_.knotBoxClip) {
       for (size_t i = first; i < last; ++i) chunkOffsets[i] = uint32_t(offsets[i] - offsets[first]);
-      B.upload(I.counts, first * 4, chunkOffsets.data() + first, (last - first) * 4);
+      B.upload(I.words, (I.ranges.counts + first) * 4, chunkOffsets.data() + first, (last - first) * 4);
       gpu::ClipParams params = clipParams(first, last - first);
       dispatch("clip_write", "clip_write", &params, sizeof(params), last - first,
                clipBindings({{SFFD_BINDING_SUB_HEADERS, cb.headers}, {SFFD_BINDING_SUB_RECORDS, cb.records}}));
@@ -274,15 +268,6 @@ const SessionTimings& DeformSession::precompute(const StageProgress& progress) {
       B.upload(cb.records, 0, b.data(), b.size());
     }
     if (progress) progress("clip", 0.2 + 0.8 * double(ci + 1) / double(plan.size() + 1));
-  }
-  if (options_.split && !chunks_.empty()) {
-    size_t largest = 0;
-    for (const Chunk& c : chunks_) largest = std::max(largest, c.count);
-    if (largest > I.samplesCapacity) {
-      if (I.samples) B.destroyBuffer(I.samples), I.owned.erase(std::find(I.owned.begin(), I.owned.end(), I.samples));
-      I.samples = I.make(B, largest * sampleBytes);
-      I.samplesCapacity = largest;
-    }
   }
   B.finish();
   timings_.dispatches = B.takeTimings();
@@ -307,10 +292,8 @@ const SessionTimings& DeformSession::deform(const Lattice& lattice, const StageP
     const Chunk& c = chunks_[ci];
     if (!c.count) continue;
     params.range = {0, uint32_t(c.count), uint32_t(I.fit.points), uint32_t(options_.level)};
-    dispatchDeform(B, params,
-                   {I.coeffs, I.frame, I.fitBuf, I.chunkBuffers[ci].headers, I.chunkBuffers[ci].records, c.patches, c.tess,
-                    options_.split ? I.samples : 0},
-                   c.count, options_.variant, options_.split);
+    deformOutSections(params, c.count, options_.level, I.fit.points, options_.split);
+    dispatchDeform(B, params, {I.coeffs, I.frame, I.chunkBuffers[ci].records, c.output}, c.count, options_.variant, options_.split);
     if (progress) progress("deform", double(ci + 1) / double(chunks_.size() + 1));
   }
   B.finish();
@@ -349,11 +332,11 @@ SmoothOutput DeformSession::output() {
     if (!c.count) continue;
     // Each download into a buffer of its own size: below level 3 a patch has more reals than its tessellation.
     std::vector<unsigned char> b(c.count * patchReals * rs);
-    backend_.download(c.patches, 0, b.data(), b.size());
+    backend_.download(c.output, c.patchesOffset, b.data(), b.size());
     std::vector<double> d = doublesOf(b, options_.variant.f64);
     std::copy(d.begin(), d.end(), out.patches.begin() + c.first * patchReals);
     b.resize(c.count * tessReals * rs);
-    backend_.download(c.tess, 0, b.data(), b.size());
+    backend_.download(c.output, 0, b.data(), b.size());
     d = doublesOf(b, options_.variant.f64);
     std::copy(d.begin(), d.end(), out.tess.begin() + c.first * tessReals);
   }

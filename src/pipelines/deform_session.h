@@ -7,7 +7,7 @@
 //
 //   DeformSession s(backend, mesh, lattice, {.edgeLength = 0.2});
 //   s.deform(lattice);                          // after every lattice edit
-//   for (const DeformSession::Chunk& c : s.chunks()) draw(c.tess, c.count);
+//   for (const DeformSession::Chunk& c : s.chunks()) draw(c.output, c.count);
 #pragma once
 #include <functional>
 #include <memory>
@@ -62,12 +62,14 @@ class DeformSession {
   const SessionTimings& deform(const Lattice& lattice, const StageProgress& progress = {});
   const SessionTimings& timings() const { return timings_; }
 
-  // Sub-triangles in groups whose buffers each fit one storage binding. Tessellation buffer layout
-  // (patch_output.h): per patch p of the chunk, tessVertexCount(level) real4 positions at
-  // 2 * nv * p, then nv real4 unit normals; w = 0. Patches: SFFD_PATCH_STRIDE real4 per patch.
+  // Sub-triangles in groups whose buffers each fit one storage binding. The output buffer (layout.h,
+  // SFFD_BINDING_DEFORM_OUT) begins with the tessellation (patch_output.h): per patch p of the chunk,
+  // tessVertexCount(level) real4 positions at 2 * nv * p, then nv real4 unit normals; w = 0. From byte
+  // patchesOffset the patches, SFFD_PATCH_STRIDE real4 per patch.
   struct Chunk {
     size_t first = 0, count = 0;   // sub-triangles [first, first + count)
-    BufferId tess = 0, patches = 0;
+    BufferId output = 0;
+    uint64_t patchesOffset = 0;
   };
   const std::vector<Chunk>& chunks() const { return chunks_; }
   size_t subTriangles() const { return subCount_; }

@@ -49,7 +49,7 @@ class SmoothRun final : public MethodRun {
   std::vector<OutputChunk> deviceOutput() const override {
     std::vector<OutputChunk> out;
     const uint64_t patchBytes = 2 * uint64_t(tessVertexCount(session_->level())) * 4 * (session_->options().variant.f64 ? 8 : 4);
-    for (const DeformSession::Chunk& c : session_->chunks()) out.push_back({c.first, c.count, c.tess, 0, c.count * patchBytes});
+    for (const DeformSession::Chunk& c : session_->chunks()) out.push_back({c.first, c.count, c.output, 0, c.count * patchBytes});
     return out;
   }
 

@@ -26,10 +26,7 @@ const bool kSoftware = [] {
 // (docs/GLES.md, "Limits"): the gles backend refuses them unless SFFD_GLES_LIMITS=device. A ratchet:
 // a kernel that uses more than its entry, or a kernel not listed that uses more than 4, fails; so
 // does an entry that is no longer needed (lower it when a kernel's bindings are merged).
-const std::map<std::string, int> kOverStorageLimit = {
-    {"clip_count", 8},             {"clip_write", 10},        {"deform_smooth", 7},
-    {"deform_step_sample", 6},     {"deform_step_fit", 7},    {"deform_step_adjust", 7},
-    {"deform_step_tessellate", 7}};
+const std::map<std::string, int> kOverStorageLimit = {};
 
 std::unique_ptr<Backend> openGles(bool deviceLimits) {
   if (!providerLibraryPresent(Provider::EGLES)) return nullptr;
