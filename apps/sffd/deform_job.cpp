@@ -1,6 +1,7 @@
 #include "apps/sffd/deform_job.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 
@@ -70,7 +71,9 @@ DeformRun runMethod(const ParsedArgs& args, Job& job, Device& device, Method met
   const char* name = method == Method::Smooth ? "smooth" : method == Method::Accurate ? "accurate" : "classic";
   DeformRun run{name, method == Method::Accurate ? "knot-box" : args.get("--clip", "regular"), line, make(), {}};
   run.deformer.deform(job.lattice);
+  const auto t0 = std::chrono::steady_clock::now();
   run.mesh = run.deformer.result();
+  run.resultMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   line->clear();
   if (method == Method::Smooth) job.mesh = run.deformer.internal().input;
   return run;

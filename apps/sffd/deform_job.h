@@ -27,6 +27,7 @@ struct DeformRun {
   std::shared_ptr<ProgressLine> line;   // what the Deformer's progress callback draws on
   Deformer deformer;
   Mesh mesh;                  // the result as `deform` writes it
+  double resultMs = 0;        // Deformer::result(): the download, pre-images and weld
   // Smooth and accurate: the tessellation with the pre-images of its vertices (downloaded again).
   std::optional<PatchVertices> patches();
 };
