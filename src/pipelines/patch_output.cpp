@@ -106,7 +106,7 @@ class Locations {
       return other_.try_emplace({uint64_t(std::min(w[a], w[b])) << 32 | std::max(w[a], w[b]), bitsOf(lam[hi]), 0}, kNone)
           .first->second;
     }
-    // lam[1] == 0 tells an edge key from this one: inside the parent no barycentric is 0.
+    // Apart from the edge keys: their last word is 0, the bits of +0, and inside a parent no barycentric is 0.
     return other_.try_emplace({uint64_t(P_.parent[p]), bitsOf(lam[0]), bitsOf(lam[1])}, kNone).first->second;
   }
 
@@ -160,7 +160,7 @@ Mesh weldPatchVertices(const PatchVertices& P) {
     for (int v = 0; v < nv; ++v) {
       const size_t g = p * nv + v;
       uint32_t fresh = Locations::kNone;
-      uint32_t& loc = boundary[v] ? where.of(p, g) : fresh;
+      uint32_t& loc = boundary[v] ? where.of(p, g) : fresh;   // a patch's inner vertices are its own
       if (loc == Locations::kNone) {
         loc = uint32_t(locs.size());
         locs.push_back({P.parent[p], uint32_t(m.normals.size()), g});
