@@ -6,6 +6,7 @@
 
 #include "backends/backend_test_support.h"
 #include "model/lattice.h"
+#include "model/mesh.h"
 #include "io/lattice_io.h"
 #include "kernels/common/shader_layout.h"
 #include "kernels/smooth/smooth_deform.h"
@@ -116,9 +117,15 @@ TEST(SmoothDeform, ClosedInputsGiveClosedOutputs) {
     Lattice L = readLattice(kData + c.lattice, o);
     for (KernelVariant v : {KernelVariant{false, true}, KernelVariant{true, false}}) {
       SmoothRun r = smooth(m, L, c.l, v);
-      Mesh out = weldPatchVertices(patchVerticesOf(r.subs, r.out));
+      PatchVertices pv = patchVerticesOf(r.subs, r.out);
+      carryAttributes(pv, m);
+      Mesh out = weldPatchVertices(pv);
       EXPECT_EQ(out.triangles.size(), r.subs.size() * 100);
       expectClosedOutput(out);
+      // Closed also welded by position bits alone: the two sides of every shared edge agree bit for bit.
+      Mesh bits = unweldedPatchMesh(pv);
+      weldPositions(bits);
+      expectClosedOutput(bits);
     }
   }
 }

@@ -44,6 +44,7 @@ Accurate accurate(const Mesh& mesh, const Lattice& L, int level = 10) {
   AccurateJob job = makeAccurateJob(mesh, L, clipAgainstKnotBoxes(mesh, L), level);
   Accurate a;
   a.pv = accuratePatchVertices(job, accurateFfd(sffd::testing::cpuBackend(), job, packLattice(L), {false, true}));
+  carryAttributes(a.pv, mesh);
   a.out = weldPatchVertices(a.pv);
   return a;
 }

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstring>
+#include <stdexcept>
 #include <unordered_map>
 
 namespace sffd {
@@ -20,21 +22,6 @@ std::vector<uint32_t> tessTriangles(int L) {
     }
   return t;
 }
-
-namespace {
-struct KeyHash {
-  size_t operator()(const std::array<uint64_t, 6 + kCarriedKeyWords>& k) const {
-    size_t h = 1469598103934665603ull;
-    for (uint64_t v : k) h = (h ^ v) * 1099511628211ull;
-    return h;
-  }
-  size_t operator()(const std::array<uint64_t, 3>& k) const {
-    size_t h = 1469598103934665603ull;
-    for (uint64_t v : k) h = (h ^ v) * 1099511628211ull;
-    return h;
-  }
-};
-}  // namespace
 
 namespace {
 // `values` (N doubles per vertex) at barycentric `lam` in triangle `t`: corners in weldId order, zero
@@ -66,6 +53,9 @@ void carryAttributes(PatchVertices& P, const Mesh& input) {
     if (!perTriangle.empty())
       for (uint32_t parent : P.parent) out.push_back(perTriangle[parent]);
   };
+  P.parentWeld.resize(3 * P.patchCount());
+  for (size_t p = 0; p < P.patchCount(); ++p)
+    for (int c = 0; c < 3; ++c) P.parentWeld[3 * p + c] = input.weldId[input.triangles[P.parent[p]][c]];
   perPatch(input.triangleMaterial, P.material);
   perPatch(input.triangleGroup, P.group);
   P.materials = input.materials;
@@ -73,45 +63,130 @@ void carryAttributes(PatchVertices& P, const Mesh& input) {
   P.materialLibraries = input.materialLibraries;
 }
 
-void carriedKey(const PatchVertices& P, size_t g, uint64_t* key) {
-  std::fill(key, key + kCarriedKeyWords, 0);
-  if (!P.texcoord.empty()) std::memcpy(key, &P.texcoord[2 * g], 16);
-  if (!P.color.empty()) std::memcpy(key + 2, &P.color[4 * g], 32);
+namespace {
+uint64_t bitsOf(double x) {
+  uint64_t b;
+  std::memcpy(&b, &x, 8);
+  return b;
 }
 
+struct Key3Hash {
+  size_t operator()(const std::array<uint64_t, 3>& k) const {
+    uint64_t h = k[0] * 0x9E3779B97F4A7C15ull;
+    h = (h ^ (h >> 29) ^ k[1]) * 0xBF58476D1CE4E5B9ull;
+    h = (h ^ (h >> 31) ^ k[2]) * 0x94D049BB133111EBull;
+    return size_t(h ^ (h >> 32));
+  }
+};
+
+// Where on the input surface a patch-boundary vertex lies, from its pre-image: a corner by the input's
+// weldId, a parent edge by its two welded corners and the barycentric of the higher one (the clip
+// measures edge points from the lower weldId and the tessellation sums the same two products on
+// both sides, so the bits agree), a point inside the parent by the parent and its barycentrics.
+class Locations {
+ public:
+  explicit Locations(const PatchVertices& P) : P_(P) {
+    uint32_t maxWeld = 0;
+    for (uint32_t w : P.parentWeld) maxWeld = std::max(maxWeld, w);
+    corner_.assign(P.parentWeld.empty() ? 0 : size_t(maxWeld) + 1, kNone);
+    other_.reserve(P.patchCount() * 3 * size_t(P.level) / 2);
+  }
+  static constexpr uint32_t kNone = ~0u;
+
+  // The slot that holds vertex g's location (kNone when it has none yet).
+  uint32_t& of(size_t p, size_t g) {
+    const double* lam = &P_.lamParent[3 * g];
+    const uint32_t* w = &P_.parentWeld[3 * p];
+    const int zeros = (lam[0] == 0) + (lam[1] == 0) + (lam[2] == 0);
+    if (zeros == 2) return corner_[w[lam[0] != 0 ? 0 : lam[1] != 0 ? 1 : 2]];
+    if (zeros == 1) {
+      const int z = lam[0] == 0 ? 0 : lam[1] == 0 ? 1 : 2, a = (z + 1) % 3, b = (z + 2) % 3;
+      if (w[a] == w[b]) return corner_[w[a]];   // an edge of no length: all of it is that corner
+      const int hi = w[a] < w[b] ? b : a;
+      return other_.try_emplace({uint64_t(std::min(w[a], w[b])) << 32 | std::max(w[a], w[b]), bitsOf(lam[hi]), 0}, kNone)
+          .first->second;
+    }
+    // Apart from the edge keys: their last word is 0, the bits of +0, and inside a parent no barycentric is 0.
+    return other_.try_emplace({uint64_t(P_.parent[p]), bitsOf(lam[0]), bitsOf(lam[1])}, kNone).first->second;
+  }
+
+ private:
+  const PatchVertices& P_;
+  std::vector<uint32_t> corner_;
+  std::unordered_map<std::array<uint64_t, 3>, uint32_t, Key3Hash> other_;
+};
+
+bool onPatchBoundary(int v, int L) {
+  const int r = int((std::sqrt(8.0 * v + 1) - 1) / 2), c = v - r * (r + 1) / 2;
+  return c == 0 || c == r || r == L;
+}
+}  // namespace
+
 Mesh weldPatchVertices(const PatchVertices& P) {
+  if (P.parentWeld.size() != 3 * P.patchCount())
+    throw std::logic_error("weldPatchVertices: parentWeld not filled (carryAttributes)");
   Mesh m;
   m.normalsFromFile = true;
   const int nv = tessVertexCount(P.level);
-  std::vector<uint32_t> local = tessTriangles(P.level);
-  std::unordered_map<std::array<uint64_t, 6 + kCarriedKeyWords>, uint32_t, KeyHash> ids;
-  std::unordered_map<std::array<uint64_t, 3>, uint32_t, KeyHash> welds;
+  const std::vector<uint32_t> local = tessTriangles(P.level);
+  std::vector<char> boundary(nv);
+  for (int v = 0; v < nv; ++v) boundary[v] = onPatchBoundary(v, P.level);
+  // Per location: its position (from the patch of the lowest parent that reaches it, so that every
+  // triangle there uses the same bits where the sides disagree: a fin, a sliver) and first vertex;
+  // per vertex: the next vertex of its location (one per distinct normal and carried value).
+  struct Location {
+    uint32_t parent, first;
+    size_t g;
+  };
+  std::vector<Location> locs;
+  std::vector<uint32_t> next;
+  Locations where(P);
+  const bool uv = !P.texcoord.empty(), rgba = !P.color.empty();
+  auto sameVertex = [&](uint32_t i, size_t g) {
+    return std::memcmp(&m.normals[i], &P.normal[3 * g], 24) == 0 && (!uv || std::memcmp(&m.texcoords[i], &P.texcoord[2 * g], 16) == 0) &&
+           (!rgba || std::memcmp(&m.colors[i], &P.color[4 * g], 32) == 0);
+  };
+  auto newVertex = [&](size_t g, uint32_t loc) {
+    const uint32_t i = uint32_t(m.normals.size());
+    m.normals.push_back({P.normal[3 * g], P.normal[3 * g + 1], P.normal[3 * g + 2]});
+    if (uv) m.texcoords.push_back({P.texcoord[2 * g], P.texcoord[2 * g + 1]});
+    if (rgba) m.colors.push_back({P.color[4 * g], P.color[4 * g + 1], P.color[4 * g + 2], P.color[4 * g + 3]});
+    m.weldId.push_back(loc);
+    next.push_back(Locations::kNone);
+    return i;
+  };
   std::vector<uint32_t> map(nv);
   for (size_t p = 0; p < P.patchCount(); ++p) {
     for (int v = 0; v < nv; ++v) {
-      size_t g = p * nv + v;
-      std::array<uint64_t, 6 + kCarriedKeyWords> key;
-      std::memcpy(key.data(), &P.position[3 * g], 24);
-      std::memcpy(key.data() + 3, &P.normal[3 * g], 24);
-      carriedKey(P, g, key.data() + 6);
-      auto [it, fresh] = ids.emplace(key, uint32_t(m.positions.size()));
-      if (fresh) {
-        m.positions.push_back({P.position[3 * g], P.position[3 * g + 1], P.position[3 * g + 2]});
-        m.normals.push_back({P.normal[3 * g], P.normal[3 * g + 1], P.normal[3 * g + 2]});
-        if (!P.texcoord.empty()) m.texcoords.push_back({P.texcoord[2 * g], P.texcoord[2 * g + 1]});
-        if (!P.color.empty()) m.colors.push_back({P.color[4 * g], P.color[4 * g + 1], P.color[4 * g + 2], P.color[4 * g + 3]});
-        std::array<uint64_t, 3> wk{key[0], key[1], key[2]};
-        m.weldId.push_back(welds.emplace(wk, uint32_t(welds.size())).first->second);
+      const size_t g = p * nv + v;
+      uint32_t fresh = Locations::kNone;
+      uint32_t& loc = boundary[v] ? where.of(p, g) : fresh;   // a patch's inner vertices are its own
+      if (loc == Locations::kNone) {
+        loc = uint32_t(locs.size());
+        locs.push_back({P.parent[p], uint32_t(m.normals.size()), g});
+        map[v] = newVertex(g, loc);
+        continue;
       }
-      map[v] = it->second;
+      Location& L = locs[loc];
+      if (P.parent[p] < L.parent) L.parent = P.parent[p], L.g = g;
+      uint32_t i = L.first;
+      while (!sameVertex(i, g) && next[i] != Locations::kNone) i = next[i];
+      if (!sameVertex(i, g)) i = next[i] = newVertex(g, loc);
+      map[v] = i;
     }
     for (size_t i = 0; i < local.size(); i += 3) {
       std::array<uint32_t, 3> t{map[local[i]], map[local[i + 1]], map[local[i + 2]]};
-      if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) continue;   // a collapsed corner of a degenerate patch
+      const uint32_t* w = m.weldId.data();
+      if (w[t[0]] == w[t[1]] || w[t[1]] == w[t[2]] || w[t[0]] == w[t[2]]) continue;   // a collapsed corner of a degenerate patch
       m.triangles.push_back(t);
       if (!P.material.empty()) m.triangleMaterial.push_back(P.material[p]);
       if (!P.group.empty()) m.triangleGroup.push_back(P.group[p]);
     }
+  }
+  m.positions.resize(m.normals.size());
+  for (size_t i = 0; i < m.positions.size(); ++i) {
+    const double* x = &P.position[3 * locs[m.weldId[i]].g];
+    m.positions[i] = {x[0], x[1], x[2]};
   }
   m.materials = P.materials;
   m.groups = P.groups;

@@ -28,29 +28,28 @@ struct PatchVertices {
   std::vector<double> texcoord;      // per patch vertex: 2, interpolated in the parent at lamParent
   std::vector<double> color;         // per patch vertex: 4 (RGBA), likewise
   std::vector<uint32_t> material, group;   // per patch: the parent's Mesh::triangleMaterial, triangleGroup
+  std::vector<uint32_t> parentWeld;  // per patch: the input weldId of the parent's 3 corners (what the weld keys on)
   std::vector<Material> materials;   // the input's tables, as Mesh has them
   std::vector<std::string> groups, materialLibraries;
   size_t patchCount() const { return parent.size(); }
   size_t vertexCount() const { return position.size() / 3; }
 };
 
-// Fills the carried fields of `patches` from `input` (the mesh its parents index): texture coordinates
+// Fills the carried fields and parentWeld of `patches` from `input` (the mesh its parents index): texture coordinates
 // and colours interpolated from the parent triangle's corners at each vertex's barycentric position,
 // computed on the host in double, so equal on every backend for equal pre-images. A vertex on an
 // edge or corner of its parent is interpolated from that edge's or corner's values alone, in an order
 // fixed by weldId, so that neighbouring patches give it the same bits.
 void carryAttributes(PatchVertices& patches, const Mesh& input);
 
-// The bits of patch vertex g's carried values (texture coordinate, colour; zero where absent) that,
-// besides position and normal, keep vertices apart in the weld: a texture seam is split exactly as a
-// crease is. kCarriedKeyWords words.
-constexpr int kCarriedKeyWords = 6;
-void carriedKey(const PatchVertices& patches, size_t g, uint64_t* key);
-
-// Welds patch vertices whose position and normal bits agree (shared boundaries of neighbouring
-// patches are bit-identical by construction, so a closed input gives a closed output; crease
-// vertices keep one vertex per normal, seam vertices one per texture coordinate (carriedKey), with a
-// common weldId). The carried fields become the Mesh's.
+// Welds the patch vertices by where they lie on the input surface (parentWeld and the pre-images),
+// not by their bits: a corner of the input is one location, a point on an input edge one location
+// for every triangle on that edge (also a non-manifold fin, whose sheets bend the edge each its own
+// way), a point inside a parent one location for its sub-triangles. Each location has one position,
+// that of the patch of the lowest parent there, so the output is closed where the input is, and one
+// vertex per distinct normal, texture coordinate and colour bits (creases and seams split vertices,
+// never positions); its vertices share a weldId, the location's index. A triangle with two corners at
+// one location (of a degenerate patch) is dropped. The carried fields become the Mesh's.
 Mesh weldPatchVertices(const PatchVertices& patches);
 
 // The tessellation with every patch vertex its own vertex (so each can carry its own value, e.g. an
