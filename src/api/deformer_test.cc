@@ -13,6 +13,7 @@
 
 #include <sffd/sffd.h>
 
+#include "api/api_test_support.h"
 #include "backends/backend_test_support.h"
 
 namespace {
@@ -46,12 +47,7 @@ Mesh icosphere(int levels) {
     double n = std::sqrt(xyz[v] * xyz[v] + xyz[v + 1] * xyz[v + 1] + xyz[v + 2] * xyz[v + 2]);
     for (int c = 0; c < 3; ++c) xyz[v + c] /= n;
   }
-  MeshView view;
-  view.positions = xyz.data();
-  view.vertexCount = xyz.size() / 3;
-  view.triangles = tri.data();
-  view.triangleCount = tri.size() / 3;
-  return meshFromView(view);
+  return sffd::testing::meshFromArrays(xyz, tri);
 }
 
 // The devices there are: the required GPU backends (skipped when absent) and the CPU reference.
@@ -61,12 +57,7 @@ std::vector<std::string> deviceNames() {
   return names;
 }
 
-Device openDevice(const std::string& name) {
-  DeviceRequest r;
-  r.name = name;
-  r.validation = true;
-  return Device::open(r);
-}
+Device openDevice(const std::string& name) { return sffd::testing::openTestDevice(name); }
 
 Lattice twisted(const Mesh& mesh, double amount) {
   Lattice L = fitLattice(mesh, {4, 5, 5}, {2, 2, 3});

@@ -13,6 +13,7 @@
 
 #include <sffd/sffd.h>
 
+#include "api/api_test_support.h"
 #include "backends/backend_test_support.h"
 #include "pipelines/deformer_internal.h"
 
@@ -52,12 +53,7 @@ Mesh uvTorus(int n, int m) {
   return mesh;
 }
 
-Device openDevice(const std::string& name) {
-  DeviceRequest r;
-  r.name = name;
-  r.validation = true;
-  return Device::open(r);
-}
+Device openDevice(const std::string& name) { return sffd::testing::openTestDevice(name); }
 
 DeformOptions options(Method method) {
   DeformOptions o;

@@ -8,6 +8,7 @@
 
 #include <sffd/sffd.h>
 
+#include "api/api_test_support.h"
 #include "backends/backend_test_support.h"
 #include "model/mesh_topology.h"
 #include "pipelines/deformer_internal.h"
@@ -34,12 +35,7 @@ Mesh uvSphere(bool open) {
       if (r > 0) tri.insert(tri.end(), {at(r, s), at(r + 1, s), at(r, s + 1)});
       if (r + 1 < rings) tri.insert(tri.end(), {at(r, s + 1), at(r + 1, s), at(r + 1, s + 1)});
     }
-  MeshView view;
-  view.positions = xyz.data();
-  view.vertexCount = xyz.size() / 3;
-  view.triangles = tri.data();
-  view.triangleCount = tri.size() / 3;
-  return meshFromView(view);
+  return sffd::testing::meshFromArrays(xyz, tri);
 }
 
 TEST(LocalFrame, OriginIsZeroNearTheWorldOriginAndTheBoxCentreFarFromIt) {
