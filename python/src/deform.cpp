@@ -65,10 +65,21 @@ Inputs inputsOf(py::handle vertices, py::handle triangles, py::handle normals) {
   return in;
 }
 
+// crease_angle: None or "auto" (the relative rule, kCreaseAngleAuto) or degrees 0..180, as --crease-angle.
+double creaseAngleOf(py::handle a) {
+  if (a.is_none() || (py::isinstance<py::str>(a) && a.cast<std::string>() == "auto")) return kCreaseAngleAuto;
+  if (!py::isinstance<py::float_>(a) && !py::isinstance<py::int_>(a))
+    throw Error(ErrorKind::Input, "crease_angle: expected None, 'auto' or degrees 0..180");
+  const double d = a.cast<double>();
+  if (!(d >= 0 && d <= 180)) throw Error(ErrorKind::Input, "crease_angle: expected degrees 0..180, got " + std::to_string(d));
+  return d;
+}
+
 PyDeformer makeDeformer(py::handle vertices, py::handle triangles, const Lattice& lattice, const std::string& method,
                         py::handle backend, py::object edgeLength, int tess, py::handle normals, bool strict,
-                        const std::string& precision) {
+                        const std::string& precision, py::handle creaseAngle) {
   DeformOptions o;
+  o.creaseAngleDeg = creaseAngleOf(creaseAngle);
   o.method = methodOf(method);
   o.edgeLength = edgeLength.is_none() ? 0.0 : edgeLength.cast<double>();
   o.tess = tess;
@@ -89,7 +100,7 @@ void bindDeform(py::module_& m, DeviceFor deviceFor) {
                          "A mesh prepared once on a device for lattices of one structure; deform(lattice) as often as asked.")
       .def(py::init(&makeDeformer), "vertices"_a, "triangles"_a, "lattice"_a, py::kw_only(), "method"_a = "smooth",
            "backend"_a = "auto", "edge_length"_a = py::none(), "tess"_a = 10, "normals"_a = py::none(), "strict"_a = false,
-           "precision"_a = "auto")
+           "precision"_a = "auto", "crease_angle"_a = py::none())
       .def(
           "deform",
           [](PyDeformer& d, const Lattice& lattice) {
@@ -107,13 +118,15 @@ void bindDeform(py::module_& m, DeviceFor deviceFor) {
   m.def(
       "deform",
       [](py::handle vertices, py::handle triangles, const Lattice& lattice, const std::string& method, py::handle backend,
-         py::object edgeLength, int tess, py::handle normals, bool strict, const std::string& precision) {
-        PyDeformer d = makeDeformer(vertices, triangles, lattice, method, backend, edgeLength, tess, normals, strict, precision);
+         py::object edgeLength, int tess, py::handle normals, bool strict, const std::string& precision,
+         py::handle creaseAngle) {
+        PyDeformer d =
+            makeDeformer(vertices, triangles, lattice, method, backend, edgeLength, tess, normals, strict, precision, creaseAngle);
         d.deformer->deform(lattice);
         return meshArrays(d.deformer->result());
       },
       "vertices"_a, "triangles"_a, "lattice"_a, "method"_a = "smooth", "backend"_a = "auto", "edge_length"_a = py::none(),
-      "tess"_a = 10, "normals"_a = py::none(), "strict"_a = false, "precision"_a = "auto",
+      "tess"_a = 10, "normals"_a = py::none(), "strict"_a = false, "precision"_a = "auto", "crease_angle"_a = py::none(),
       "Deforms a triangle mesh: (vertices, triangles, normals) as float64, uint32, float64 arrays.");
 
   m.def(

@@ -181,3 +181,30 @@ def test_every_device_gives_the_cpu_bits_in_strict_mode(sphere, label):
     got = sffd.deform(v, t, lat, backend=label, tess=3, strict=True)
     for a, b in zip(ref, got):
         np.testing.assert_array_equal(a, b)
+
+
+def coarse_torus(n=8):
+    """An n x n torus without normals: smooth, though every edge bends by 40 to 50 degrees."""
+    a, b = np.meshgrid(np.arange(n) * 2 * np.pi / n, np.arange(n) * 2 * np.pi / n, indexing="ij")
+    v = np.stack([(2 + np.cos(b)) * np.cos(a), (2 + np.cos(b)) * np.sin(a), np.sin(b)], -1).reshape(-1, 3)
+    t = []
+    for i in range(n):
+        for j in range(n):
+            p, q, r, s = i * n + j, ((i + 1) % n) * n + j, ((i + 1) % n) * n + (j + 1) % n, i * n + (j + 1) % n
+            t += [[p, q, r], [p, r, s]]
+    return v, np.array(t, dtype=np.uint32)
+
+
+def test_crease_angle_for_meshes_without_normals():
+    v, t = coarse_torus()
+    lat = sffd.Lattice.fitted(v).preset("bend", 0.5)
+    run = lambda **kw: sffd.deform(v, t, lat, backend="cpu", tess=2, **kw)
+    default, auto, flat = run(), run(crease_angle="auto"), run(crease_angle=180)
+    for a, b, c in zip(default, auto, flat):   # the rule finds no crease on a coarse torus
+        np.testing.assert_array_equal(a, b)
+        np.testing.assert_array_equal(a, c)
+    creased = run(crease_angle=40)   # every edge a crease: its vertices split by normal
+    assert len(creased[0]) > len(default[0])
+    for bad in (-1, 181, "sharp", float("nan")):
+        with pytest.raises(sffd.InputError, match="crease_angle"):
+            run(crease_angle=bad)
