@@ -155,6 +155,17 @@ Mesh weldPatchVertices(const PatchVertices& P) {
     next.push_back(Locations::kNone);
     return i;
   };
+  // Reserved for at most every patch vertex and triangle (address space only: no growth copies, and the
+  // pages not reached are never touched).
+  m.normals.reserve(P.vertexCount());
+  if (uv) m.texcoords.reserve(P.vertexCount());
+  if (rgba) m.colors.reserve(P.vertexCount());
+  m.weldId.reserve(P.vertexCount());
+  next.reserve(P.vertexCount());
+  locs.reserve(P.vertexCount());
+  m.triangles.reserve(P.patchCount() * local.size() / 3);
+  if (!P.material.empty()) m.triangleMaterial.reserve(P.patchCount() * local.size() / 3);
+  if (!P.group.empty()) m.triangleGroup.reserve(P.patchCount() * local.size() / 3);
   std::vector<uint32_t> map(nv);
   for (size_t p = 0; p < P.patchCount(); ++p) {
     for (int v = 0; v < nv; ++v) {
@@ -183,10 +194,10 @@ Mesh weldPatchVertices(const PatchVertices& P) {
       if (!P.group.empty()) m.triangleGroup.push_back(P.group[p]);
     }
   }
-  m.positions.resize(m.normals.size());
-  for (size_t i = 0; i < m.positions.size(); ++i) {
+  m.positions.reserve(m.normals.size());
+  for (size_t i = 0; i < m.normals.size(); ++i) {
     const double* x = &P.position[3 * locs[m.weldId[i]].g];
-    m.positions[i] = {x[0], x[1], x[2]};
+    m.positions.push_back({x[0], x[1], x[2]});
   }
   m.materials = P.materials;
   m.groups = P.groups;
