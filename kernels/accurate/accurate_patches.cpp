@@ -287,31 +287,49 @@ AccurateOutput accurateFfd(Backend& backend, const AccurateJob& job, const Packe
   return out;
 }
 
-PatchVertices accuratePatchVertices(const AccurateJob& job, const AccurateOutput& out) {
-  PatchVertices pv;
-  pv.level = job.level;
-  const int L = job.level, nv = tessVertexCount(L);
-  const size_t ns = job.count();
-  pv.parent.resize(ns);
-  pv.lamParent.resize(ns * nv * 3);
-  pv.position.resize(ns * nv * 3);
-  pv.normal.resize(ns * nv * 3);
-  for (size_t s = 0; s < ns; ++s) {
+namespace {
+template <class Real>
+void appendAccurate(const AccurateJob& job, size_t first, size_t count, const Real* positions, const Real* normals,
+                    PatchVertices& pv) {
+  const int L = pv.level, nv = tessVertexCount(L);
+  // Reserved, not resized: every element is pushed once, in order (no zero fill of what is overwritten).
+  const size_t reals = 3 * job.count() * size_t(nv);
+  pv.parent.reserve(job.count());
+  pv.lamParent.reserve(reals);
+  pv.position.reserve(reals);
+  pv.normal.reserve(reals);
+  for (size_t s = first; s < first + count; ++s) {
     const SubTriangle& T = job.subs[s];
-    pv.parent[s] = T.parent;
+    pv.parent.push_back(T.parent);
     for (int r = 0; r <= L; ++r)
       for (int q = 0; q <= r; ++q) {
         const int v = r * (r + 1) / 2 + q;
         const double l0 = double(L - r) / L, l1 = double(r - q) / L, l2 = double(q) / L;
         glm::dvec3 lam = (l0 * T.corners[0].lam + l1 * T.corners[1].lam) + l2 * T.corners[2].lam;
-        const size_t g = s * nv + v;
+        const size_t g = (s - first) * nv + v;
         for (int a = 0; a < 3; ++a) {
-          pv.lamParent[3 * g + a] = lam[a];
-          pv.position[3 * g + a] = out.positions[4 * g + a] + 0.0;   // -0 -> +0: welding compares bits
-          pv.normal[3 * g + a] = out.normals[4 * g + a] + 0.0;
+          pv.lamParent.push_back(lam[a]);
+          pv.position.push_back(double(positions[4 * g + a]) + 0.0);   // -0 -> +0: welding compares bits
+          pv.normal.push_back(double(normals[4 * g + a]) + 0.0);
         }
       }
   }
+}
+}  // namespace
+
+void appendAccuratePatchVertices(const AccurateJob& job, size_t first, size_t count, const float* positions,
+                                 const float* normals, PatchVertices& pv) {
+  appendAccurate(job, first, count, positions, normals, pv);
+}
+void appendAccuratePatchVertices(const AccurateJob& job, size_t first, size_t count, const double* positions,
+                                 const double* normals, PatchVertices& pv) {
+  appendAccurate(job, first, count, positions, normals, pv);
+}
+
+PatchVertices accuratePatchVertices(const AccurateJob& job, const AccurateOutput& out) {
+  PatchVertices pv;
+  pv.level = job.level;
+  appendAccurate(job, 0, job.count(), out.positions.data(), out.normals.data(), pv);
   return pv;
 }
 

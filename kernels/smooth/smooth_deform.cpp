@@ -129,36 +129,50 @@ void dispatchDeform(Backend& backend, const gpu::DeformParams& params, const Def
   }
 }
 
-PatchVertices patchVerticesOf(const SubTriangleRecords& subs, const SmoothOutput& out) {
-  PatchVertices P;
-  P.level = out.level;
-  const int L = out.level, nv = tessVertexCount(L);
-  const size_t n = subs.size();
-  P.parent.resize(n);
-  P.lamParent.resize(n * nv * 3);
-  P.position.resize(n * nv * 3);
-  P.normal.resize(n * nv * 3);
-  for (size_t s = 0; s < n; ++s) {
-    P.parent[s] = subs.headers[4 * s];
+namespace {
+template <class Real>
+void appendPatchVerticesOf(const SubTriangleRecords& subs, size_t first, size_t count, const Real* tess, PatchVertices& P) {
+  const int L = P.level, nv = tessVertexCount(L);
+  // Reserved, not resized: every element is pushed once, in order (no zero fill of what is overwritten).
+  const size_t reals = 3 * subs.size() * size_t(nv);
+  P.parent.reserve(subs.size());
+  P.lamParent.reserve(reals);
+  P.position.reserve(reals);
+  P.normal.reserve(reals);
+  for (size_t s = first; s < first + count; ++s) {
+    P.parent.push_back(subs.headers[4 * s]);
     glm::dvec3 lam[3];
     for (int c = 0; c < 3; ++c) {
       const double* l = &subs.records[(s * SFFD_SUB_STRIDE + SFFD_SUB_LAM + c) * 4];
       lam[c] = {l[0], l[1], l[2]};
     }
-    const double* t = &out.tess[s * 2 * nv * 4];
+    const Real* t = &tess[(s - first) * 2 * nv * 4];
     for (int r = 0; r <= L; ++r)
       for (int c = 0; c <= r; ++c) {
         int v = r * (r + 1) / 2 + c;
         glm::dvec3 w(double(L - r) / L, double(r - c) / L, double(c) / L);
         glm::dvec3 lp = w.x * lam[0] + w.y * lam[1] + w.z * lam[2];
-        size_t g = s * nv + v;
         for (int a = 0; a < 3; ++a) {
-          P.lamParent[3 * g + a] = lp[a];
-          P.position[3 * g + a] = t[4 * v + a];
-          P.normal[3 * g + a] = t[4 * (nv + v) + a];
+          P.lamParent.push_back(lp[a]);
+          P.position.push_back(double(t[4 * v + a]));
+          P.normal.push_back(double(t[4 * (nv + v) + a]));
         }
       }
   }
+}
+}  // namespace
+
+void appendPatchVertices(const SubTriangleRecords& subs, size_t first, size_t count, const float* tess, PatchVertices& P) {
+  appendPatchVerticesOf(subs, first, count, tess, P);
+}
+void appendPatchVertices(const SubTriangleRecords& subs, size_t first, size_t count, const double* tess, PatchVertices& P) {
+  appendPatchVerticesOf(subs, first, count, tess, P);
+}
+
+PatchVertices patchVerticesOf(const SubTriangleRecords& subs, const SmoothOutput& out) {
+  PatchVertices P;
+  P.level = out.level;
+  appendPatchVerticesOf(subs, 0, subs.size(), out.tess.data(), P);
   return P;
 }
 

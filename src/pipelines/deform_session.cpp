@@ -308,15 +308,13 @@ SubTriangleRecords DeformSession::records() {
   SubTriangleRecords R;
   R.headers.resize(4 * subCount_);
   R.records.resize(subCount_ * SFFD_SUB_STRIDE * 4);
-  const size_t rs = impl_->realSize;
+  std::vector<float> scratch;
   for (size_t ci = 0; ci < chunks_.size(); ++ci) {
     const Chunk& c = chunks_[ci];
     if (!c.count) continue;
     backend_.download(impl_->chunkBuffers[ci].headers, 0, &R.headers[4 * c.first], c.count * 16);
-    std::vector<unsigned char> b(c.count * SFFD_SUB_STRIDE * 4 * rs);
-    backend_.download(impl_->chunkBuffers[ci].records, 0, b.data(), b.size());
-    std::vector<double> d = doublesOf(b, options_.variant.f64);
-    std::copy(d.begin(), d.end(), R.records.begin() + c.first * SFFD_SUB_STRIDE * 4);
+    downloadRealsInto(backend_, impl_->chunkBuffers[ci].records, 0, c.count * SFFD_SUB_STRIDE * 4, options_.variant.f64,
+                      &R.records[c.first * SFFD_SUB_STRIDE * 4], scratch);
   }
   return R;
 }
@@ -324,21 +322,16 @@ SubTriangleRecords DeformSession::records() {
 SmoothOutput DeformSession::output() {
   SmoothOutput out;
   out.level = options_.level;
-  const size_t nv = size_t(tessVertexCount(options_.level)), rs = impl_->realSize;
+  const size_t nv = size_t(tessVertexCount(options_.level));
+  std::vector<float> scratch;
   const size_t patchReals = SFFD_PATCH_STRIDE * 4, tessReals = 2 * nv * 4;
   out.patches.resize(subCount_ * patchReals);
   out.tess.resize(subCount_ * tessReals);
   for (const Chunk& c : chunks_) {
     if (!c.count) continue;
-    // Each download into a buffer of its own size: below level 3 a patch has more reals than its tessellation.
-    std::vector<unsigned char> b(c.count * patchReals * rs);
-    backend_.download(c.output, c.patchesOffset, b.data(), b.size());
-    std::vector<double> d = doublesOf(b, options_.variant.f64);
-    std::copy(d.begin(), d.end(), out.patches.begin() + c.first * patchReals);
-    b.resize(c.count * tessReals * rs);
-    backend_.download(c.output, 0, b.data(), b.size());
-    d = doublesOf(b, options_.variant.f64);
-    std::copy(d.begin(), d.end(), out.tess.begin() + c.first * tessReals);
+    downloadRealsInto(backend_, c.output, c.patchesOffset, c.count * patchReals, options_.variant.f64,
+                      &out.patches[c.first * patchReals], scratch);
+    downloadRealsInto(backend_, c.output, 0, c.count * tessReals, options_.variant.f64, &out.tess[c.first * tessReals], scratch);
   }
   out.timings = timings_.dispatches;
   out.wallMs = timings_.wallMs;

@@ -5,6 +5,8 @@
 // chunk's corners: one storage range for the kernel, layout.h).
 #include <algorithm>
 #include <chrono>
+#include <memory>
+#include <stdexcept>
 
 #include "core/job_budget.h"
 #include "core/wall_clock.h"
@@ -88,18 +90,29 @@ class AccurateRun final : public MethodRun {
   }
 
   std::optional<PatchVertices> patchVertices() const override {
-    AccurateOutput out;
-    const size_t nv = size_t(tessVertexCount(job_.level));
-    out.positions.resize(job_.count() * nv * 4);
-    out.normals.resize(job_.count() * nv * 4);
-    for (const Chunk& c : chunks_) {
-      std::vector<double> pos = downloadReals(B_, c.out, 0, c.count * nv * 4, variant_.f64);
-      std::vector<double> nrm = downloadReals(B_, c.out, c.half, c.count * nv * 4, variant_.f64);
-      std::copy(pos.begin(), pos.end(), out.positions.begin() + c.first * nv * 4);
-      std::copy(nrm.begin(), nrm.end(), out.normals.begin() + c.first * nv * 4);
-    }
-    PatchVertices p = accuratePatchVertices(job_, out);
+    PatchVertices p = variant_.f64 ? downloadPatchVertices<double>() : downloadPatchVertices<float>();
     carryAttributes(p, input_);
+    return p;
+  }
+
+  // Each chunk's positions and normals read into one buffer each and widened once, straight into the
+  // patch vertices (no host copy of the whole output).
+  template <class Real>
+  PatchVertices downloadPatchVertices() const {
+    const size_t nv = size_t(tessVertexCount(job_.level));
+    size_t most = 0;
+    for (const Chunk& c : chunks_) most = std::max(most, c.count);
+    std::unique_ptr<Real[]> pos(new Real[most * nv * 4]), nrm(new Real[most * nv * 4]);   // not zero-filled: overwritten
+    PatchVertices p;
+    p.level = job_.level;
+    for (const Chunk& c : chunks_) {
+      if (!c.count) continue;
+      if (c.first != p.patchCount()) throw std::logic_error("AccurateRun: chunks out of order");
+      B_.download(c.out, 0, pos.get(), c.count * nv * 4 * sizeof(Real));
+      B_.download(c.out, c.half, nrm.get(), c.count * nv * 4 * sizeof(Real));
+      appendAccuratePatchVertices(job_, c.first, c.count, pos.get(), nrm.get(), p);
+    }
+    if (p.patchCount() != job_.count()) throw std::logic_error("AccurateRun: chunks do not cover the sub-triangles");
     return p;
   }
 

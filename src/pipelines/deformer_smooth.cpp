@@ -1,5 +1,9 @@
 // Deformer, Method::Smooth: DeformSession (deform_session.h) keeps the sub-triangle records and the
 // tessellation on the device; the results are downloaded when asked for.
+#include <algorithm>
+#include <memory>
+#include <stdexcept>
+
 #include "kernels/smooth/smooth_deform.h"
 #include "pipelines/deform_session.h"
 #include "pipelines/deformer_internal.h"
@@ -38,8 +42,28 @@ class SmoothRun final : public MethodRun {
 
   std::optional<PatchVertices> patchVertices() const override {
     if (!records_) records_ = session_->records();   // fixed by the pre-compute: downloaded once
-    PatchVertices p = patchVerticesOf(*records_, session_->output());
+    PatchVertices p = session_->options().variant.f64 ? downloadPatchVertices<double>() : downloadPatchVertices<float>();
     carryAttributes(p, input_);
+    return p;
+  }
+
+  // patchVerticesOf(records, session->output()) without its host copies of the whole output (and of the
+  // patches, which the vertices do not need): each chunk's tessellation read into one buffer and widened once.
+  template <class Real>
+  PatchVertices downloadPatchVertices() const {
+    const size_t tessReals = 2 * size_t(tessVertexCount(session_->level())) * 4;
+    size_t most = 0;
+    for (const DeformSession::Chunk& c : session_->chunks()) most = std::max(most, c.count);
+    std::unique_ptr<Real[]> tess(new Real[most * tessReals]);   // not zero-filled: each download overwrites it
+    PatchVertices p;
+    p.level = session_->level();
+    for (const DeformSession::Chunk& c : session_->chunks()) {
+      if (!c.count) continue;
+      if (c.first != p.patchCount()) throw std::logic_error("SmoothRun: chunks out of order");
+      session_->backend().download(c.output, 0, tess.get(), c.count * tessReals * sizeof(Real));
+      appendPatchVertices(*records_, c.first, c.count, tess.get(), p);
+    }
+    if (p.patchCount() != records_->size()) throw std::logic_error("SmoothRun: chunks do not cover the sub-triangles");
     return p;
   }
 

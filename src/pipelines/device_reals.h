@@ -75,4 +75,18 @@ inline std::vector<double> downloadReals(Backend& backend, BufferId buffer, uint
   return doublesOf(b, f64);
 }
 
+// The same into `out` (room for `count`): doubles read in place, floats through `scratch` (kept by the
+// caller across calls) and widened once; no other copy.
+inline void downloadRealsInto(Backend& backend, BufferId buffer, uint64_t offset, size_t count, bool f64, double* out,
+                              std::vector<float>& scratch) {
+  if (!count) return;
+  if (f64) {
+    backend.download(buffer, offset, out, count * 8);
+    return;
+  }
+  if (scratch.size() < count) scratch.resize(count);
+  backend.download(buffer, offset, scratch.data(), count * 4);
+  for (size_t i = 0; i < count; ++i) out[i] = scratch[i];
+}
+
 }  // namespace sffd

@@ -5,7 +5,6 @@
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
-#include <unordered_map>
 
 namespace sffd {
 
@@ -79,17 +78,54 @@ struct Key3Hash {
   }
 };
 
+// A hash map from 3-word keys to a slot, by open addressing with linear probing (one flat table: no
+// allocation a key, as the node-based std::unordered_map makes). The all-zero key marks an empty slot;
+// Locations never makes it. A returned slot stays valid until the next of().
+class Key3Map {
+ public:
+  explicit Key3Map(size_t expected) {
+    size_t n = 16;
+    while (n < 2 * expected) n *= 2;
+    slots_.resize(n);
+  }
+  uint32_t& of(const std::array<uint64_t, 3>& key, uint32_t fresh) {
+    if (2 * (used_ + 1) > slots_.size()) grow();
+    Slot* s = find(key);
+    if (s->key == kEmpty) s->key = key, s->value = fresh, ++used_;
+    return s->value;
+  }
+
+ private:
+  struct Slot {
+    std::array<uint64_t, 3> key{0, 0, 0};
+    uint32_t value = 0;
+  };
+  static constexpr std::array<uint64_t, 3> kEmpty{0, 0, 0};
+  Slot* find(const std::array<uint64_t, 3>& key) {
+    const size_t mask = slots_.size() - 1;
+    for (size_t i = Key3Hash()(key) & mask;; i = (i + 1) & mask)
+      if (slots_[i].key == key || slots_[i].key == kEmpty) return &slots_[i];
+  }
+  void grow() {
+    std::vector<Slot> old(slots_.size() * 2);
+    old.swap(slots_);
+    for (const Slot& s : old)
+      if (s.key != kEmpty) *find(s.key) = s;
+  }
+  std::vector<Slot> slots_;
+  size_t used_ = 0;
+};
+
 // Where on the input surface a patch-boundary vertex lies, from its pre-image: a corner by the input's
 // weldId, a parent edge by its two welded corners and the barycentric of the higher one (the clip
 // measures edge points from the lower weldId and the tessellation sums the same two products on
 // both sides, so the bits agree), a point inside the parent by the parent and its barycentrics.
 class Locations {
  public:
-  explicit Locations(const PatchVertices& P) : P_(P) {
+  explicit Locations(const PatchVertices& P) : P_(P), other_(P.patchCount() * 3 * size_t(P.level) / 2) {
     uint32_t maxWeld = 0;
     for (uint32_t w : P.parentWeld) maxWeld = std::max(maxWeld, w);
     corner_.assign(P.parentWeld.empty() ? 0 : size_t(maxWeld) + 1, kNone);
-    other_.reserve(P.patchCount() * 3 * size_t(P.level) / 2);
   }
   static constexpr uint32_t kNone = ~0u;
 
@@ -103,17 +139,18 @@ class Locations {
       const int z = lam[0] == 0 ? 0 : lam[1] == 0 ? 1 : 2, a = (z + 1) % 3, b = (z + 2) % 3;
       if (w[a] == w[b]) return corner_[w[a]];   // an edge of no length: all of it is that corner
       const int hi = w[a] < w[b] ? b : a;
-      return other_.try_emplace({uint64_t(std::min(w[a], w[b])) << 32 | std::max(w[a], w[b]), bitsOf(lam[hi]), 0}, kNone)
-          .first->second;
+      // Never all zero: the two weldIds differ.
+      return other_.of({uint64_t(std::min(w[a], w[b])) << 32 | std::max(w[a], w[b]), bitsOf(lam[hi]), 0}, kNone);
     }
-    // Apart from the edge keys: their last word is 0, the bits of +0, and inside a parent no barycentric is 0.
-    return other_.try_emplace({uint64_t(P_.parent[p]), bitsOf(lam[0]), bitsOf(lam[1])}, kNone).first->second;
+    // Apart from the edge keys: their last word is 0, the bits of +0, and inside a parent no barycentric
+    // is 0 (so neither is this key all zero).
+    return other_.of({uint64_t(P_.parent[p]), bitsOf(lam[0]), bitsOf(lam[1])}, kNone);
   }
 
  private:
   const PatchVertices& P_;
   std::vector<uint32_t> corner_;
-  std::unordered_map<std::array<uint64_t, 3>, uint32_t, Key3Hash> other_;
+  Key3Map other_;
 };
 
 bool onPatchBoundary(int v, int L) {
@@ -155,6 +192,17 @@ Mesh weldPatchVertices(const PatchVertices& P) {
     next.push_back(Locations::kNone);
     return i;
   };
+  // Reserved for at most every patch vertex and triangle (address space only: no growth copies, and the
+  // pages not reached are never touched).
+  m.normals.reserve(P.vertexCount());
+  if (uv) m.texcoords.reserve(P.vertexCount());
+  if (rgba) m.colors.reserve(P.vertexCount());
+  m.weldId.reserve(P.vertexCount());
+  next.reserve(P.vertexCount());
+  locs.reserve(P.vertexCount());
+  m.triangles.reserve(P.patchCount() * local.size() / 3);
+  if (!P.material.empty()) m.triangleMaterial.reserve(P.patchCount() * local.size() / 3);
+  if (!P.group.empty()) m.triangleGroup.reserve(P.patchCount() * local.size() / 3);
   std::vector<uint32_t> map(nv);
   for (size_t p = 0; p < P.patchCount(); ++p) {
     for (int v = 0; v < nv; ++v) {
@@ -183,10 +231,10 @@ Mesh weldPatchVertices(const PatchVertices& P) {
       if (!P.group.empty()) m.triangleGroup.push_back(P.group[p]);
     }
   }
-  m.positions.resize(m.normals.size());
-  for (size_t i = 0; i < m.positions.size(); ++i) {
+  m.positions.reserve(m.normals.size());
+  for (size_t i = 0; i < m.normals.size(); ++i) {
     const double* x = &P.position[3 * locs[m.weldId[i]].g];
-    m.positions[i] = {x[0], x[1], x[2]};
+    m.positions.push_back({x[0], x[1], x[2]});
   }
   m.materials = P.materials;
   m.groups = P.groups;
