@@ -292,12 +292,7 @@ template <class Real>
 void appendAccurate(const AccurateJob& job, size_t first, size_t count, const Real* positions, const Real* normals,
                     PatchVertices& pv) {
   const int L = pv.level, nv = tessVertexCount(L);
-  // Reserved, not resized: every element is pushed once, in order (no zero fill of what is overwritten).
-  const size_t reals = 3 * job.count() * size_t(nv);
-  pv.parent.reserve(job.count());
-  pv.lamParent.reserve(reals);
-  pv.position.reserve(reals);
-  pv.normal.reserve(reals);
+  pv.reserve(job.count());
   for (size_t s = first; s < first + count; ++s) {
     const SubTriangle& T = job.subs[s];
     pv.parent.push_back(T.parent);

@@ -133,12 +133,7 @@ namespace {
 template <class Real>
 void appendPatchVerticesOf(const SubTriangleRecords& subs, size_t first, size_t count, const Real* tess, PatchVertices& P) {
   const int L = P.level, nv = tessVertexCount(L);
-  // Reserved, not resized: every element is pushed once, in order (no zero fill of what is overwritten).
-  const size_t reals = 3 * subs.size() * size_t(nv);
-  P.parent.reserve(subs.size());
-  P.lamParent.reserve(reals);
-  P.position.reserve(reals);
-  P.normal.reserve(reals);
+  P.reserve(subs.size());
   for (size_t s = first; s < first + count; ++s) {
     P.parent.push_back(subs.headers[4 * s]);
     glm::dvec3 lam[3];

@@ -32,6 +32,15 @@ struct PatchVertices {
   std::vector<Material> materials;   // the input's tables, as Mesh has them
   std::vector<std::string> groups, materialLibraries;
   size_t patchCount() const { return parent.size(); }
+  // Room for `patches` patches of `level` in parent, lamParent, position and normal, reserved, not
+  // resized: producers push every element once, in order (no zero fill of what is overwritten).
+  void reserve(size_t patches) {
+    const size_t reals = 3 * patches * size_t(tessVertexCount(level));
+    parent.reserve(patches);
+    lamParent.reserve(reals);
+    position.reserve(reals);
+    normal.reserve(reals);
+  }
   size_t vertexCount() const { return position.size() / 3; }
 };
 
