@@ -112,6 +112,13 @@ TEST(View, DraftsWhileDraggingThenFullQualityOnRelease) {
   EXPECT_EQ(after.rgba, full.rgba);
   EXPECT_GT(compare(sffd::gl::readPng((dir / "during.png").string()), full).meanAbs, 0.0);
   EXPECT_NE(run(common + "--draft-tess 65 --replay " + (dir / "plain.txt").string(), dir, x).status, 0);
+  // --draft-tess 0, or a level not below --tess: full quality throughout the gesture.
+  for (const char* off : {"--draft-tess 0", "--draft-tess 10 --tess 10"}) {
+    Result o = run(common + off + " --replay " + (dir / "drafts.txt").string() + " --stats " + (dir / "off.json").string(), dir, x);
+    ASSERT_EQ(o.status, 0) << o.err;
+    EXPECT_EQ(nlohmann::json::parse(slurp(dir / "off.json"))["draft_frames"], 0) << off;
+    EXPECT_EQ(sffd::gl::readPng((dir / "during.png").string()).rgba, full.rgba) << off;
+  }
 }
 
 TEST(View, ReplayScreenshotsMatchRender) {

@@ -232,7 +232,7 @@ void App::drawFrame(bool present) {
   renderer_->context().activate();
   camera_.apply(ro_);
   const bool draft = interacting();
-  target_.bind(fbW_, fbH_, draft && cfg_.draftLevel > 0 ? 1 : 4);   // no multisampling while dragging
+  target_.bind(fbW_, fbH_, draft && scene_->draftsOn() ? 1 : 4);   // no multisampling while dragging
   std::vector<gl::SlotCamera> cams = renderer_->draw(ro_, fbW_, fbH_);
   if (!cams.empty()) lastCam_ = cams[0], haveCam_ = true;
   if (haveCam_) {

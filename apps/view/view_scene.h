@@ -47,6 +47,7 @@ class Scene {
 
   const StageTimes& times() const { return times_; }
   bool drawingDraft() const { return activeLevel_ != level_; }   // the last update was a draft
+  bool draftsOn() const { return draftLevel_ > 0; }               // a draft level below the full one was given
   int level() const { return activeLevel_; }                     // the tessellation level drawn
   std::string path() const;                      // "zero-copy", "session+copy" (smooth, downloaded) or "host" (others), for the HUD
   const std::vector<TessSource>& tessSources() const { return tess_; }
