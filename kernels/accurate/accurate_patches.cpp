@@ -10,6 +10,7 @@
 #include <sffd/error.h>
 #include "core/job_budget.h"
 #include "model/lattice_pack.h"
+#include "core/kernel_registry.h"
 #include "core/wall_clock.h"
 
 namespace sffd {
@@ -262,7 +263,7 @@ void dispatchAccurateChunk(Backend& backend, const gpu::LatticeParams& lattice, 
     params.tables = {frame.matrixAt, frame.basisAt, 0, 0};
     Dispatch d;
     d.kernel = "accurate_patches";
-    d.variant = variant;
+    d.variant = forLattice(variant, lattice);
     d.params = &params;
     d.paramsSize = sizeof(params);
     d.label = stage == SFFD_ACC_STAGE_SAMPLES ? "accurate_samples" : stage == SFFD_ACC_STAGE_PATCHES ? "accurate_patches" : "accurate_tessellate";

@@ -5,6 +5,7 @@
 
 #include <sffd/error.h>
 #include "kernels/common/cpu_kernel.h"
+#include "core/kernel_registry.h"
 #include "core/wall_clock.h"
 
 namespace sffd {
@@ -80,7 +81,7 @@ void dispatchClassicFfd(Backend& backend, const gpu::LatticeParams& lattice, Ker
   params.range = {0, uint32_t(count), uint32_t(normalsAt), 0};
   Dispatch d;
   d.kernel = "classic_ffd";
-  d.variant = variant;
+  d.variant = forLattice(variant, lattice);
   d.params = &params;
   d.paramsSize = sizeof(params);
   d.buffers = {b.coeffs, b.frame, b.in, b.out};

@@ -25,7 +25,7 @@ void main() {
     if (S.odd) { uint x = idx[1]; idx[1] = idx[2]; idx[2] = x; }
     Site site[3];
     SiteValue val[3];
-    for (uint c = 0u; c < 3u; ++c) {
+    for (uint c = 0u; c < sffdRolled(3u); ++c) {
       uint v = params.table.y + 4u * (S.entry.x + idx[c]);
       real3 lamCanon = real3(uintBitsToFloat(splitTable(v)), uintBitsToFloat(splitTable(v + 1u)), uintBitsToFloat(splitTable(v + 2u)));
       uint w = splitTable(v + 3u);
@@ -37,7 +37,7 @@ void main() {
     uint o = out0 + k;
     uint rec = SFFD_SUB_STRIDE * o;
     uint creaseBits = 0u;
-    for (uint c = 0u; c < 3u; ++c) {
+    for (uint c = 0u; c < sffdRolled(3u); ++c) {
       subRecords[rec + SFFD_SUB_LAM + c] = real4(val[c].lam, 0);
       subRecords[rec + SFFD_SUB_XPN + c] = real4(val[c].xpn, 0);
       subRecords[rec + SFFD_SUB_XFLAT + c] = real4(val[c].xflat, 0);

@@ -9,17 +9,22 @@ layout(std430, SFFD_SET binding = SFFD_BINDING_LATTICE_FRAME) readonly buffer La
 
 // Lattice reads go through these two functions: from the deform kernels' parameter block when the
 // host put the lattice there (layout.h, DeformParams), else from the storage buffers above. An `if`
-// rather than a select, so that the storage-buffer read is skipped, not merely discarded.
+// rather than a select, so that the storage-buffer read is skipped, not merely discarded; with the
+// host's assumption (layout.h SFFD_ASSUME_*) the other read is not compiled at all.
 #if defined(SFFD_LATTICE_INLINE) && !SFFD_F64
+bool latticeInParams() {
+  return sffdAssumes(SFFD_ASSUME_LATTICE_IN_PARAMS) ||
+         (!sffdAssumes(SFFD_ASSUME_LATTICE_IN_STORAGE) && params.lattice.break_offset.w != 0u);
+}
 real latticeFrameAt(uint i) {
   real v;
-  if (params.lattice.break_offset.w != 0u) v = params.inline_lattice[i >> 2u][i & 3u];
+  if (latticeInParams()) v = params.inline_lattice[i >> 2u][i & 3u];
   else v = latticeFrame[i];
   return v;
 }
 real3 latticeCoeffAt(uint c) {
   real3 v;
-  if (params.lattice.break_offset.w != 0u) v = params.inline_lattice[params.lattice.break_offset.w + c].xyz;
+  if (latticeInParams()) v = params.inline_lattice[params.lattice.break_offset.w + c].xyz;
   else v = latticeCoeffs[c].xyz;
   return v;
 }
@@ -169,7 +174,8 @@ LatticeSample latticeEvaluate(LatticeParams L, real3 x) {
   uint box = (span0 * L.boxes.y + span1) * L.boxes.z + span2;
   uint base = box * L.boxes.w;
   P real3 R = real3(0), Ru = real3(0), Rv = real3(0), Rw = real3(0);
-  if (L.degree.xyz == uvec3(2u)) {
+  bool degree2 = sffdAssumes(SFFD_ASSUME_DEGREE2) || (!sffdAssumes(SFFD_ASSUME_GENERAL_DEGREE) && L.degree.xyz == uvec3(2u));
+  if (degree2) {
     latticeVolume2(base, s0, s1, s2, R, Ru, Rv, Rw);
   } else {
     real bu[SFFD_MAX_DEGREE + 1], dbu[SFFD_MAX_DEGREE + 1];

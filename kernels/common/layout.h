@@ -67,6 +67,19 @@
 #define SFFD_OUTSIDE_EXTRAPOLATE 0u   // evaluate the nearest knot box's polynomial (continuous)
 #define SFFD_OUTSIDE_KEEP 1u          // leave the point and its normal unmoved, as PyGeM does
 
+// What a kernel that evaluates the lattice may be compiled to assume, as bits of one specialization
+// constant (Vulkan; a define on OpenGL): the host names what its lattice and parameter block hold, and
+// the code for the other case is dropped before the driver generates machine code (llvmpipe and
+// lavapipe do that at the first dispatch, and every storage-buffer read is much code there). 0: no
+// assumption, every case decided at run time. Results are the same either way.
+#define SFFD_SPEC_ASSUMPTIONS 0
+#define SFFD_ASSUME_DEGREE2 1u             // degree 2 on every axis
+#define SFFD_ASSUME_GENERAL_DEGREE 2u      // any other degrees
+#define SFFD_ASSUME_LATTICE_IN_PARAMS 4u   // DeformParams.inline_lattice holds the lattice
+#define SFFD_ASSUME_LATTICE_IN_STORAGE 8u  // the lattice storage buffers hold it
+#define SFFD_ASSUME_FIT_IN_PARAMS 16u      // DeformParams.inline_lattice holds the fit table
+#define SFFD_ASSUME_FIT_IN_STORAGE 32u     // the lattice frame range holds it
+
 // The lattice part of every parameter block.
 SFFD_STRUCT_BEGIN(LatticeParams)
   SFFD_UVEC4 degree;         // xyz: degree per axis (1..SFFD_MAX_DEGREE); w: outside_mode

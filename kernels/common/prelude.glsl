@@ -76,6 +76,22 @@ uint sffdThreadIndex() {
   return gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * (gl_NumWorkGroups.x * uint(SFFD_LOCAL_SIZE));
 }
 
+// The host's assumptions for this dispatch (layout.h SFFD_ASSUME_*).
+#ifdef VULKAN
+layout(constant_id = SFFD_SPEC_ASSUMPTIONS) const uint sffdAssumptions = 0u;
+#else
+#ifndef SFFD_ASSUMPTIONS
+#define SFFD_ASSUMPTIONS 0u
+#endif
+const uint sffdAssumptions = SFFD_ASSUMPTIONS;
+#endif
+bool sffdAssumes(uint bit) { return (sffdAssumptions & bit) != 0u; }
+
+// n, in a form no shader compiler can fold (gl_NumWorkGroups.z is at least 1): a loop bounded by it is
+// compiled as one copy of its body, not unrolled. For loops whose body is large: llvmpipe and lavapipe
+// generate machine code at a kernel's first dispatch, and unrolled bodies made that take seconds.
+uint sffdRolled(uint n) { return min(n, n + gl_NumWorkGroups.z - 1u); }
+
 #if SFFD_STRICT
 real sdot(real3 a, real3 b) {
   P real xy = a.x * b.x + a.y * b.y;

@@ -7,6 +7,7 @@
 #include <sffd/error.h>
 #include "kernels/pn/pn_eval.h"
 #include "kernels/common/shader_layout.h"
+#include "core/kernel_registry.h"
 #include "core/wall_clock.h"
 
 namespace sffd {
@@ -111,7 +112,7 @@ void dispatchDeform(Backend& backend, const gpu::DeformParams& params, const Def
     Dispatch d;
     d.kernel = kernel;
     d.label = label;
-    d.variant = variant;
+    d.variant = forLattice(variant, params);
     d.params = &params;
     d.paramsSize = sizeof(params);
     d.buffers = buffers;

@@ -19,7 +19,8 @@ layout(std140, SFFD_SET binding = SFFD_BINDING_PARAMS) uniform DeformBlock { Def
 #if !SFFD_F64
 real fitAt(uint i) {
   real v;
-  if (params.sections.x != 0u) v = params.inline_lattice[params.sections.x + (i >> 2u)][i & 3u];
+  bool inParams = sffdAssumes(SFFD_ASSUME_FIT_IN_PARAMS) || (!sffdAssumes(SFFD_ASSUME_FIT_IN_STORAGE) && params.sections.x != 0u);
+  if (inParams) v = params.inline_lattice[params.sections.x + (i >> 2u)][i & 3u];
   else v = latticeFrame[params.sections.y + i];
   return v;
 }

@@ -15,10 +15,14 @@
 
 namespace sffd {
 
-// Arithmetic variant of a kernel (see kernels/common/prelude.glsl).
+// Variant of a kernel (see kernels/common/prelude.glsl).
 struct KernelVariant {
   bool strict = false;   // every operation precise, fixed order: bit-identical across APIs
   bool f64 = false;      // double-precision arithmetic and storage
+  // SFFD_ASSUME_* bits (kernels/common/layout.h): what a lattice-evaluating kernel is compiled to
+  // assume about its lattice, so the driver compiles less code (docs/PERFORMANCE.md "Cold start").
+  // 0: nothing, decided at run time. The same results either way.
+  uint32_t assumptions = 0;
   bool operator==(const KernelVariant&) const = default;
 };
 

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <mutex>
+#include <set>
 
 #include "kernels/common/shader_layout.h"
 
@@ -18,9 +20,33 @@ std::string glslForVariant(const EmbeddedKernel& kernel, KernelVariant variant, 
   std::string src = es ? kernel.gles : kernel.glsl;
   size_t eol = src.find('\n');
   std::string defines = std::string("#define SFFD_STRICT ") + (variant.strict ? "1" : "0") +
-                        "\n#define SFFD_F64 " + (variant.f64 ? "1" : "0") + "\n";
+                        "\n#define SFFD_F64 " + (variant.f64 ? "1" : "0") +
+                        "\n#define SFFD_ASSUMPTIONS " + std::to_string(variant.assumptions) + "u\n";
   src.insert(eol == std::string::npos ? src.size() : eol + 1, defines);
   return src;
+}
+
+std::string variantName(KernelVariant v) {
+  std::string name = std::string(v.strict ? "strict" : "fast") + (v.f64 ? " f64" : " f32");
+  if (v.assumptions) {
+    char hex[16];
+    std::snprintf(hex, sizeof(hex), "0x%x", unsigned(v.assumptions));
+    name += std::string(" assuming ") + hex;
+  }
+  return name;
+}
+
+KernelVariant forLattice(KernelVariant v, const gpu::LatticeParams& lattice) {
+  const bool degree2 = lattice.degree.x == 2 && lattice.degree.y == 2 && lattice.degree.z == 2;
+  v.assumptions |= degree2 ? SFFD_ASSUME_DEGREE2 : SFFD_ASSUME_GENERAL_DEGREE;
+  return v;
+}
+
+KernelVariant forLattice(KernelVariant v, const gpu::DeformParams& params) {
+  v = forLattice(v, params.lattice);
+  v.assumptions |= params.lattice.break_offset.w ? SFFD_ASSUME_LATTICE_IN_PARAMS : SFFD_ASSUME_LATTICE_IN_STORAGE;
+  v.assumptions |= params.sections.x ? SFFD_ASSUME_FIT_IN_PARAMS : SFFD_ASSUME_FIT_IN_STORAGE;
+  return v;
 }
 
 Error noFloat64Error(const DeviceInfo& info) {
@@ -41,11 +67,26 @@ void gridFor(uint64_t threads, const DeviceLimits& limits, uint32_t groups[3]) {
   groups[2] = 1;
 }
 
+bool compileTraceOn() {
+  static const bool on = [] {
+    const char* v = std::getenv("SFFD_TRACE_COMPILE");
+    return v && *v && std::string_view(v) != "0";
+  }();
+  return on;
+}
+
+void traceFirstDispatch(std::string_view label, double deviceMs) {
+  if (!compileTraceOn()) return;
+  static std::mutex mutex;
+  static std::set<std::string, std::less<>> seen;
+  std::lock_guard<std::mutex> lock(mutex);
+  if (!seen.insert(std::string(label)).second) return;
+  std::fprintf(stderr, "sffd: first dispatch %.*s: %.1f ms\n", int(label.size()), label.data(), deviceMs);
+}
+
 CompileTrace::CompileTrace(std::string_view backend, std::string_view kernel, KernelVariant variant) {
-  const char* on = std::getenv("SFFD_TRACE_COMPILE");
-  if (!on || !*on || std::string_view(on) == "0") return;
-  what_ = std::string(backend) + " " + std::string(kernel) + (variant.strict ? " strict" : " fast") +
-          (variant.f64 ? " f64" : " f32");
+  if (!compileTraceOn()) return;
+  what_ = std::string(backend) + " " + std::string(kernel) + " " + variantName(variant);
   start_ = std::chrono::steady_clock::now();
 }
 

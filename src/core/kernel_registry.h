@@ -10,6 +10,7 @@
 #include <string_view>
 
 #include "core/backend.h"
+#include "kernels/common/shader_layout.h"
 
 namespace sffd {
 
@@ -21,7 +22,17 @@ struct EmbeddedKernel {
   size_t spirvWords[4];
 };
 
+// The SPIR-V of a variant (the assumptions are a specialization constant of it).
 inline int variantIndex(KernelVariant v) { return (v.strict ? 1 : 0) + (v.f64 ? 2 : 0); }
+// One compiled pipeline or program per key.
+inline uint64_t variantKey(KernelVariant v) { return uint64_t(variantIndex(v)) + 4 * uint64_t(v.assumptions); }
+// "strict f32", "fast f64 assuming 0x5", ...: for messages and traces.
+std::string variantName(KernelVariant v);
+// The variant a lattice-evaluating kernel is dispatched with: assuming the lattice's degrees
+// (SFFD_ASSUME_DEGREE2 or _GENERAL_DEGREE) and, given the deform kernels' parameter block, where the
+// lattice and the fit table are read from.
+KernelVariant forLattice(KernelVariant v, const gpu::LatticeParams& lattice);
+KernelVariant forLattice(KernelVariant v, const gpu::DeformParams& params);
 
 std::span<const EmbeddedKernel> embeddedKernels();
 // nullptr when no kernel has that name.
@@ -33,6 +44,10 @@ std::string glslForVariant(const EmbeddedKernel& kernel, KernelVariant variant, 
 // pipeline, GL program) prints one line `sffd: compile BACKEND KERNEL VARIANT: MS ms` to stderr when this
 // goes out of scope: which variants a run compiles and what creating each costs. llvmpipe and lavapipe
 // generate the machine code later, at the first dispatch (docs/PERFORMANCE.md "Cold start").
+bool compileTraceOn();
+// With tracing on, the device time of the first dispatch of each label in the process, one line
+// `sffd: first dispatch LABEL: MS ms`: on llvmpipe and lavapipe it includes that code generation.
+void traceFirstDispatch(std::string_view label, double deviceMs);
 class CompileTrace {
  public:
   CompileTrace(std::string_view backend, std::string_view kernel, KernelVariant variant);

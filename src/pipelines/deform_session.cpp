@@ -17,6 +17,7 @@
 #include "kernels/pn/pn_triangles.h"
 #include "model/prepared_mesh.h"
 #include "kernels/clip/split_pattern_table.h"
+#include "core/kernel_registry.h"
 #include "core/wall_clock.h"
 #include "pipelines/device_reals.h"
 
@@ -116,6 +117,7 @@ void sumStages(SessionTimings& t) {
   t.pnMs = t.clipMs = t.deformMs = 0;
   for (const DispatchTiming& d : t.dispatches) {
     double ms = std::max(d.gpuMs, 0.0);
+    traceFirstDispatch(d.label, d.gpuMs);
     if (d.label == "pn") t.pnMs += ms;
     else if (d.label.rfind("clip", 0) == 0) t.clipMs += ms;
     else if (d.label.rfind("deform", 0) == 0) t.deformMs += ms;

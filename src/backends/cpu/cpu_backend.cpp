@@ -14,6 +14,7 @@
 #include <vector>
 
 #include <sffd/error.h>
+#include "core/kernel_registry.h"
 #include "core/wall_clock.h"
 
 namespace sffd {
@@ -43,8 +44,6 @@ DeviceInfo deviceInfo() {
 }
 
 namespace {
-
-std::string variantName(KernelVariant v) { return std::string(v.strict ? "strict" : "fast") + (v.f64 ? " f64" : " f32"); }
 
 // Threads kept for the backend's dispatches. The calling thread works too and returns as soon as every
 // block is done: a worker the scheduler has not woken yet (cores shared with other processes) is not

@@ -65,10 +65,6 @@ void fitVersion(std::string& src, int contextVersion) {
   if (want > have && have >= 430) src.replace(9, 3, std::to_string(have));
 }
 
-std::string variantName(KernelVariant v) {
-  return std::string(v.strict ? "strict" : "fast") + (v.f64 ? "-f64" : "-f32");
-}
-
 struct Program {
   GLuint name = 0;
   GLint paramsBlockSize = -1;   // GL_UNIFORM_BLOCK_DATA_SIZE of the block at binding 0 (-1: none)
@@ -460,7 +456,7 @@ class GlBackend final : public Backend {
   }
 
   const Program& program(const EmbeddedKernel& kernel, KernelVariant variant) {
-    auto key = std::make_pair(&kernel, variantIndex(variant));
+    auto key = std::make_pair(&kernel, variantKey(variant));
     auto it = programs_.find(key);
     if (it != programs_.end()) return it->second;
     std::string what = std::string(kernel.name) + " (" + variantName(variant) + ")";
@@ -533,7 +529,7 @@ class GlBackend final : public Backend {
   DeviceInfo info_;
   std::unordered_map<BufferId, Buf> buffers_;
   BufferId nextId_ = 1;
-  std::map<std::pair<const EmbeddedKernel*, int>, Program> programs_;
+  std::map<std::pair<const EmbeddedKernel*, uint64_t>, Program> programs_;
   GLuint ubo_ = 0;
   uint64_t uboSize_ = 0, uboHead_ = 0, uboAlign_ = 256, maxParams_ = 16384;
   std::vector<Pending> pending_;

@@ -53,7 +53,7 @@ void Kernels::destroy() {
 
 VkPipeline Kernels::pipeline(std::string_view kernel, KernelVariant variant) {
   const int v = variantIndex(variant);
-  auto key = std::make_pair(std::string(kernel), v);
+  auto key = std::make_pair(std::string(kernel), variantKey(variant));
   if (auto it = pipelines_.find(key); it != pipelines_.end()) return it->second;
 
   const EmbeddedKernel* k = findKernel(kernel);
@@ -78,6 +78,11 @@ VkPipeline Kernels::pipeline(std::string_view kernel, KernelVariant variant) {
   ci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
   ci.stage.module = module;
   ci.stage.pName = "main";
+  // The assumptions as a specialization constant (ignored by kernels that do not declare it).
+  const uint32_t assumptions = variant.assumptions;
+  VkSpecializationMapEntry entry{SFFD_SPEC_ASSUMPTIONS, 0, sizeof(assumptions)};
+  VkSpecializationInfo spec{1, &entry, sizeof(assumptions), &assumptions};
+  ci.stage.pSpecializationInfo = &spec;
   ci.layout = pipelineLayout_;
   VkPipeline pipeline = VK_NULL_HANDLE;
   VkResult r = api.vkCreateComputePipelines(dev, cache_, 1, &ci, nullptr, &pipeline);

@@ -33,7 +33,7 @@ class Kernels {
   VkDescriptorSetLayout setLayout_ = VK_NULL_HANDLE;
   VkPipelineLayout pipelineLayout_ = VK_NULL_HANDLE;
   VkPipelineCache cache_ = VK_NULL_HANDLE;   // in memory only: Mesa and vendor drivers keep their own disk caches
-  std::map<std::pair<std::string, int>, VkPipeline> pipelines_;
+  std::map<std::pair<std::string, uint64_t>, VkPipeline> pipelines_;
 };
 
 }  // namespace sffd::vk
