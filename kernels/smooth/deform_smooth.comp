@@ -6,9 +6,9 @@
 // tessellation at level L. The split form (deform_step_*) runs the same functions one step a dispatch.
 #extension GL_GOOGLE_include_directive : require
 #include "../common/prelude.glsl"
+#define SFFD_DEFORM_OUT_ACCESS writeonly
 #include "smooth_deform.glsl"
 
-layout(std430, SFFD_SET binding = SFFD_BINDING_DEFORM_OUT) writeonly buffer DeformOut { real4 deformOut[]; };
 
 void main() {
   uint tid = sffdThreadIndex();
@@ -31,14 +31,5 @@ void main() {
     patches(pbase + 10u + k) = real4(ncp[k], 0);
   }
   uint L = params.range.w;
-  uint nv = (L + 1u) * (L + 2u) / 2u;
-  uint tbase = 2u * nv * st;
-  for (uint r = 0u; r <= L; ++r)
-    for (uint t = 0u; t <= r; ++t) {
-      real3 x, n;
-      smoothTessVertex(cp, ncp, L, r, t, x, n);
-      uint v = r * (r + 1u) / 2u + t;
-      tess(tbase + v) = real4(x, 0);
-      tess(tbase + nv + v) = real4(n, 0);
-    }
+  smoothTessellate(cp, ncp, L, (L + 1u) * (L + 2u) * st);   // 2 * vertex count * st
 }

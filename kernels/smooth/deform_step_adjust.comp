@@ -3,7 +3,6 @@
 #extension GL_GOOGLE_include_directive : require
 #include "../common/prelude.glsl"
 #include "smooth_deform.glsl"
-layout(std430, SFFD_SET binding = SFFD_BINDING_DEFORM_OUT) buffer DeformOut { real4 deformOut[]; };
 
 void main() {
   uint tid = sffdThreadIndex();

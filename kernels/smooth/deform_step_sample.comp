@@ -3,8 +3,8 @@
 // for the later steps. Same functions as the fused kernel deform_smooth.
 #extension GL_GOOGLE_include_directive : require
 #include "../common/prelude.glsl"
+#define SFFD_DEFORM_OUT_ACCESS writeonly
 #include "smooth_deform.glsl"
-layout(std430, SFFD_SET binding = SFFD_BINDING_DEFORM_OUT) writeonly buffer DeformOut { real4 deformOut[]; };
 
 void main() {
   uint tid = sffdThreadIndex();

@@ -31,6 +31,11 @@ layout(std430, SFFD_SET binding = SFFD_BINDING_DEFORM_SUB_RECORDS) readonly buff
 // The crease slot bits of sub-triangle st (layout.h: an integer-valued real).
 uint smoothCreaseBits(uint st) { return uint(subRecords[SFFD_SUB_STRIDE * st + SFFD_SUB_CREASE_BITS].w); }
 // The output range's sections (layout.h, SFFD_BINDING_DEFORM_OUT): tessellation, patches, samples.
+// A kernel that only writes it defines SFFD_DEFORM_OUT_ACCESS writeonly before including this file.
+#ifndef SFFD_DEFORM_OUT_ACCESS
+#define SFFD_DEFORM_OUT_ACCESS
+#endif
+layout(std430, SFFD_SET binding = SFFD_BINDING_DEFORM_OUT) SFFD_DEFORM_OUT_ACCESS buffer DeformOut { real4 deformOut[]; };
 #define tess(i) deformOut[i]
 #define patches(i) deformOut[params.sections.z + (i)]
 #define samples(i) deformOut[params.sections.w + (i)]
@@ -198,53 +203,64 @@ void smoothAdjust(uint creaseBits, real3 adj[3], real3 adjNbr[6], inout real3 cp
   cp[4] = centre;
 }
 
-// Step 6: tessellation vertex (r, t) at level L. Corners exact, edge vertices on the canonical edge
-// curve, the rest by the patch.
-void smoothTessVertex(real3 cp[10], real3 ncp[10], uint L, uint r, uint t, out real3 x, out real3 n) {
-  uint i = L - r, j = r - t, k = t;
-  // Control points are picked with constant indices in each branch: a local array indexed by a
-  // variable lives in memory on lavapipe (SPIR-V path), three times slower than GL's select chains.
-  if (i == L || j == L || k == L) {
-    real3 xc = cp[9], nc = ncp[9];
-    if (i == L) { xc = cp[0]; nc = ncp[0]; }
-    else if (j == L) { xc = cp[6]; nc = ncp[6]; }
-    x = xc;
-    n = snormalize(nc);
-  } else if (i == 0u || j == 0u || k == 0u) {
-    // Edge a -> a+1 is (0,1) when k == 0, (1,2) when i == 0, (2,0) when j == 0; its cubic runs through
-    // corner a, the control points of slots 2a+1 and 2a+2, corner a+1 (cp 0,1,3,6 / 6,7,8,9 / 9,5,2,0).
-    uint stepsFromA = i;
+// Step 6: the tessellation at level L: vertex (r, t), r = 0..L, t = 0..r, at index r (r + 1) / 2 + t
+// of the sub-triangle's positions (from tbase) and normals (from tbase + the vertex count), with
+// barycentrics (L - r, r - t, t) / L. Corners exact, edge vertices on the canonical edge curve, the
+// rest by the patch. Each kind of vertex has its own loop: llvmpipe and lavapipe run both sides of
+// every `if` under a lane mask, so one loop choosing the kind per vertex paid for all three kinds at
+// every vertex. Control points are picked by selects or constant indices (a local array indexed by a
+// variable lives in memory on lavapipe).
+void smoothTessellate(real3 cp[10], real3 ncp[10], uint L, uint tbase) {
+  uint nv = (L + 1u) * (L + 2u) / 2u;
+  uint lastRow = L * (L + 1u) / 2u;
+  for (uint c = 0u; c < 3u; ++c) {
+    uint v = c == 0u ? 0u : (c == 1u ? lastRow : lastRow + L);
+    real3 xc = c == 0u ? cp[0] : (c == 1u ? cp[6] : cp[9]);
+    real3 nc = c == 0u ? ncp[0] : (c == 1u ? ncp[6] : ncp[9]);
+    tess(tbase + v) = real4(xc, 0);
+    tess(tbase + nv + v) = real4(snormalize(nc), 0);
+  }
+  // Edge a runs from corner a to a + 1: vertices (s, 0), (L, s), (L - s, L - s) for a = 0, 1, 2, s steps
+  // from corner a; its cubic runs through corner a, the control points of slots 2a+1 and 2a+2 and corner
+  // a+1 (cp 0,1,3,6 / 6,7,8,9 / 9,5,2,0).
+  for (uint a = 0u; a < 3u; ++a) {
     real3 e0 = cp[9], e1 = cp[5], e2 = cp[2], e3 = cp[0], f0 = ncp[9], f1 = ncp[5], f2 = ncp[2], f3 = ncp[0];
-    if (k == 0u) {
-      stepsFromA = j;
+    if (a == 0u) {
       e0 = cp[0]; e1 = cp[1]; e2 = cp[3]; e3 = cp[6]; f0 = ncp[0]; f1 = ncp[1]; f2 = ncp[3]; f3 = ncp[6];
-    } else if (i == 0u) {
-      stepsFromA = k;
+    } else if (a == 1u) {
       e0 = cp[6]; e1 = cp[7]; e2 = cp[8]; e3 = cp[9]; f0 = ncp[6]; f1 = ncp[7]; f2 = ncp[8]; f3 = ncp[9];
     }
     // Evaluated from the lexicographically smaller corner, so both patches of the edge agree bit for bit.
-    uint steps = stepsFromA;
-    if (lexLess(e3, e0)) {
-      steps = L - stepsFromA;
+    bool reversed = lexLess(e3, e0);
+    if (reversed) {
       real3 t0 = e0, t1 = e1, g0 = f0, g1 = f1;
       e0 = e3; e1 = e2; e2 = t1; e3 = t0;
       f0 = f3; f1 = f2; f2 = g1; f3 = g0;
     }
-    P real u = real(steps) / real(L);
-    x = pnEdgeCurve(e0, e1, e2, e3, u);
-    n = snormalize(pnEdgeCurve(f0, f1, f2, f3, u));
-  } else {
-    P real3 lam = real3(real(i), real(j), real(k)) / real(L);
-    real w[10];
-    pnCubicWeights(lam, w);
-    P real3 xs = real3(0), ns = real3(0);
-    for (uint q = 0u; q < 10u; ++q) {
-      xs = xs + cp[q] * w[q];
-      ns = ns + ncp[q] * w[q];
+    for (uint s = 1u; s < L; ++s) {
+      uint r = a == 0u ? s : (a == 1u ? L : L - s);
+      uint t = a == 0u ? 0u : (a == 1u ? s : L - s);
+      uint v = r * (r + 1u) / 2u + t;
+      uint steps = reversed ? L - s : s;
+      P real u = real(steps) / real(L);
+      tess(tbase + v) = real4(pnEdgeCurve(e0, e1, e2, e3, u), 0);
+      tess(tbase + nv + v) = real4(snormalize(pnEdgeCurve(f0, f1, f2, f3, u)), 0);
     }
-    x = xs;
-    n = snormalize(ns);
   }
+  for (uint r = 2u; r < L; ++r)
+    for (uint t = 1u; t < r; ++t) {
+      uint v = r * (r + 1u) / 2u + t;
+      P real3 lam = real3(real(L - r), real(r - t), real(t)) / real(L);
+      real w[10];
+      pnCubicWeights(lam, w);
+      P real3 xs = real3(0), ns = real3(0);
+      for (uint q = 0u; q < 10u; ++q) {
+        xs = xs + cp[q] * w[q];
+        ns = ns + ncp[q] * w[q];
+      }
+      tess(tbase + v) = real4(xs, 0);
+      tess(tbase + nv + v) = real4(snormalize(ns), 0);
+    }
 }
 
 #endif
