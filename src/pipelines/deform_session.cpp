@@ -361,6 +361,28 @@ SubTriangleRecords DeformSession::records() {
   return R;
 }
 
+SubTrianglePreImages DeformSession::preImages() {
+  SubTrianglePreImages P;
+  P.parent.reserve(subCount_);
+  P.lam.reserve(9 * subCount_);
+  std::vector<uint32_t> headers;
+  auto load = [&](auto& records) {   // one chunk's records at a time, as the device holds them
+    for (size_t ci = 0; ci < chunks_.size(); ++ci) {
+      const Chunk& c = chunks_[ci];
+      if (!c.count) continue;
+      headers.resize(4 * c.count);
+      records.resize(c.count * SFFD_SUB_STRIDE * 4);
+      backend_.download(impl_->chunkBuffers[ci].headers, 0, headers.data(), c.count * 16);
+      backend_.download(impl_->chunkBuffers[ci].records, 0, records.data(), records.size() * sizeof(records[0]));
+      P.append(headers.data(), records.data(), c.count);
+    }
+  };
+  std::vector<float> f;
+  std::vector<double> d;
+  options_.variant.f64 ? load(d) : load(f);
+  return P;
+}
+
 SmoothOutput DeformSession::output() {
   SmoothOutput out;
   out.level = options_.level;

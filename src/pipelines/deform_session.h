@@ -82,6 +82,7 @@ class DeformSession {
   // Host copies, downloaded on demand: the sub-triangle records of the last precompute() (for
   // pre-images and error analysis) and the output of the last deform().
   SubTriangleRecords records();
+  SubTrianglePreImages preImages();   // what of the records the patch vertices need, a chunk at a time
   SmoothOutput output();
 
  private:
