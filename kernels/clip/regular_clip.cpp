@@ -207,9 +207,10 @@ void ClipRanges::name(gpu::ClipParams& p) const {
   p.words = {uint32_t(triangles), uint32_t(clipHeaders), uint32_t(counts), 0};
 }
 
-std::vector<double> clipRealRange(const ClipRanges& r, const PreparedMesh& mesh, const std::vector<double>* pnRecords,
-                                  const PackedClip& clip) {
-  std::vector<double> v(4 * r.realElements, 0.0);
+template <class Real>
+std::vector<Real> clipRealRange(const ClipRanges& r, const PreparedMesh& mesh, const std::vector<double>* pnRecords,
+                                const PackedClip& clip) {
+  std::vector<Real> v(4 * r.realElements, Real(0));
   const std::vector<double> verts = meshVertexRange(mesh);
   std::copy(verts.begin(), verts.end(), v.begin());
   auto part = [&](const std::vector<double>& from, uint64_t stride, uint64_t at) {
@@ -220,6 +221,8 @@ std::vector<double> clipRealRange(const ClipRanges& r, const PreparedMesh& mesh,
   std::copy(clip.reals.begin(), clip.reals.end(), v.begin() + 4 * r.clipReals);
   return v;
 }
+template std::vector<float> clipRealRange<float>(const ClipRanges&, const PreparedMesh&, const std::vector<double>*, const PackedClip&);
+template std::vector<double> clipRealRange<double>(const ClipRanges&, const PreparedMesh&, const std::vector<double>*, const PackedClip&);
 
 std::vector<uint32_t> clipWordRange(const ClipRanges& r, const PreparedMesh& mesh, const PackedClip& clip) {
   std::vector<uint32_t> w(r.words, 0);
@@ -241,7 +244,7 @@ SubTriangleRecords clipRun(Backend& backend, const PreparedMesh& M, const PnOutp
   PackedClip pc = packClip(clip);
   const size_t n = clip.triangles.size();
   const ClipRanges ranges = clipRanges(M, n, sizeof(Real));
-  const std::vector<Real> reals = convertReals<Real>(clipRealRange(ranges, M, &pn.records, pc));
+  const std::vector<Real> reals = clipRealRange<Real>(ranges, M, &pn.records, pc);
   const std::vector<uint32_t> words = clipWordRange(ranges, M, pc);
   auto fits = [&](size_t bytes, const char* what) {
     if (bytes > lim.maxStorageBufferRange)

@@ -83,8 +83,10 @@ ClipRanges clipRanges(const PreparedMesh& mesh, size_t clipTriangles, size_t rea
 ClipRanges clipRanges(uint64_t vertices, uint64_t firstParent, uint64_t parents, uint64_t firstClip, uint64_t clips,
                       size_t realSize);
 // The reals' range (the PN records' section zero without `pnRecords`, the whole mesh's: the caller's
-// pn_triangles writes it) and the words' range; `clip` holds the chunk's clip triangles (packClip).
-std::vector<double> clipRealRange(const ClipRanges& r, const PreparedMesh& mesh, const std::vector<double>* pnRecords,
+// pn_triangles writes it), in the kernel's reals (float or double: no wider copy of a large range),
+// and the words' range; `clip` holds the chunk's clip triangles (packClip).
+template <class Real>
+std::vector<Real> clipRealRange(const ClipRanges& r, const PreparedMesh& mesh, const std::vector<double>* pnRecords,
                                   const PackedClip& clip);
 std::vector<uint32_t> clipWordRange(const ClipRanges& r, const PreparedMesh& mesh, const PackedClip& clip);
 

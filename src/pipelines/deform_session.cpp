@@ -24,8 +24,9 @@ namespace sffd {
 
 struct DeformSession::Impl {
   Lattice structure;            // degrees, counts, knots, frame of the session's lattice
-  PreparedMesh mesh;
-  ClipTriangles clip;
+  PreparedMesh mesh;             // until uploaded; kept for the knot-box clipping (which reads it on the host)
+  ClipTriangles clip;            // until uploaded (clipCount stays)
+  size_t triangles = 0, clipCount = 0;
   std::vector<SubTriangle> knotBoxSubs;
   FitTable fit;
   size_t realSize = 4;
@@ -119,15 +120,22 @@ void DeformSession::prepare(const Mesh& input, const Lattice& lattice, const Sta
     std::vector<unsigned char> b = realBytes(v, f64);
     return I.upload(backend, b.data(), b.size());
   };
+  auto uploadVector = [&](const auto& v) { return I.upload(backend, v.data(), v.size() * sizeof(v[0])); };
   for (const ClipRanges& r : preChunks(I.mesh, I.clip, I.realSize, backend.info().limits.maxStorageBufferRange,
                                        options.maxChunkParents)) {
     const PackedClip pc = options.knotBoxClip ? PackedClip{} : packClip(I.clip, r.firstClip, r.firstClip + r.clips);
     Impl::PreChunk c{r};
-    c.reals = up(clipRealRange(r, I.mesh, nullptr, pc));
-    const std::vector<uint32_t> words = clipWordRange(r, I.mesh, pc);
-    c.words = I.upload(backend, words.data(), words.size() * 4);
+    if (f64) c.reals = uploadVector(clipRealRange<double>(r, I.mesh, nullptr, pc));
+    else c.reals = uploadVector(clipRealRange<float>(r, I.mesh, nullptr, pc));
+    c.words = uploadVector(clipWordRange(r, I.mesh, pc));
     I.pre.push_back(c);
   }
+  // The device holds what the regular clipping reads from here on: the host copies go (the knot-box
+  // clipping reads the prepared mesh on the host).
+  I.triangles = I.mesh.triangleCount();
+  I.clipCount = I.clip.triangles.size();
+  I.clip = {};
+  if (!options.knotBoxClip) I.mesh = {};
   PackedLattice packed = packLattice(lattice);
   I.frame = up(deformFrameRange(packed, I.fit.data));
   I.coeffs = up(packed.coeffs);
@@ -161,7 +169,7 @@ const SessionTimings& DeformSession::precompute(const StageProgress& progress) {
   const DeviceLimits& lim = B.info().limits;
   auto t0 = std::chrono::steady_clock::now();
   timings_ = {};
-  const size_t nt = I.mesh.triangleCount();
+  const size_t nt = I.triangles;
   auto dispatch = [&](const char* kernel, const char* label, const void* params, size_t paramsSize, size_t threads,
                       std::vector<BufferBinding> buffers) {
     Dispatch d;
@@ -218,7 +226,7 @@ const SessionTimings& DeformSession::precompute(const StageProgress& progress) {
   size_t clipN = 0;
   if (progress) progress("clip", 0.2);
   if (!options_.knotBoxClip) {
-    clipN = I.clip.triangles.size();
+    clipN = I.clipCount;
     std::vector<uint32_t> counts(clipN);
     for (const Impl::PreChunk& c : I.pre) {
       if (!c.ranges.clips) continue;
