@@ -71,11 +71,13 @@ std::vector<ClipRanges> preChunks(const PreparedMesh& mesh, const ClipTriangles&
       if (!fits(next)) break;
       r = next;
     }
-    if (!r.parents && p0 < nt)
+    if (!r.parents && p0 < nt) {
+      const ClipRanges one = clipRanges(nv, p0, 1, c0, 0, realSize);
       throw Error(ErrorKind::Input, "the job's vertices and one triangle's PN record and clip triangles (" +
-                                        std::to_string(clipRanges(nv, p0, 1, c0, 0, realSize).byteOf(r.realElements) >> 20) +
+                                        std::to_string(one.byteOf(one.realElements) >> 20) +
                                         " MiB) exceed one storage binding on this device (" + std::to_string(limit >> 20) +
                                         " MiB); use a coarser mesh");
+    }
     out.push_back(r);
     p0 += r.parents, c0 += r.clips;
   } while (p0 < nt);
