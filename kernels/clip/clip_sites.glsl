@@ -96,7 +96,8 @@ struct SiteValue {
 };
 
 struct Parent {
-  uint id;
+  uint id;      // the mesh's triangle id
+  uint local;   // its entry in the bound per-parent sections (ClipParams.range.w)
   uvec4 verts, welds;
   real3 V[3], N[3];
 };
@@ -104,8 +105,9 @@ struct Parent {
 Parent loadParent(uint id) {
   Parent p;
   p.id = id;
-  p.verts = triangles(SFFD_MESH_TRIANGLE_STRIDE * id);
-  p.welds = triangles(SFFD_MESH_TRIANGLE_STRIDE * id + 1u);
+  p.local = id - params.range.w;
+  p.verts = triangles(SFFD_MESH_TRIANGLE_STRIDE * p.local);
+  p.welds = triangles(SFFD_MESH_TRIANGLE_STRIDE * p.local + 1u);
   for (uint c = 0u; c < 3u; ++c) {
     p.V[c] = positions(p.verts[c]).xyz;
     p.N[c] = normals(p.verts[c]).xyz;
@@ -124,7 +126,7 @@ uint slotOf(uint corner, uint e) { return corner == e ? 2u * corner + 1u : 2u * 
 
 SiteValue evaluateSite(Parent p, Site s) {
   SiteValue r;
-  uint base = SFFD_PN_STRIDE * p.id;
+  uint base = SFFD_PN_STRIDE * p.local;
   if (s.kind < 3u) {
     uint k = s.kind;
     r.lam = real3(0);
@@ -181,8 +183,8 @@ real siteParamOnEdge(Parent p, Site s, uint e) {
 real4 neighbourNormalOnEdge(Parent p, uint e, real t) {
   uint lo, hi;
   edgeEnds(p, e, lo, hi);
-  uint sLo = SFFD_SLOT_NORMAL_STRIDE * p.id + 2u * slotOf(lo, e);
-  uint sHi = SFFD_SLOT_NORMAL_STRIDE * p.id + 2u * slotOf(hi, e);
+  uint sLo = SFFD_SLOT_NORMAL_STRIDE * p.local + 2u * slotOf(lo, e);
+  uint sHi = SFFD_SLOT_NORMAL_STRIDE * p.local + 2u * slotOf(hi, e);
   real4 fLo = slotNormals(sLo), gLo = slotNormals(sLo + 1u);
   real4 fHi = slotNormals(sHi), gHi = slotNormals(sHi + 1u);
   if (fLo.w < real(0.5) && fHi.w < real(0.5)) return real4(0);

@@ -85,19 +85,20 @@ struct ClipTwin {
   ParentT<Real> parent(uint32_t id) const {
     ParentT<Real> p;
     p.id = id;
-    args.check(8 * (uint64_t(id) + 1) <= meshTriangles.size() && 4 * SFFD_PN_STRIDE * (uint64_t(id) + 1) <= pn.size() &&
-                   4 * SFFD_SLOT_NORMAL_STRIDE * (uint64_t(id) + 1) <= slots.size(),
+    const uint64_t local = uint64_t(id) - params.range.w;   // the entry in the bound per-parent sections
+    args.check(id >= params.range.w && 8 * (local + 1) <= meshTriangles.size() && 4 * SFFD_PN_STRIDE * (local + 1) <= pn.size() &&
+                   4 * SFFD_SLOT_NORMAL_STRIDE * (local + 1) <= slots.size(),
                "a clip triangle's parent is outside the mesh buffers");
     for (int c = 0; c < 3; ++c) {
-      p.verts[c] = meshTriangles[8 * id + c];
-      p.welds[c] = meshTriangles[8 * id + 4 + c];
+      p.verts[c] = meshTriangles[8 * local + c];
+      p.welds[c] = meshTriangles[8 * local + 4 + c];
       args.check(4 * (uint64_t(p.verts[c]) + 1) <= std::min(positions.size(), normals.size()),
                  "a triangle's vertex id is outside the vertex buffers");
       p.V[c] = v3(positions.data(), p.verts[c]);
       p.N[c] = v3(normals.data(), p.verts[c]);
     }
-    p.pn = &pn[size_t(id) * SFFD_PN_STRIDE * 4];
-    p.slot = &slots[size_t(id) * SFFD_SLOT_NORMAL_STRIDE * 4];
+    p.pn = &pn[local * SFFD_PN_STRIDE * 4];
+    p.slot = &slots[local * SFFD_SLOT_NORMAL_STRIDE * 4];
     return p;
   }
 

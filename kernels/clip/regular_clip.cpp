@@ -129,13 +129,15 @@ ClipTriangles buildClipTriangles(const Mesh& mesh, double l, int nmax) {
 
 // ---------------------------------------------------------------- packed inputs of the clip kernels
 
-PackedClip packClip(const ClipTriangles& clip) {
+PackedClip packClip(const ClipTriangles& clip) { return packClip(clip, 0, clip.triangles.size()); }
+
+PackedClip packClip(const ClipTriangles& clip, size_t first, size_t last) {
   PackedClip P;
-  size_t n = clip.triangles.size();
+  size_t n = last - first;
   P.headers.assign(8 * n, 0);
   P.reals.assign(4 * SFFD_CLIP_REAL_STRIDE * n, 0.0);
   for (size_t i = 0; i < n; ++i) {
-    const ClipTriangle& c = clip.triangles[i];
+    const ClipTriangle& c = clip.triangles[first + i];
     uint32_t kinds = 0;
     for (int k = 0; k < 3; ++k) kinds |= uint32_t(c.corners[k].kind) << (8 * k);
     P.headers[8 * i] = c.parent;
@@ -176,45 +178,58 @@ const PackedTable& packedTable() {
 }
 
 ClipRanges clipRanges(const PreparedMesh& mesh, size_t clipTriangles, size_t realSize) {
+  return clipRanges(mesh.positions.size() / 4, 0, mesh.triangleCount(), 0, clipTriangles, realSize);
+}
+
+ClipRanges clipRanges(uint64_t vertices, uint64_t firstParent, uint64_t parents, uint64_t firstClip, uint64_t clips,
+                      size_t realSize) {
   ClipRanges r;
   r.realSize = realSize;
+  r.firstParent = firstParent, r.parents = parents, r.firstClip = firstClip, r.clips = clips;
   const uint64_t realAlign = SFFD_SECTION_ALIGN / (4 * realSize), wordAlign = SFFD_SECTION_ALIGN / 4;
   auto up = [](uint64_t v, uint64_t a) { return (v + a - 1) / a * a; };
-  const uint64_t nv = mesh.positions.size() / 4, nt = mesh.triangleCount();
-  r.normals = nv;
-  r.slotNormals = up(2 * nv, realAlign);
-  r.pn = up(r.slotNormals + SFFD_SLOT_NORMAL_STRIDE * nt, realAlign);
-  r.clipReals = up(r.pn + SFFD_PN_STRIDE * nt, realAlign);
-  r.realElements = r.clipReals + SFFD_CLIP_REAL_STRIDE * clipTriangles;
+  r.normals = vertices;
+  r.slotNormals = up(2 * vertices, realAlign);
+  r.pn = up(r.slotNormals + SFFD_SLOT_NORMAL_STRIDE * parents, realAlign);
+  r.clipReals = up(r.pn + SFFD_PN_STRIDE * parents, realAlign);
+  r.realElements = r.clipReals + SFFD_CLIP_REAL_STRIDE * clips;
   r.triangles = up(packedTable().words.size(), wordAlign);
-  r.clipHeaders = up(r.triangles + mesh.triangles.size(), wordAlign);
-  r.counts = up(r.clipHeaders + 4 * SFFD_CLIP_HEADER_STRIDE * clipTriangles, wordAlign);
-  r.words = r.counts + clipTriangles;
+  r.clipHeaders = up(r.triangles + 4 * SFFD_MESH_TRIANGLE_STRIDE * parents, wordAlign);
+  r.counts = up(r.clipHeaders + 4 * SFFD_CLIP_HEADER_STRIDE * clips, wordAlign);
+  r.words = r.counts + clips;
   return r;
 }
 
 void ClipRanges::name(gpu::ClipParams& p) const {
   p.range.z = uint32_t(normals);
+  p.range.w = uint32_t(firstParent);
   p.sections = {uint32_t(slotNormals), uint32_t(pn), uint32_t(clipReals), 0};
   p.words = {uint32_t(triangles), uint32_t(clipHeaders), uint32_t(counts), 0};
 }
 
-std::vector<double> clipRealRange(const ClipRanges& r, const PreparedMesh& mesh, const std::vector<double>* pnRecords,
-                                  const PackedClip& clip) {
-  std::vector<double> v(4 * r.realElements, 0.0);
+template <class Real>
+std::vector<Real> clipRealRange(const ClipRanges& r, const PreparedMesh& mesh, const std::vector<double>* pnRecords,
+                                const PackedClip& clip) {
+  std::vector<Real> v(4 * r.realElements, Real(0));
   const std::vector<double> verts = meshVertexRange(mesh);
   std::copy(verts.begin(), verts.end(), v.begin());
-  std::copy(mesh.slotNormals.begin(), mesh.slotNormals.end(), v.begin() + 4 * r.slotNormals);
-  if (pnRecords) std::copy(pnRecords->begin(), pnRecords->end(), v.begin() + 4 * r.pn);
+  auto part = [&](const std::vector<double>& from, uint64_t stride, uint64_t at) {
+    std::copy_n(from.begin() + 4 * stride * r.firstParent, 4 * stride * r.parents, v.begin() + 4 * at);
+  };
+  part(mesh.slotNormals, SFFD_SLOT_NORMAL_STRIDE, r.slotNormals);
+  if (pnRecords) part(*pnRecords, SFFD_PN_STRIDE, r.pn);
   std::copy(clip.reals.begin(), clip.reals.end(), v.begin() + 4 * r.clipReals);
   return v;
 }
+template std::vector<float> clipRealRange<float>(const ClipRanges&, const PreparedMesh&, const std::vector<double>*, const PackedClip&);
+template std::vector<double> clipRealRange<double>(const ClipRanges&, const PreparedMesh&, const std::vector<double>*, const PackedClip&);
 
 std::vector<uint32_t> clipWordRange(const ClipRanges& r, const PreparedMesh& mesh, const PackedClip& clip) {
   std::vector<uint32_t> w(r.words, 0);
   const PackedTable& T = packedTable();
   std::copy(T.words.begin(), T.words.end(), w.begin());
-  std::copy(mesh.triangles.begin(), mesh.triangles.end(), w.begin() + r.triangles);
+  const uint64_t perParent = 4 * SFFD_MESH_TRIANGLE_STRIDE;
+  std::copy_n(mesh.triangles.begin() + perParent * r.firstParent, perParent * r.parents, w.begin() + r.triangles);
   std::copy(clip.headers.begin(), clip.headers.end(), w.begin() + r.clipHeaders);
   return w;
 }
@@ -229,7 +244,7 @@ SubTriangleRecords clipRun(Backend& backend, const PreparedMesh& M, const PnOutp
   PackedClip pc = packClip(clip);
   const size_t n = clip.triangles.size();
   const ClipRanges ranges = clipRanges(M, n, sizeof(Real));
-  const std::vector<Real> reals = convertReals<Real>(clipRealRange(ranges, M, &pn.records, pc));
+  const std::vector<Real> reals = clipRealRange<Real>(ranges, M, &pn.records, pc);
   const std::vector<uint32_t> words = clipWordRange(ranges, M, pc);
   auto fits = [&](size_t bytes, const char* what) {
     if (bytes > lim.maxStorageBufferRange)

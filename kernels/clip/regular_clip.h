@@ -59,25 +59,34 @@ struct PackedClip {
   std::vector<double> reals;
 };
 PackedClip packClip(const ClipTriangles& clip);
+PackedClip packClip(const ClipTriangles& clip, size_t first, size_t last);   // clip triangles [first, last)
 struct PackedTable {
   std::vector<uint32_t> words;
   uint32_t nmax = 0, vertexWord = 0, triangleWord = 0;
 };
 const PackedTable& packedTable();
 
-// The clip kernels' two input ranges (layout.h, SFFD_BINDING_CLIP_REALS and SFFD_BINDING_CLIP_WORDS):
-// where each section begins, in real4 elements and in words, each at a multiple of SFFD_SECTION_ALIGN
-// bytes. The one place that lays them out; clipRealRange and clipWordRange fill them.
+// The clip kernels' two input ranges (layout.h, SFFD_BINDING_CLIP_REALS and SFFD_BINDING_CLIP_WORDS) of
+// one pre-compute chunk: all the vertices, the chunk's parents [firstParent, + parents) and their clip
+// triangles [firstClip, + clips); where each section begins, in real4 elements and in words, each at a
+// multiple of SFFD_SECTION_ALIGN bytes. The one place that lays them out; clipRealRange and
+// clipWordRange fill them.
 struct ClipRanges {
+  uint64_t firstParent = 0, parents = 0, firstClip = 0, clips = 0;
   uint64_t normals = 0, slotNormals = 0, pn = 0, clipReals = 0, realElements = 0;
   uint64_t triangles = 0, clipHeaders = 0, counts = 0, words = 0;
   size_t realSize = 4;
   uint64_t byteOf(uint64_t element) const { return element * 4 * realSize; }   // of a real4 element
-  void name(gpu::ClipParams& params) const;   // range.z, sections, words
+  void name(gpu::ClipParams& params) const;   // range.z, range.w, sections, words
 };
-ClipRanges clipRanges(const PreparedMesh& mesh, size_t clipTriangles, size_t realSize);
-// The reals' range (the PN records' section zero without `pnRecords`: the caller's pn_triangles writes it).
-std::vector<double> clipRealRange(const ClipRanges& r, const PreparedMesh& mesh, const std::vector<double>* pnRecords,
+ClipRanges clipRanges(const PreparedMesh& mesh, size_t clipTriangles, size_t realSize);   // the whole mesh, one chunk
+ClipRanges clipRanges(uint64_t vertices, uint64_t firstParent, uint64_t parents, uint64_t firstClip, uint64_t clips,
+                      size_t realSize);
+// The reals' range (the PN records' section zero without `pnRecords`, the whole mesh's: the caller's
+// pn_triangles writes it), in the kernel's reals (float or double: no wider copy of a large range),
+// and the words' range; `clip` holds the chunk's clip triangles (packClip).
+template <class Real>
+std::vector<Real> clipRealRange(const ClipRanges& r, const PreparedMesh& mesh, const std::vector<double>* pnRecords,
                                   const PackedClip& clip);
 std::vector<uint32_t> clipWordRange(const ClipRanges& r, const PreparedMesh& mesh, const PackedClip& clip);
 

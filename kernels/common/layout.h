@@ -122,7 +122,9 @@ SFFD_STRUCT_END(ClassicParams)
 // triangles whose edges need more than Nmax segments). Four storage blocks in all (the OpenGL ES 3.1
 // minimum): two input ranges of sections at the elements ClipParams names, and the two outputs. Each
 // section begins at a multiple of SFFD_SECTION_ALIGN bytes, so that pn_triangles binds the mesh's
-// sections and writes the PN records as ranges of their own.
+// sections and writes the PN records as ranges of their own. A mesh beyond one binding is cut into
+// pre-compute chunks of consecutive parents, each with ranges of its own laid out the same way (all
+// the vertices, then that chunk's parents and clip triangles).
 #define SFFD_BINDING_CLIP_REALS SFFD_SLOT_1      // real4: the mesh vertices (positions, then normals from element
                                                  // range.z); from element sections.x the slot normals
                                                  // (SFFD_SLOT_NORMAL_STRIDE per triangle); from sections.y the PN
@@ -159,7 +161,9 @@ SFFD_STRUCT_END(ClassicParams)
 #define SFFD_SUB_CREASE_BITS SFFD_SUB_LAM
 
 SFFD_STRUCT_BEGIN(ClipParams)
-  SFFD_UVEC4 range;      // x: first clip triangle, y: clip triangle count, z: the first normal of the reals' range
+  SFFD_UVEC4 range;      // x: first clip triangle, y: clip triangle count, z: the first normal of the reals' range,
+                         // w: the parent of the per-parent sections' first entry (the mesh triangles, slot normals
+                         // and PN records of a pre-compute chunk; parent ids in the clip headers are the mesh's)
   SFFD_UVEC4 table;      // x: Nmax, y: first vertex word, z: first triangle word (of the split table)
   SFFD_VEC4 target;      // x: target edge length l
   SFFD_UVEC4 sections;   // first element in the reals' range of x: the slot normals, y: the PN records, z: the clip triangles

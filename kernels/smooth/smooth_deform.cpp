@@ -132,14 +132,14 @@ void dispatchDeform(Backend& backend, const gpu::DeformParams& params, const Def
 
 namespace {
 template <class Real>
-void appendPatchVerticesOf(const SubTriangleRecords& subs, size_t first, size_t count, const Real* tess, PatchVertices& P) {
+void appendPatchVerticesOf(const SubTrianglePreImages& subs, size_t first, size_t count, const Real* tess, PatchVertices& P) {
   const int L = P.level, nv = tessVertexCount(L);
   P.reserve(subs.size());
   for (size_t s = first; s < first + count; ++s) {
-    P.parent.push_back(subs.headers[4 * s]);
+    P.parent.push_back(subs.parent[s]);
     glm::dvec3 lam[3];
     for (int c = 0; c < 3; ++c) {
-      const double* l = &subs.records[(s * SFFD_SUB_STRIDE + SFFD_SUB_LAM + c) * 4];
+      const double* l = &subs.lam[9 * s + 3 * c];
       lam[c] = {l[0], l[1], l[2]};
     }
     const Real* t = &tess[(s - first) * 2 * nv * 4];
@@ -158,17 +158,19 @@ void appendPatchVerticesOf(const SubTriangleRecords& subs, size_t first, size_t 
 }
 }  // namespace
 
-void appendPatchVertices(const SubTriangleRecords& subs, size_t first, size_t count, const float* tess, PatchVertices& P) {
+void appendPatchVertices(const SubTrianglePreImages& subs, size_t first, size_t count, const float* tess, PatchVertices& P) {
   appendPatchVerticesOf(subs, first, count, tess, P);
 }
-void appendPatchVertices(const SubTriangleRecords& subs, size_t first, size_t count, const double* tess, PatchVertices& P) {
+void appendPatchVertices(const SubTrianglePreImages& subs, size_t first, size_t count, const double* tess, PatchVertices& P) {
   appendPatchVerticesOf(subs, first, count, tess, P);
 }
 
 PatchVertices patchVerticesOf(const SubTriangleRecords& subs, const SmoothOutput& out) {
   PatchVertices P;
   P.level = out.level;
-  appendPatchVerticesOf(subs, 0, subs.size(), out.tess.data(), P);
+  SubTrianglePreImages pre;
+  pre.append(subs.headers.data(), subs.records.data(), subs.size());
+  appendPatchVerticesOf(pre, 0, pre.size(), out.tess.data(), P);
   return P;
 }
 

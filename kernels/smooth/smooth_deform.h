@@ -51,14 +51,31 @@ uint64_t deformOutSections(gpu::DeformParams& params, uint64_t count, int level,
 void dispatchDeform(Backend& backend, const gpu::DeformParams& params, const DeformBuffers& buffers, size_t count,
                     KernelVariant variant, bool split);
 
+// What the patch vertices need of the sub-triangle records: each one's parent and its corners'
+// barycentrics there (76 bytes a sub-triangle instead of the records' 688).
+struct SubTrianglePreImages {
+  std::vector<uint32_t> parent;   // per sub-triangle
+  std::vector<double> lam;        // 9 per sub-triangle: corner c's barycentrics from 3c
+  size_t size() const { return parent.size(); }
+  // Appends `count` sub-triangles from their headers (4 words each) and records (SFFD_SUB_STRIDE real4 each).
+  template <class Real>
+  void append(const uint32_t* headers, const Real* records, size_t count) {
+    for (size_t s = 0; s < count; ++s) {
+      parent.push_back(headers[4 * s]);
+      for (int c = 0; c < 3; ++c)
+        for (int a = 0; a < 3; ++a) lam.push_back(double(records[(s * SFFD_SUB_STRIDE + SFFD_SUB_LAM + c) * 4 + a]));
+    }
+  }
+};
+
 // The tessellation with each vertex's pre-image in its parent triangle (for the writers and the
 // error analysis).
 PatchVertices patchVerticesOf(const SubTriangleRecords& subs, const SmoothOutput& out);
 // The same, a chunk at a time: appends sub-triangles [first, first + count) to `patches` (level set,
 // sub-triangles before `first` appended), their tessellation at `tess` as the device holds it (2 nv
 // (x, y, z, w) a sub-triangle: positions, then normals), widened to double here.
-void appendPatchVertices(const SubTriangleRecords& subs, size_t first, size_t count, const float* tess, PatchVertices& patches);
-void appendPatchVertices(const SubTriangleRecords& subs, size_t first, size_t count, const double* tess, PatchVertices& patches);
+void appendPatchVertices(const SubTrianglePreImages& subs, size_t first, size_t count, const float* tess, PatchVertices& patches);
+void appendPatchVertices(const SubTrianglePreImages& subs, size_t first, size_t count, const double* tess, PatchVertices& patches);
 
 struct CpuKernelArgs;
 namespace cpu {

@@ -184,14 +184,17 @@ JobEstimate estimateSmoothJob(const Mesh& mesh, double S, int level, size_t real
   const double nv = double((level + 1) * (level + 2) / 2), tris = double(level) * level, nt = double(mesh.triangles.size());
   const double r4 = 4.0 * double(realBytes);   // one real4
   // Device, per sub-triangle: header, record, patch and tessellation (positions and normals); per
-  // input triangle its PN record and about one clip triangle of 3 real4 corners and a header.
+  // input triangle the pre-compute's inputs and PN record and about one clip triangle (layout.h: slot
+  // normals, PN record, clip reals; 68 bytes of triangle, clip header and count words).
   const double device = S * (16 + SFFD_SUB_STRIDE * r4 + SFFD_PATCH_STRIDE * r4 + 2 * nv * r4) +
-                        nt * (SFFD_PN_STRIDE * r4 + 3 * r4 + 16) + double(meshBytes(mesh, false));
-  // Host, per sub-triangle, at the peak (the weld, smooth's result()): the downloaded records (4
-  // doubles a real4), the pre-images and positions and normals of the patch vertices (9 doubles), the
-  // weld's two hash entries and the welded vertex with push_back's slack (about 256 bytes), the
-  // triangles; then the writer's position index (76 bytes a vertex, as for classic).
-  const double perSub = (16 + SFFD_SUB_STRIDE * 32.0) + 4 + nv * 72 + nv * 256 + tris * 24 + nv * 76;
+                        nt * ((SFFD_SLOT_NORMAL_STRIDE + SFFD_PN_STRIDE + SFFD_CLIP_REAL_STRIDE) * r4 + 68) +
+                        double(meshBytes(mesh, false));
+  // Host, per sub-triangle, at the peak (the weld, smooth's result()): its parent and corner
+  // barycentrics (SubTrianglePreImages, 76 bytes), the pre-images and positions and normals of the
+  // patch vertices (9 doubles), the weld's two hash entries and the welded vertex with push_back's
+  // slack (about 256 bytes), the triangles; then the writer's position index (76 bytes a vertex, as
+  // for classic).
+  const double perSub = 4 + 9 * 8 + nv * 72 + nv * 256 + tris * 24 + nv * 76;
   // The input held by the Deformer, the session's copy and the prepared mesh, and per triangle the
   // topology and clip triangles (about 256 bytes).
   const double input = 3.0 * double(meshBytes(mesh, true)) + nt * 256;

@@ -25,15 +25,18 @@ namespace sffd {
 
 struct DeformSession::Impl {
   Lattice structure;            // degrees, counts, knots, frame of the session's lattice
-  PreparedMesh mesh;
-  ClipTriangles clip;
+  PreparedMesh mesh;             // until uploaded; kept for the knot-box clipping (which reads it on the host)
+  ClipTriangles clip;            // until uploaded (clipCount stays)
+  size_t triangles = 0, clipCount = 0;
   std::vector<SubTriangle> knotBoxSubs;
   FitTable fit;
   size_t realSize = 4;
   std::vector<BufferId> owned;   // every buffer, destroyed with the session
-  // The clip kernels' two input ranges; pn_triangles reads the mesh's sections and writes the PN records' as ranges.
-  ClipRanges ranges;
-  BufferId reals = 0, words = 0;
+  // The pre-compute's chunks of consecutive parents, each with the clip kernels' two input ranges in
+  // buffers of its own (all the vertices, then its parents' and clip triangles' sections), so that no
+  // binding exceeds the device's limit; pn_triangles reads the mesh's sections and writes the PN records'.
+  struct PreChunk { ClipRanges ranges; BufferId reals = 0, words = 0; };
+  std::vector<PreChunk> pre;
   BufferId frame = 0, coeffs = 0;
   struct ChunkBuffers { BufferId headers = 0, records = 0; size_t firstClip = 0, clipCount = 0; };
   std::vector<ChunkBuffers> chunkBuffers;
@@ -49,6 +52,40 @@ struct DeformSession::Impl {
     return id;
   }
 };
+
+namespace {
+
+// The pre-compute's chunks: consecutive parents (and their clip triangles, which follow the parents'
+// order), as many to a chunk as keep both of its input ranges within one storage binding.
+std::vector<ClipRanges> preChunks(const PreparedMesh& mesh, const ClipTriangles& clip, size_t realSize, uint64_t limit,
+                                  size_t maxParents) {
+  const uint64_t nv = mesh.positions.size() / 4, nt = mesh.triangleCount();
+  const std::vector<ClipTriangle>& ct = clip.triangles;
+  auto fits = [&](const ClipRanges& r) { return r.byteOf(r.realElements) <= limit && r.words * 4 <= limit; };
+  std::vector<ClipRanges> out;
+  uint64_t p0 = 0, c0 = 0;
+  do {
+    ClipRanges r = clipRanges(nv, p0, 0, c0, 0, realSize);
+    for (uint64_t p1 = p0, c1 = c0; p1 < nt && (!maxParents || p1 - p0 < maxParents); ++p1) {
+      while (c1 < ct.size() && ct[c1].parent == p1) ++c1;
+      ClipRanges next = clipRanges(nv, p0, p1 + 1 - p0, c0, c1 - c0, realSize);
+      if (!fits(next)) break;
+      r = next;
+    }
+    if (!r.parents && p0 < nt) {
+      const ClipRanges one = clipRanges(nv, p0, 1, c0, 0, realSize);
+      throw Error(ErrorKind::Input, "the job's vertices and one triangle's PN record and clip triangles (" +
+                                        std::to_string(one.byteOf(one.realElements) >> 20) +
+                                        " MiB) exceed one storage binding on this device (" + std::to_string(limit >> 20) +
+                                        " MiB); use a coarser mesh");
+    }
+    out.push_back(r);
+    p0 += r.parents, c0 += r.clips;
+  } while (p0 < nt);
+  return out;
+}
+
+}  // namespace
 
 DeformSession::DeformSession(Backend& backend, const Mesh& input, const Lattice& lattice, const DeformSessionOptions& options,
                              const StageProgress& progress)
@@ -82,29 +119,33 @@ void DeformSession::prepare(const Mesh& input, const Lattice& lattice, const Sta
   int s = options.samples > 0 ? options.samples : lattice.degree[0] + lattice.degree[1] + lattice.degree[2];
   I.fit = makeFitTable(std::max(3, s));
 
-  const DeviceLimits& lim = backend.info().limits;
-  auto fits = [&](size_t bytes, const char* what) {
-    if (bytes > lim.maxStorageBufferRange)
-      throw Error(ErrorKind::Input, std::string("the job's ") + what + " (" + std::to_string(bytes >> 20) +
-                                        " MiB) exceed one storage binding on this device (" +
-                                        std::to_string(lim.maxStorageBufferRange >> 20) + " MiB); use a coarser mesh");
-  };
   auto up = [&](const std::vector<double>& v) {
     std::vector<unsigned char> b = realBytes(v, f64);
     return I.upload(backend, b.data(), b.size());
   };
-  const PackedClip pc = options.knotBoxClip ? PackedClip{} : packClip(I.clip);
-  I.ranges = clipRanges(I.mesh, I.clip.triangles.size(), I.realSize);
-  fits(I.ranges.byteOf(I.ranges.realElements), "vertices, PN records and clip triangles");
-  fits(I.ranges.words * 4, "triangles and clip triangles");
-  I.reals = up(clipRealRange(I.ranges, I.mesh, nullptr, pc));
-  const std::vector<uint32_t> words = clipWordRange(I.ranges, I.mesh, pc);
-  I.words = I.upload(backend, words.data(), words.size() * 4);
+  auto uploadVector = [&](const auto& v) { return I.upload(backend, v.data(), v.size() * sizeof(v[0])); };
+  for (const ClipRanges& r : preChunks(I.mesh, I.clip, I.realSize, backend.info().limits.maxStorageBufferRange,
+                                       options.maxChunkParents)) {
+    const PackedClip pc = options.knotBoxClip ? PackedClip{} : packClip(I.clip, r.firstClip, r.firstClip + r.clips);
+    Impl::PreChunk c{r};
+    if (f64) c.reals = uploadVector(clipRealRange<double>(r, I.mesh, nullptr, pc));
+    else c.reals = uploadVector(clipRealRange<float>(r, I.mesh, nullptr, pc));
+    c.words = uploadVector(clipWordRange(r, I.mesh, pc));
+    I.pre.push_back(c);
+  }
+  // The device holds what the regular clipping reads from here on: the host copies go (the knot-box
+  // clipping reads the prepared mesh on the host).
+  I.triangles = I.mesh.triangleCount();
+  I.clipCount = I.clip.triangles.size();
+  I.clip = {};
+  if (!options.knotBoxClip) I.mesh = {};
   PackedLattice packed = packLattice(lattice);
   I.frame = up(deformFrameRange(packed, I.fit.data));
   I.coeffs = up(packed.coeffs);
   precompute(progress);
 }
+
+size_t DeformSession::precomputeChunks() const { return impl_->pre.size(); }
 
 DeformSession::~DeformSession() {
   for (BufferId b : impl_->owned) backend_.destroyBuffer(b);
@@ -132,7 +173,7 @@ const SessionTimings& DeformSession::precompute(const StageProgress& progress) {
   const DeviceLimits& lim = B.info().limits;
   auto t0 = std::chrono::steady_clock::now();
   timings_ = {};
-  const size_t nt = I.mesh.triangleCount();
+  const size_t nt = I.triangles;
   auto dispatch = [&](const char* kernel, const char* label, const void* params, size_t paramsSize, size_t threads,
                       std::vector<BufferBinding> buffers) {
     Dispatch d;
@@ -146,31 +187,32 @@ const SessionTimings& DeformSession::precompute(const StageProgress& progress) {
     B.dispatch(d);
     B.barrier();
   };
-  // The clip kernels' parameters and bindings (mesh, PN records, clip triangles, counts), for both passes.
-  auto clipParams = [&](size_t first, size_t count) {
+  // The clip kernels' parameters and bindings (a pre-compute chunk's inputs; counts), for both passes.
+  auto clipParams = [&](const ClipRanges& r, size_t first, size_t count) {
     gpu::ClipParams params;
     const PackedTable& T = packedTable();
     params.table = {T.nmax, T.vertexWord, T.triangleWord, 0};
     params.target = {float(options_.edgeLength), 0, 0, 0};
     params.range = {uint32_t(first), uint32_t(count), 0, 0};
-    I.ranges.name(params);
+    r.name(params);
     return params;
   };
-  auto clipBindings = [&](std::vector<BufferBinding> extra) {
-    std::vector<BufferBinding> b = {{SFFD_BINDING_CLIP_REALS, I.reals}, {SFFD_BINDING_CLIP_WORDS, I.words}};
+  auto clipBindings = [&](const Impl::PreChunk& c, std::vector<BufferBinding> extra) {
+    std::vector<BufferBinding> b = {{SFFD_BINDING_CLIP_REALS, c.reals}, {SFFD_BINDING_CLIP_WORDS, c.words}};
     b.insert(b.end(), extra.begin(), extra.end());
     return b;
   };
   if (progress) progress("pn", 0.1);
-  if (nt) {
+  for (const Impl::PreChunk& c : I.pre) {
+    const ClipRanges& R = c.ranges;
+    if (!R.parents) continue;
     gpu::PnParams params;
-    const ClipRanges& R = I.ranges;
-    params.range = {0, uint32_t(nt), uint32_t(R.normals), 0};
-    dispatch("pn_triangles", "pn", &params, sizeof(params), nt,
-             {{SFFD_BINDING_MESH_VERTICES, I.reals, 0, R.byteOf(R.slotNormals)},
-              {SFFD_BINDING_MESH_TRIANGLES, I.words, R.triangles * 4, I.mesh.triangles.size() * 4},
-              {SFFD_BINDING_MESH_SLOT_NORMALS, I.reals, R.byteOf(R.slotNormals), R.byteOf(R.pn - R.slotNormals)},
-              {SFFD_BINDING_PN_OUT, I.reals, R.byteOf(R.pn), R.byteOf(SFFD_PN_STRIDE * nt)}});
+    params.range = {0, uint32_t(R.parents), uint32_t(R.normals), 0};
+    dispatch("pn_triangles", "pn", &params, sizeof(params), R.parents,
+             {{SFFD_BINDING_MESH_VERTICES, c.reals, 0, R.byteOf(R.slotNormals)},
+              {SFFD_BINDING_MESH_TRIANGLES, c.words, R.triangles * 4, R.parents * 4 * SFFD_MESH_TRIANGLE_STRIDE * 4},
+              {SFFD_BINDING_MESH_SLOT_NORMALS, c.reals, R.byteOf(R.slotNormals), R.byteOf(R.pn - R.slotNormals)},
+              {SFFD_BINDING_PN_OUT, c.reals, R.byteOf(R.pn), R.byteOf(SFFD_PN_STRIDE * R.parents)}});
   }
   // Sub-triangle counts per chunk, and the chunk layout (a clip triangle's sub-triangles stay in one chunk).
   const size_t nv = size_t(tessVertexCount(options_.level));
@@ -188,12 +230,13 @@ const SessionTimings& DeformSession::precompute(const StageProgress& progress) {
   size_t clipN = 0;
   if (progress) progress("clip", 0.2);
   if (!options_.knotBoxClip) {
-    clipN = I.clip.triangles.size();
-    gpu::ClipParams params = clipParams(0, clipN);
+    clipN = I.clipCount;
     std::vector<uint32_t> counts(clipN);
-    if (clipN) {
-      dispatch("clip_count", "clip_count", &params, sizeof(params), clipN, clipBindings({}));
-      B.download(I.words, I.ranges.counts * 4, counts.data(), clipN * 4);
+    for (const Impl::PreChunk& c : I.pre) {
+      if (!c.ranges.clips) continue;
+      gpu::ClipParams params = clipParams(c.ranges, 0, c.ranges.clips);
+      dispatch("clip_count", "clip_count", &params, sizeof(params), c.ranges.clips, clipBindings(c, {}));
+      B.download(c.words, c.ranges.counts * 4, &counts[c.ranges.firstClip], c.ranges.clips * 4);
     }
     offsets.assign(clipN + 1, 0);
     for (size_t i = 0; i < clipN; ++i) offsets[i + 1] = offsets[i] + counts[i], maxSubs = std::max<uint64_t>(maxSubs, counts[i]);
@@ -201,8 +244,11 @@ const SessionTimings& DeformSession::precompute(const StageProgress& progress) {
     // The 2015 clipping is the CPU baseline: PN records come back to the host for it once.
     PnOutput pn;
     pn.records = doublesOf([&] {
-      std::vector<unsigned char> b(nt * SFFD_PN_STRIDE * 4 * I.realSize);
-      if (nt) B.download(I.reals, I.ranges.byteOf(I.ranges.pn), b.data(), b.size());
+      const uint64_t perParent = SFFD_PN_STRIDE * 4 * I.realSize;
+      std::vector<unsigned char> b(nt * perParent);
+      for (const Impl::PreChunk& c : I.pre)
+        if (c.ranges.parents)
+          B.download(c.reals, c.ranges.byteOf(c.ranges.pn), &b[c.ranges.firstParent * perParent], c.ranges.parents * perParent);
       return b;
     }(), options_.variant.f64);
     knotRecords = recordsFromSubTriangles(I.mesh, pn, I.knotBoxSubs, options_.variant);
@@ -213,14 +259,18 @@ const SessionTimings& DeformSession::precompute(const StageProgress& progress) {
   subCount_ = offsets.back();
 
   // The chunks: per chunk the sub-triangle records and the deform outputs. A clip triangle's
-  // sub-triangles stay in one chunk. The buffers are kept when the layout is the one already there
-  // (a repeated precompute), so that nothing is reallocated.
-  struct Plan { size_t firstClip, clipCount, first, count; };
+  // sub-triangles stay in one chunk, and a chunk's clip triangles in one pre-compute chunk (clip_write
+  // reads its inputs). The buffers are kept when the layout is the one already there (a repeated
+  // precompute), so that nothing is reallocated.
+  struct Plan { size_t firstClip, clipCount, first, count, pre; };
   std::vector<Plan> plan;
-  for (size_t first = 0; first < clipN;) {
+  for (size_t first = 0, pre = 0; first < clipN;) {
+    if (!options_.knotBoxClip)
+      while (first >= I.pre[pre].ranges.firstClip + I.pre[pre].ranges.clips) ++pre;
+    const size_t end = options_.knotBoxClip ? clipN : I.pre[pre].ranges.firstClip + I.pre[pre].ranges.clips;
     size_t last = first;
-    while (last < clipN && offsets[last + 1] - offsets[first] <= maxSubs) ++last;
-    plan.push_back({first, last - first, offsets[first], offsets[last] - offsets[first]});
+    while (last < end && offsets[last + 1] - offsets[first] <= maxSubs) ++last;
+    plan.push_back({first, last - first, offsets[first], offsets[last] - offsets[first], pre});
     first = last;
   }
   bool same = plan.size() == chunks_.size();
@@ -257,11 +307,13 @@ const SessionTimings& DeformSession::precompute(const StageProgress& progress) {
     const Impl::ChunkBuffers& cb = I.chunkBuffers[ci];
     const size_t first = p.firstClip, last = p.firstClip + p.clipCount, subs = p.count;
     if (!options_.knotBoxClip) {
+      const Impl::PreChunk& in = I.pre[p.pre];
+      const size_t local = first - in.ranges.firstClip;   // the first clip triangle in the chunk's inputs
       for (size_t i = first; i < last; ++i) chunkOffsets[i] = uint32_t(offsets[i] - offsets[first]);
-      B.upload(I.words, (I.ranges.counts + first) * 4, chunkOffsets.data() + first, (last - first) * 4);
-      gpu::ClipParams params = clipParams(first, last - first);
+      B.upload(in.words, (in.ranges.counts + local) * 4, chunkOffsets.data() + first, (last - first) * 4);
+      gpu::ClipParams params = clipParams(in.ranges, local, last - first);
       dispatch("clip_write", "clip_write", &params, sizeof(params), last - first,
-               clipBindings({{SFFD_BINDING_SUB_HEADERS, cb.headers}, {SFFD_BINDING_SUB_RECORDS, cb.records}}));
+               clipBindings(in, {{SFFD_BINDING_SUB_HEADERS, cb.headers}, {SFFD_BINDING_SUB_RECORDS, cb.records}}));
     } else if (subs) {
       B.upload(cb.headers, 0, &knotRecords.headers[4 * c.first], subs * 16);
       std::vector<double> part(knotRecords.records.begin() + c.first * SFFD_SUB_STRIDE * 4,
@@ -319,6 +371,28 @@ SubTriangleRecords DeformSession::records() {
                       &R.records[c.first * SFFD_SUB_STRIDE * 4], scratch);
   }
   return R;
+}
+
+SubTrianglePreImages DeformSession::preImages() {
+  SubTrianglePreImages P;
+  P.parent.reserve(subCount_);
+  P.lam.reserve(9 * subCount_);
+  std::vector<uint32_t> headers;
+  auto load = [&](auto& records) {   // one chunk's records at a time, as the device holds them
+    for (size_t ci = 0; ci < chunks_.size(); ++ci) {
+      const Chunk& c = chunks_[ci];
+      if (!c.count) continue;
+      headers.resize(4 * c.count);
+      records.resize(c.count * SFFD_SUB_STRIDE * 4);
+      backend_.download(impl_->chunkBuffers[ci].headers, 0, headers.data(), c.count * 16);
+      backend_.download(impl_->chunkBuffers[ci].records, 0, records.data(), records.size() * sizeof(records[0]));
+      P.append(headers.data(), records.data(), c.count);
+    }
+  };
+  std::vector<float> f;
+  std::vector<double> d;
+  options_.variant.f64 ? load(d) : load(f);
+  return P;
 }
 
 SmoothOutput DeformSession::output() {

@@ -31,6 +31,7 @@ struct DeformSessionOptions {
   bool split = false;          // deform as four dispatches (per-step timings) instead of the fused kernel
   double creaseAngleDeg = kCreaseAngleAuto;  // for a mesh without normals: applyCreaseAngle's threshold
   size_t maxChunkSubTriangles = 0;   // 0: chunks as large as the device allows (smaller only to test chunking)
+  size_t maxChunkParents = 0;        // the same for the pre-compute's chunks of mesh triangles
 };
 
 // Told the stage and the fraction of the call done, at stage boundaries and after each chunk; it may
@@ -73,6 +74,7 @@ class DeformSession {
   };
   const std::vector<Chunk>& chunks() const { return chunks_; }
   size_t subTriangles() const { return subCount_; }
+  size_t precomputeChunks() const;   // the pre-compute's chunks of mesh triangles (options().maxChunkParents)
   int level() const { return options_.level; }
   const DeformSessionOptions& options() const { return options_; }
   Backend& backend() { return backend_; }
@@ -80,6 +82,7 @@ class DeformSession {
   // Host copies, downloaded on demand: the sub-triangle records of the last precompute() (for
   // pre-images and error analysis) and the output of the last deform().
   SubTriangleRecords records();
+  SubTrianglePreImages preImages();   // what of the records the patch vertices need, a chunk at a time
   SmoothOutput output();
 
  private:

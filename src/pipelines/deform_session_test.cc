@@ -120,6 +120,41 @@ TEST_P(DeformSessionTest, ChunkedSplitAndKnotBoxSessionsEqualCpuReference) {
   EXPECT_EQ(vk::validationMessageCount(), 0u);
 }
 
+// The pre-compute in chunks of a few mesh triangles (the path of a mesh beyond one storage binding):
+// the same records and output as in one chunk, with pre-split parents (cube2 at a short edge length),
+// sub-triangle chunks across the pre-compute's, a repeated precompute, and knot-box clipping.
+TEST_P(DeformSessionTest, PrecomputeChunksGiveTheSameRecordsAndOutput) {
+  OpenedBackend b = open();
+  for (auto [file, l] : {std::pair{"/cube2.obj", 0.05}, std::pair{"/sphere.obj", 0.3}}) {
+    for (bool knotBox : {false, true}) {
+      SCOPED_TRACE(std::string(file) + (knotBox ? " knot-box" : " regular"));
+      Mesh m = readMesh(std::string(SFFD_TEST_DATA) + file);
+      Lattice A = latticeFor(m, 5, 0.1);
+      DeformSessionOptions o;
+      o.variant = {true, false};
+      o.edgeLength = l;
+      o.level = 3;
+      o.knotBoxClip = knotBox;
+      DeformSession one(*b.backend, m, A, o);
+      ASSERT_EQ(one.precomputeChunks(), 1u);
+      one.deform(A);
+      o.maxChunkParents = 5;
+      o.maxChunkSubTriangles = 50;
+      DeformSession many(*b.backend, m, A, o);
+      EXPECT_GT(many.precomputeChunks(), 2u);
+      many.precompute();
+      many.deform(A);
+      SubTriangleRecords r1 = one.records(), r2 = many.records();
+      EXPECT_EQ(r2.headers, r1.headers);
+      EXPECT_EQ(r2.records, r1.records);
+      SmoothOutput o1 = one.output(), o2 = many.output();
+      EXPECT_EQ(o2.tess, o1.tess);
+      EXPECT_EQ(o2.patches, o1.patches);
+    }
+  }
+  EXPECT_EQ(vk::validationMessageCount(), 0u);
+}
+
 // A lattice too large for the deform kernels' parameter block is read from the storage buffers:
 // the same bits.
 TEST_P(DeformSessionTest, LatticeTooLargeToInlineGivesTheSameOutput) {

@@ -41,7 +41,7 @@ class SmoothRun final : public MethodRun {
   }
 
   std::optional<PatchVertices> patchVertices() const override {
-    if (!records_) records_ = session_->records();   // fixed by the pre-compute: downloaded once
+    if (!records_) records_ = session_->preImages();   // fixed by the pre-compute: downloaded once
     PatchVertices p = session_->options().variant.f64 ? downloadPatchVertices<double>() : downloadPatchVertices<float>();
     carryAttributes(p, input_);
     return p;
@@ -90,7 +90,7 @@ class SmoothRun final : public MethodRun {
  private:
   const Mesh& input_;   // Deformer::Impl::input, which outlives the run
   std::unique_ptr<DeformSession> session_;
-  mutable std::optional<SubTriangleRecords> records_;
+  mutable std::optional<SubTrianglePreImages> records_;
 };
 
 }  // namespace
