@@ -122,20 +122,6 @@ TEST(MeshWrite, AttributesRoundTrip) {
   fs::remove_all(dir);
 }
 
-std::string base64(const std::string& bytes) {
-  static const char* abc = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  for (size_t i = 0; i < bytes.size(); i += 3) {
-    const size_t n = std::min<size_t>(3, bytes.size() - i);   // bytes in this group; 4 - (3 - n) characters, then '='
-    uint32_t v = 0;
-    for (size_t k = 0; k < 3; ++k) v = (v << 8) | (k < n ? uint8_t(bytes[i + k]) : 0u);
-    for (size_t k = 0; k < 4; ++k) out += k <= n ? abc[(v >> (18 - 6 * k)) & 63] : '=';
-  }
-  return out;
-}
-
-// The glTF reader on a file made here: node transforms (a translated child of a mirroring node),
-// strips, fans, normalized byte colours, flipped texture coordinates, a skipped line primitive.
 // The OBJ and OFF writers write one position per location when the mesh names its locations
 // (Mesh::weldIdIsLocation, the smooth and accurate output): two locations at one position stay two
 // vertices. Otherwise (a mesh read from a file, or a location whose vertices were moved apart) one per
@@ -184,6 +170,20 @@ TEST(MeshWrite, LocationsAtOnePositionStayApart) {
   fs::remove_all(dir);
 }
 
+std::string base64(const std::string& bytes) {
+  static const char* abc = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  for (size_t i = 0; i < bytes.size(); i += 3) {
+    const size_t n = std::min<size_t>(3, bytes.size() - i);   // bytes in this group; 4 - (3 - n) characters, then '='
+    uint32_t v = 0;
+    for (size_t k = 0; k < 3; ++k) v = (v << 8) | (k < n ? uint8_t(bytes[i + k]) : 0u);
+    for (size_t k = 0; k < 4; ++k) out += k <= n ? abc[(v >> (18 - 6 * k)) & 63] : '=';
+  }
+  return out;
+}
+
+// The glTF reader on a file made here: node transforms (a translated child of a mirroring node),
+// strips, fans, normalized byte colours, flipped texture coordinates, a skipped line primitive.
 TEST(MeshRead, GltfPrimitivesAndTransforms) {
   const fs::path dir = tempDir("mesh_read_gltf");
   std::string bin;
