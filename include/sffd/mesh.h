@@ -35,7 +35,14 @@ struct Material {
 struct Mesh {
   std::vector<glm::dvec3> positions;             // per vertex
   std::vector<glm::dvec3> normals;               // per vertex, unit length
-  std::vector<uint32_t> weldId;                  // per vertex: index of its distinct position
+  std::vector<uint32_t> weldId;                  // per vertex: index of its distinct position, or location (below)
+  // false: weldId is by exact position (the readers, meshFromView), and the OBJ and OFF writers find
+  // the distinct positions themselves. true: weldId names each vertex's location on the input surface
+  // (the smooth and accurate output, weldPatchVertices), one position a location, and those writers
+  // write one position per location: two locations that round to one position (a sliver thinner than
+  // float's resolution) stay two, so the file keeps the output's topology. A location whose vertices
+  // no longer share one position (moved apart by the caller) makes the writers fall back to positions.
+  bool weldIdIsLocation = false;
   std::vector<std::array<uint32_t, 3>> triangles;  // counter-clockwise vertex indices
   bool normalsFromFile = false;                  // false: normals were computed on load
   // .bpt input only: the exact surface, and for each vertex its patch and (u, v) (error reference).

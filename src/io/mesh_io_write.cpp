@@ -104,11 +104,31 @@ Carried checkWritable(const std::string& path, const Mesh& mesh) {
   return c;
 }
 
+// Per vertex the index of the position it is written as (numbered by first appearance), and their count:
+// the mesh's locations when it names them (Mesh::weldIdIsLocation: no hash of the positions, and two
+// locations at one position stay two), else its distinct position bits.
+std::vector<uint32_t> positionIds(const Mesh& mesh, uint32_t& count) {
+  const size_t n = mesh.positions.size();
+  constexpr uint32_t kNone = ~0u;
+  std::vector<uint32_t> id(n), first;   // first: per location, its first vertex
+  bool usable = mesh.weldIdIsLocation && mesh.weldId.size() == n;
+  if (usable) first.assign(n, kNone);
+  count = 0;
+  for (size_t v = 0; usable && v < n; ++v) {
+    const uint32_t w = mesh.weldId[v];
+    if (w >= n) usable = false;
+    else if (first[w] == kNone) first[w] = uint32_t(v), id[v] = count++;
+    else if (std::memcmp(&mesh.positions[v], &mesh.positions[first[w]], sizeof(glm::dvec3)) == 0) id[v] = id[first[w]];
+    else usable = false;
+  }
+  return usable ? id : meshio::distinctPositions(mesh.positions, count);
+}
+
 void writeObj(std::ostream& os, const Mesh& mesh, int digits, const Carried& has) {
-  // Positions are written once per distinct value (so a welded mesh stays welded for every OBJ reader),
+  // Positions are written once per location or distinct value (so a welded mesh stays welded for every OBJ reader),
   // texture coordinates and normals once per vertex; a face corner is "position/vertex/vertex".
   uint32_t count = 0;
-  std::vector<uint32_t> pid = meshio::distinctPositions(mesh.positions, count);
+  std::vector<uint32_t> pid = positionIds(mesh, count);
   ChunkedWriter w(os);
   std::string& s = w.buf();
   s += "# sffd mesh: " + std::to_string(count) + " positions, " + std::to_string(mesh.positions.size()) + " vertices, " +
@@ -234,9 +254,9 @@ void writePly(std::ostream& os, const Mesh& mesh, int digits, const Carried& has
 }
 
 void writeOff(std::ostream& os, const Mesh& mesh, int digits) {
-  // OFF holds positions only: one per distinct position, so a welded mesh stays welded.
+  // OFF holds positions only: one per location or distinct position, so a welded mesh stays welded.
   uint32_t count = 0;
-  std::vector<uint32_t> pid = meshio::distinctPositions(mesh.positions, count);
+  std::vector<uint32_t> pid = positionIds(mesh, count);
   ChunkedWriter w(os);
   std::string& s = w.buf();
   s += "OFF\n" + std::to_string(count) + " " + std::to_string(mesh.triangles.size()) + " 0\n";

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <fstream>
+#include <sstream>
 
 #include <sffd/error.h>
 
@@ -118,6 +119,54 @@ TEST(MeshWrite, AttributesRoundTrip) {
   const Mesh st = readMesh((dir / "st.ply").string());
   EXPECT_EQ(st.texcoords[0], glm::dvec2(0.25, 0.5));
   EXPECT_EQ(st.colors[0], glm::dvec4(1, 0.5, 0, 1));
+  fs::remove_all(dir);
+}
+
+// The OBJ and OFF writers write one position per location when the mesh names its locations
+// (Mesh::weldIdIsLocation, the smooth and accurate output): two locations at one position stay two
+// vertices. Otherwise (a mesh read from a file, or a location whose vertices were moved apart) one per
+// distinct position.
+TEST(MeshWrite, LocationsAtOnePositionStayApart) {
+  const fs::path dir = tempDir("mesh_write_locations");
+  Mesh m;   // vertex 3 lies where vertex 0 does, at another location; vertex 4 is vertex 1's location again
+  m.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 0}, {1, 0, 0}};
+  m.weldId = {0, 1, 2, 3, 1};
+  m.triangles = {{0, 1, 2}, {3, 2, 4}};
+  // The file's vertex count and its faces' position indices (from 0).
+  auto written = [&](const char* ext) {
+    const fs::path path = dir / (std::string("m") + ext);
+    writeMesh(path.string(), m);
+    std::istringstream in(slurp(path));
+    std::string word;
+    size_t vertices = 0, nf = 0, three = 0;
+    std::vector<uint32_t> corners(6);
+    if (std::string(ext) == ".off") {
+      in >> word >> vertices >> nf >> three;
+      for (size_t i = 0; i < 3 * vertices; ++i) in >> word;
+      for (size_t f = 0; f < 2; ++f) in >> three >> corners[3 * f] >> corners[3 * f + 1] >> corners[3 * f + 2];
+    } else {
+      size_t c = 0;
+      for (std::string line; std::getline(in, line);) {
+        if (line.rfind("v ", 0) == 0) ++vertices;
+        std::istringstream l(line);
+        if (l >> word && word == "f")
+          while (l >> word) corners.at(c++) = uint32_t(std::stoul(word)) - 1;
+      }
+    }
+    return std::pair{vertices, corners};
+  };
+  using Corners = std::vector<uint32_t>;
+  for (const char* ext : {".obj", ".off"}) {
+    SCOPED_TRACE(ext);
+    m.weldIdIsLocation = true;
+    EXPECT_EQ(written(ext), std::pair(size_t(4), Corners{0, 1, 2, 3, 2, 1}));
+    m.weldIdIsLocation = false;   // weldId by position, as read from a file
+    EXPECT_EQ(written(ext), std::pair(size_t(3), Corners{0, 1, 2, 0, 2, 1}));
+    m.weldIdIsLocation = true;
+    m.positions[4] = {2, 0, 0};   // one location, two positions: by position
+    EXPECT_EQ(written(ext), std::pair(size_t(4), Corners{0, 1, 2, 0, 2, 3}));
+    m.positions[4] = m.positions[1];
+  }
   fs::remove_all(dir);
 }
 

@@ -164,6 +164,7 @@ Mesh weldPatchVertices(const PatchVertices& P) {
     throw std::logic_error("weldPatchVertices: parentWeld not filled (carryAttributes)");
   Mesh m;
   m.normalsFromFile = true;
+  m.weldIdIsLocation = true;
   const int nv = tessVertexCount(P.level);
   const std::vector<uint32_t> local = tessTriangles(P.level);
   std::vector<char> boundary(nv);

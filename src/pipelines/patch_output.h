@@ -57,7 +57,8 @@ void carryAttributes(PatchVertices& patches, const Mesh& input);
 // way), a point inside a parent one location for its sub-triangles. Each location has one position,
 // that of the patch of the lowest parent there, so the output is closed where the input is, and one
 // vertex per distinct normal, texture coordinate and colour bits (creases and seams split vertices,
-// never positions); its vertices share a weldId, the location's index. A triangle with two corners at
+// never positions); its vertices share a weldId, the location's index (Mesh::weldIdIsLocation, so the
+// writers keep locations that round to one position apart). A triangle with two corners at
 // one location (of a degenerate patch) is dropped. The carried fields become the Mesh's.
 Mesh weldPatchVertices(const PatchVertices& patches);
 
