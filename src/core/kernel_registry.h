@@ -40,14 +40,16 @@ const EmbeddedKernel* findKernel(std::string_view name);
 // GLSL source of a variant for an OpenGL (es: OpenGL ES) driver: the variant defines follow the #version line.
 std::string glslForVariant(const EmbeddedKernel& kernel, KernelVariant variant, bool es = false);
 
+// Whether SFFD_TRACE_COMPILE is set (and not 0).
+bool compileTraceOn();
+// With tracing on, the device time of the first dispatch of each label in the process, one line
+// `sffd: first dispatch LABEL: MS ms`: on llvmpipe and lavapipe it includes the code generation.
+void traceFirstDispatch(std::string_view label, double deviceMs);
+
 // With SFFD_TRACE_COMPILE=1 in the environment, a backend's creation of one kernel variant (Vulkan
 // pipeline, GL program) prints one line `sffd: compile BACKEND KERNEL VARIANT: MS ms` to stderr when this
 // goes out of scope: which variants a run compiles and what creating each costs. llvmpipe and lavapipe
 // generate the machine code later, at the first dispatch (docs/PERFORMANCE.md "Cold start").
-bool compileTraceOn();
-// With tracing on, the device time of the first dispatch of each label in the process, one line
-// `sffd: first dispatch LABEL: MS ms`: on llvmpipe and lavapipe it includes that code generation.
-void traceFirstDispatch(std::string_view label, double deviceMs);
 class CompileTrace {
  public:
   CompileTrace(std::string_view backend, std::string_view kernel, KernelVariant variant);
