@@ -31,10 +31,11 @@ uvec4 clipWords4(uint w) { return uvec4(clipInWords[w], clipInWords[w + 1u], cli
 #define triangles(i) clipWords4(params.words.x + 4u * (i))
 #define clipHeaders(i) clipWords4(params.words.y + 4u * (i))
 
-const uint kSlotCp[6] = uint[6](2u, 1u, 3u, 7u, 8u, 5u);
-const uint kEdgeNormalCp[3] = uint[3](1u, 4u, 2u);
-const uint kCornerCp[3] = uint[3](0u, 6u, 9u);
-const uint kCornerNormalCp[3] = uint[3](0u, 3u, 5u);
+// Control point of slot s (2, 1, 3, 7, 8, 5) and normal control point of edge e (1, 4, 2), as 4-bit
+// fields of a constant: a constant array indexed by a variable is copied into local memory at every
+// use in the SPIR-V that glslang emits (smooth_deform.glsl has the same for the deform kernels).
+uint kSlotCp(uint s) { return (0x587312u >> (4u * s)) & 15u; }
+uint kEdgeNormalCp(uint e) { return (0x241u >> (4u * e)) & 15u; }
 
 // The split of one clip triangle: counts, the canonical-to-local corner map and the pattern entry.
 struct ClipSetup {
@@ -115,6 +116,16 @@ Parent loadParent(uint id) {
   return p;
 }
 
+// Corner c's position and normal, and the unit barycentric of corner c: selects, not a local array
+// indexed by a variable (kept in memory on lavapipe, and much code to generate on Mesa 25.0).
+real3 parentV(Parent p, uint c) { return c == 0u ? p.V[0] : (c == 1u ? p.V[1] : p.V[2]); }
+real3 parentN(Parent p, uint c) { return c == 0u ? p.N[0] : (c == 1u ? p.N[1] : p.N[2]); }
+// (a at corner ca, b at corner cb, 0 at the third), ca != cb.
+real3 twoCornerLam(uint ca, real a, uint cb, real b) {
+  return real3(ca == 0u ? a : (cb == 0u ? b : real(0)), ca == 1u ? a : (cb == 1u ? b : real(0)),
+               ca == 2u ? a : (cb == 2u ? b : real(0)));
+}
+
 // Corners of parent edge e ordered by weld id.
 void edgeEnds(Parent p, uint e, out uint lo, out uint hi) {
   lo = e;
@@ -129,33 +140,35 @@ SiteValue evaluateSite(Parent p, Site s) {
   uint base = SFFD_PN_STRIDE * p.local;
   if (s.kind < 3u) {
     uint k = s.kind;
-    r.lam = real3(0);
-    r.lam[k] = real(1);
-    r.xpn = p.V[k];
-    r.xflat = p.V[k];
-    r.nlin = p.N[k];
-    r.npn = p.N[k];
+    r.lam = real3(k == 0u ? real(1) : real(0), k == 1u ? real(1) : real(0), k == 2u ? real(1) : real(0));
+    r.xpn = parentV(p, k);
+    r.xflat = r.xpn;
+    r.nlin = parentN(p, k);
+    r.npn = r.nlin;
   } else if (s.kind < 6u) {
     uint e = s.kind - 3u, lo, hi;
     edgeEnds(p, e, lo, hi);
     P real t = s.t;
     P real u = real(1) - t;
-    r.lam = real3(0);
-    r.lam[lo] = u;
-    r.lam[hi] = t;
-    real3 bLo = pn(base + kSlotCp[slotOf(lo, e)]).xyz, bHi = pn(base + kSlotCp[slotOf(hi, e)]).xyz;
-    r.xpn = pnEdgeCurve(p.V[lo], bLo, bHi, p.V[hi], t);
-    P real3 xf = p.V[lo] + (p.V[hi] - p.V[lo]) * t;
+    r.lam = twoCornerLam(lo, u, hi, t);
+    real3 bLo = pn(base + kSlotCp(slotOf(lo, e))).xyz, bHi = pn(base + kSlotCp(slotOf(hi, e))).xyz;
+    real3 vLo = parentV(p, lo), vHi = parentV(p, hi), nLo = parentN(p, lo), nHi = parentN(p, hi);
+    r.xpn = pnEdgeCurve(vLo, bLo, bHi, vHi, t);
+    P real3 xf = vLo + (vHi - vLo) * t;
     r.xflat = xf;
-    r.nlin = snormalize(p.N[lo] * u + p.N[hi] * t);
-    r.npn = pnEdgeNormalCurve(p.N[lo], pn(base + SFFD_PN_NORMALS + kEdgeNormalCp[e]).xyz, p.N[hi], t);
+    r.nlin = snormalize(nLo * u + nHi * t);
+    r.npn = pnEdgeNormalCurve(nLo, pn(base + SFFD_PN_NORMALS + kEdgeNormalCp(e)).xyz, nHi, t);
   } else {
     P real3 l = s.lam;
     r.lam = l;
     real w[10];
     pnCubicWeights(l, w);
-    P real3 x = real3(0);
-    for (uint i = 0u; i < 10u; ++i) x = x + pn(base + i).xyz * w[i];
+    // Sums written out in the loops' order: on Mesa 25.0 this branch took most of clip_write's 13 to
+    // 17 s of machine-code generation at its first dispatch with the loops, about half that without.
+    P real3 x = (((((((((real3(0) + pn(base).xyz * w[0]) + pn(base + 1u).xyz * w[1]) + pn(base + 2u).xyz * w[2]) +
+                      pn(base + 3u).xyz * w[3]) + pn(base + 4u).xyz * w[4]) + pn(base + 5u).xyz * w[5]) +
+                   pn(base + 6u).xyz * w[6]) + pn(base + 7u).xyz * w[7]) + pn(base + 8u).xyz * w[8]) +
+                pn(base + 9u).xyz * w[9];
     r.xpn = x;
     P real3 xf = (p.V[0] * l.x + p.V[1] * l.y) + p.V[2] * l.z;
     r.xflat = xf;
@@ -163,8 +176,9 @@ SiteValue evaluateSite(Parent p, Site s) {
     r.nlin = snormalize(nl);
     real q[6];
     pnQuadraticWeights(l, q);
-    P real3 nn = real3(0);
-    for (uint i = 0u; i < 6u; ++i) nn = nn + pn(base + SFFD_PN_NORMALS + i).xyz * q[i];
+    uint nb = base + SFFD_PN_NORMALS;
+    P real3 nn = (((((real3(0) + pn(nb).xyz * q[0]) + pn(nb + 1u).xyz * q[1]) + pn(nb + 2u).xyz * q[2]) +
+                   pn(nb + 3u).xyz * q[3]) + pn(nb + 4u).xyz * q[4]) + pn(nb + 5u).xyz * q[5];
     r.npn = snormalize(nn);
   }
   return r;
@@ -194,7 +208,7 @@ real4 neighbourNormalOnEdge(Parent p, uint e, real t) {
   // neighbour's own records hold it there.
   if (t == real(0)) return real4(nLo, 1);
   if (t == real(1)) return real4(nHi, 1);
-  real3 nMid = pnEdgeNormal(p.V[lo], p.V[hi], nLo, nHi);
+  real3 nMid = pnEdgeNormal(parentV(p, lo), parentV(p, hi), nLo, nHi);
   return real4(pnEdgeNormalCurve(nLo, nMid, nHi, t), 1);
 }
 
