@@ -163,7 +163,8 @@ void adjust(uint32_t creaseBits, const RVec3<Real> adj[3], const RVec3<Real> adj
   cp[4] = edgeSum / Real(4) - cornerSum / Real(6);
 }
 
-// Step 6: the tessellation at level Lv, positions then normals (smoothTessVertex for every vertex).
+// Step 6: the tessellation at level Lv, positions then normals; the twin of smoothTessellate (smooth_deform.glsl),
+// one vertex at a time in index order where the kernel has one loop per kind of vertex: the same values.
 template <class Real>
 void tessellate(const RVec3<Real> cp[10], const RVec3<Real> ncp[10], int Lv, Real* tessOut) {
   const int nv = (Lv + 1) * (Lv + 2) / 2;
