@@ -31,17 +31,13 @@ uvec4 clipWords4(uint w) { return uvec4(clipInWords[w], clipInWords[w + 1u], cli
 #define triangles(i) clipWords4(params.words.x + 4u * (i))
 #define clipHeaders(i) clipWords4(params.words.y + 4u * (i))
 
-// Control point of slot s (2, 1, 3, 7, 8, 5) and normal control point of edge e (1, 4, 2), as 4-bit
-// fields of a constant: a constant array indexed by a variable is copied into local memory at every
-// use in the SPIR-V that glslang emits (smooth_deform.glsl has the same for the deform kernels).
-uint kSlotCp(uint s) { return (0x587312u >> (4u * s)) & 15u; }
-uint kEdgeNormalCp(uint e) { return (0x241u >> (4u * e)) & 15u; }
-
 // The split of one clip triangle: counts, the canonical-to-local corner map and the pattern entry.
 struct ClipSetup {
-  uint perm[3];      // canonical corner m -> local corner
+  // Vectors, not arrays: a vector's component picked by a variable is a select, an array's element a
+  // memory access (one per lane on lavapipe 22.3).
+  uvec3 perm;        // canonical corner m -> local corner
   bool odd;          // the map reverses the winding
-  uint count[3];     // segments of canonical edges C0C1, C1C2, C2C0
+  uvec3 count;       // segments of canonical edges C0C1, C1C2, C2C0
   uvec4 entry;       // firstVertex, vertexCount, firstTriangle, triangleCount
 };
 
@@ -96,11 +92,16 @@ struct SiteValue {
   real3 lam, xpn, xflat, nlin, npn;
 };
 
+// A parent triangle and its PN record, read once per clip triangle: on lavapipe 22.3 a storage read
+// at an address that differs between lanes is a loop over the lanes, and both sides of every branch
+// run under lane masks, so reads in the per-sub-triangle loop were most of clip_write's time.
 struct Parent {
   uint id;      // the mesh's triangle id
   uint local;   // its entry in the bound per-parent sections (ClipParams.range.w)
   uvec4 verts, welds;
   real3 V[3], N[3];
+  real3 b[10];  // the PN control points, in the linear index order
+  real3 n[6];   // the PN normal control points
 };
 
 Parent loadParent(uint id) {
@@ -113,8 +114,19 @@ Parent loadParent(uint id) {
     p.V[c] = positions(p.verts[c]).xyz;
     p.N[c] = normals(p.verts[c]).xyz;
   }
+  uint base = SFFD_PN_STRIDE * p.local;
+  for (uint i = 0u; i < 10u; ++i) p.b[i] = pn(base + i).xyz;
+  for (uint i = 0u; i < 6u; ++i) p.n[i] = pn(base + SFFD_PN_NORMALS + i).xyz;
   return p;
 }
+
+// The edge control point of slot s and the normal control point of edge e (1, 4, 2), picked from the
+// registers by selects.
+real3 slotCp(Parent p, uint s) {
+  uint i = kSlotCp(s);
+  return i == 1u ? p.b[1] : (i == 2u ? p.b[2] : (i == 3u ? p.b[3] : (i == 5u ? p.b[5] : (i == 7u ? p.b[7] : p.b[8]))));
+}
+real3 edgeNormalCp(Parent p, uint e) { return e == 0u ? p.n[1] : (e == 1u ? p.n[4] : p.n[2]); }
 
 // Corner c's position and normal, and the unit barycentric of corner c: selects, not a local array
 // indexed by a variable (kept in memory on lavapipe, and much code to generate on Mesa 25.0).
@@ -137,7 +149,6 @@ uint slotOf(uint corner, uint e) { return corner == e ? 2u * corner + 1u : 2u * 
 
 SiteValue evaluateSite(Parent p, Site s) {
   SiteValue r;
-  uint base = SFFD_PN_STRIDE * p.local;
   if (s.kind < 3u) {
     uint k = s.kind;
     r.lam = real3(k == 0u ? real(1) : real(0), k == 1u ? real(1) : real(0), k == 2u ? real(1) : real(0));
@@ -151,13 +162,12 @@ SiteValue evaluateSite(Parent p, Site s) {
     P real t = s.t;
     P real u = real(1) - t;
     r.lam = twoCornerLam(lo, u, hi, t);
-    real3 bLo = pn(base + kSlotCp(slotOf(lo, e))).xyz, bHi = pn(base + kSlotCp(slotOf(hi, e))).xyz;
     real3 vLo = parentV(p, lo), vHi = parentV(p, hi), nLo = parentN(p, lo), nHi = parentN(p, hi);
-    r.xpn = pnEdgeCurve(vLo, bLo, bHi, vHi, t);
+    r.xpn = pnEdgeCurve(vLo, slotCp(p, slotOf(lo, e)), slotCp(p, slotOf(hi, e)), vHi, t);
     P real3 xf = vLo + (vHi - vLo) * t;
     r.xflat = xf;
     r.nlin = snormalize(nLo * u + nHi * t);
-    r.npn = pnEdgeNormalCurve(nLo, pn(base + SFFD_PN_NORMALS + kEdgeNormalCp(e)).xyz, nHi, t);
+    r.npn = pnEdgeNormalCurve(nLo, edgeNormalCp(p, e), nHi, t);
   } else {
     P real3 l = s.lam;
     r.lam = l;
@@ -165,10 +175,8 @@ SiteValue evaluateSite(Parent p, Site s) {
     pnCubicWeights(l, w);
     // Sums written out in the loops' order: on Mesa 25.0 this branch took most of clip_write's 13 to
     // 17 s of machine-code generation at its first dispatch with the loops, about half that without.
-    P real3 x = (((((((((real3(0) + pn(base).xyz * w[0]) + pn(base + 1u).xyz * w[1]) + pn(base + 2u).xyz * w[2]) +
-                      pn(base + 3u).xyz * w[3]) + pn(base + 4u).xyz * w[4]) + pn(base + 5u).xyz * w[5]) +
-                   pn(base + 6u).xyz * w[6]) + pn(base + 7u).xyz * w[7]) + pn(base + 8u).xyz * w[8]) +
-                pn(base + 9u).xyz * w[9];
+    P real3 x = (((((((((real3(0) + p.b[0] * w[0]) + p.b[1] * w[1]) + p.b[2] * w[2]) + p.b[3] * w[3]) + p.b[4] * w[4]) +
+                   p.b[5] * w[5]) + p.b[6] * w[6]) + p.b[7] * w[7]) + p.b[8] * w[8]) + p.b[9] * w[9];
     r.xpn = x;
     P real3 xf = (p.V[0] * l.x + p.V[1] * l.y) + p.V[2] * l.z;
     r.xflat = xf;
@@ -176,70 +184,106 @@ SiteValue evaluateSite(Parent p, Site s) {
     r.nlin = snormalize(nl);
     real q[6];
     pnQuadraticWeights(l, q);
-    uint nb = base + SFFD_PN_NORMALS;
-    P real3 nn = (((((real3(0) + pn(nb).xyz * q[0]) + pn(nb + 1u).xyz * q[1]) + pn(nb + 2u).xyz * q[2]) +
-                   pn(nb + 3u).xyz * q[3]) + pn(nb + 4u).xyz * q[4]) + pn(nb + 5u).xyz * q[5];
+    P real3 nn = (((((real3(0) + p.n[0] * q[0]) + p.n[1] * q[1]) + p.n[2] * q[2]) + p.n[3] * q[3]) + p.n[4] * q[4]) + p.n[5] * q[5];
     r.npn = snormalize(nn);
   }
   return r;
 }
 
 // Parameter of a site along parent edge e (the site lies on it), from the edge's lower-weld endpoint.
-real siteParamOnEdge(Parent p, Site s, uint e) {
+real siteParamOnEdge(Parent p, uint kind, real t, uint e) {
   uint lo, hi;
   edgeEnds(p, e, lo, hi);
-  if (s.kind < 3u) return s.kind == lo ? real(0) : real(1);
-  return s.t;
+  return kind < 3u ? (kind == lo ? real(0) : real(1)) : t;
 }
 
-// The neighbouring triangle's PN normal at a point of parent edge e, and whether the edge is a crease
-// there (w = 1). Its normals at the edge's ends are in this triangle's slot records.
-real4 neighbourNormalOnEdge(Parent p, uint e, real t) {
-  uint lo, hi;
+// The neighbouring triangle's PN normal along one parent edge, where the edge is a crease: its normals
+// at the edge's ends are in this triangle's slot records.
+struct EdgeNeighbour {
+  bool crease;
+  uint e;                 // the parent edge
+  real3 nLo, nMid, nHi;   // the neighbour's quadratic normal curve, from the edge's lower-weld end
+};
+
+EdgeNeighbour edgeNeighbour(Parent p, real pe) {
+  EdgeNeighbour r;
+  r.crease = false;
+  r.e = 0u;
+  r.nLo = r.nMid = r.nHi = real3(0);
+  if (pe < real(0)) return r;   // the clip edge is not on a parent edge
+  uint e = uint(pe), lo, hi;
   edgeEnds(p, e, lo, hi);
   uint sLo = SFFD_SLOT_NORMAL_STRIDE * p.local + 2u * slotOf(lo, e);
   uint sHi = SFFD_SLOT_NORMAL_STRIDE * p.local + 2u * slotOf(hi, e);
   real4 fLo = slotNormals(sLo), gLo = slotNormals(sLo + 1u);
   real4 fHi = slotNormals(sHi), gHi = slotNormals(sHi + 1u);
-  if (fLo.w < real(0.5) && fHi.w < real(0.5)) return real4(0);
-  real3 nLo = gLo.w > real(0.5) ? gLo.xyz : fLo.xyz;   // the one that is not this triangle's own
-  real3 nHi = gHi.w > real(0.5) ? gHi.xyz : fHi.xyz;
-  // At the edge's ends the neighbour's normal is its vertex normal itself, bit for bit, as the
-  // neighbour's own records hold it there.
-  if (t == real(0)) return real4(nLo, 1);
-  if (t == real(1)) return real4(nHi, 1);
-  real3 nMid = pnEdgeNormal(parentV(p, lo), parentV(p, hi), nLo, nHi);
-  return real4(pnEdgeNormalCurve(nLo, nMid, nHi, t), 1);
+  r.e = e;
+  r.crease = !(fLo.w < real(0.5) && fHi.w < real(0.5));
+  r.nLo = gLo.w > real(0.5) ? gLo.xyz : fLo.xyz;   // the one that is not this triangle's own
+  r.nHi = gHi.w > real(0.5) ? gHi.xyz : fHi.xyz;
+  r.nMid = pnEdgeNormal(parentV(p, lo), parentV(p, hi), r.nLo, r.nHi);
+  return r;
 }
 
+// The neighbour's normal at parameter t of the edge. At the edge's ends it is its vertex normal itself,
+// bit for bit, as the neighbour's own records hold it there.
+real3 neighbourNormalAt(EdgeNeighbour n, real t) {
+  if (t == real(0)) return n.nLo;
+  if (t == real(1)) return n.nHi;
+  return pnEdgeNormalCurve(n.nLo, n.nMid, n.nHi, t);
+}
+
+// A clip triangle's corners and edges, read once (as Parent): per corner its barycentrics in the
+// parent (w: the parameter t on a parent edge) and site kind, per clip edge the parent edge it lies on
+// (x, -1 if none) and the parameters of its ends there (y, z).
+struct ClipTriangle {
+  uint parent, kinds;
+  uvec4 welds;
+  real4 lam[3], edgeParams[3];
+};
+
+ClipTriangle loadClipTriangle(uint ct) {
+  ClipTriangle T;
+  uvec4 h = clipHeaders(SFFD_CLIP_HEADER_STRIDE * ct);
+  T.parent = h.x;
+  T.kinds = h.y;
+  T.welds = clipHeaders(SFFD_CLIP_HEADER_STRIDE * ct + 1u);
+  uint base = SFFD_CLIP_REAL_STRIDE * ct;
+  for (uint c = 0u; c < 3u; ++c) {
+    T.lam[c] = clipReals(base + c);
+    T.edgeParams[c] = clipReals(base + 6u + c);
+  }
+  return T;
+}
+
+real4 cornerLam(ClipTriangle T, uint c) { return c == 0u ? T.lam[0] : (c == 1u ? T.lam[1] : T.lam[2]); }
+real4 clipEdgeParams(ClipTriangle T, uint e) { return e == 0u ? T.edgeParams[0] : (e == 1u ? T.edgeParams[1] : T.edgeParams[2]); }
+
 // Site of a corner of the clip triangle.
-Site clipCornerSite(uint ct, uint c) {
-  uint kinds = clipHeaders(SFFD_CLIP_HEADER_STRIDE * ct).y;
+Site clipCornerSite(ClipTriangle T, uint c) {
   Site s;
-  s.kind = (kinds >> (8u * c)) & 255u;
-  real4 l = clipReals(SFFD_CLIP_REAL_STRIDE * ct + c);
+  s.kind = (T.kinds >> (8u * c)) & 255u;
+  real4 l = cornerLam(T, c);
   s.lam = l.xyz;
   s.t = l.w;
   return s;
 }
 
 // Site of a pattern vertex of the clip triangle. `edge`/`step` come from the table.
-Site patternSite(uint ct, ClipSetup S, uint edge, uint step, real3 lamCanon) {
-  if (edge < 3u && step == 0u) return clipCornerSite(ct, S.perm[edge]);
+Site patternSite(ClipTriangle T, ClipSetup S, uint edge, uint step, real3 lamCanon) {
+  if (edge < 3u && step == 0u) return clipCornerSite(T, S.perm[edge]);
   real3 lamLocal;
   lamLocal[S.perm[0]] = lamCanon.x;
   lamLocal[S.perm[1]] = lamCanon.y;
   lamLocal[S.perm[2]] = lamCanon.z;
-  uint base = SFFD_CLIP_REAL_STRIDE * ct;
   if (edge < 3u) {
     // On clip edge between local corners a and b: the parameter from the lower-weld end is that
     // end's partner's weight, bit-identical from both sides (the table's symmetric pairs).
     uint a = S.perm[edge], b = S.perm[(edge + 1u) % 3u];
-    uvec4 welds = clipHeaders(SFFD_CLIP_HEADER_STRIDE * ct + 1u);
-    uint lo = welds[a] <= welds[b] ? a : b, hi = lo == a ? b : a;
+    uint lo = T.welds[a] <= T.welds[b] ? a : b, hi = lo == a ? b : a;
     P real tl = lamLocal[hi];
     uint ce = (b == (a + 1u) % 3u) ? a : b;   // local clip edge index (corner ce -> ce+1)
-    real4 ep = clipReals(base + 6u + ce);
+    real4 ep = clipEdgeParams(T, ce);
     Site s;
     if (ep.x >= real(0)) {
       real tLo = lo == ce ? ep.y : ep.z, tHi = lo == ce ? ep.z : ep.y;
@@ -248,7 +292,7 @@ Site patternSite(uint ct, ClipSetup S, uint edge, uint step, real3 lamCanon) {
       s.t = tt;
       s.lam = real3(0);
     } else {
-      real3 lamLo = clipReals(base + lo).xyz, lamHi = clipReals(base + hi).xyz;
+      real3 lamLo = cornerLam(T, lo).xyz, lamHi = cornerLam(T, hi).xyz;
       s.kind = 6u;
       s.t = real(0);
       P real3 lm = lamLo + (lamHi - lamLo) * tl;
@@ -259,7 +303,7 @@ Site patternSite(uint ct, ClipSetup S, uint edge, uint step, real3 lamCanon) {
   Site s;
   s.kind = 6u;
   s.t = real(0);
-  P real3 lm = (clipReals(base).xyz * lamLocal.x + clipReals(base + 1u).xyz * lamLocal.y) + clipReals(base + 2u).xyz * lamLocal.z;
+  P real3 lm = (T.lam[0].xyz * lamLocal.x + T.lam[1].xyz * lamLocal.y) + T.lam[2].xyz * lamLocal.z;
   s.lam = lm;
   return s;
 }

@@ -7,6 +7,11 @@
 #ifndef SFFD_PN_GLSL
 #define SFFD_PN_GLSL
 
+// Control point of corner slot s (2, 1, 3, 7, 8, 5; kSlotControlPoint in pn_eval.h) as 4-bit fields of
+// a constant: a constant array indexed by a variable is copied into local memory at every use in the
+// SPIR-V that glslang emits, which made the Vulkan kernels several times slower than GL on lavapipe.
+uint kSlotCp(uint s) { return (0x587312u >> (4u * s)) & 15u; }
+
 // Edge control point next to corner Vc on the edge towards Vo (METHOD.md 3.2). nFirst.w = 1 marks
 // a crease: the point is projected onto the crease line t = normalize(nFirst x nSecond).
 real3 pnEdgePoint(real3 Vc, real3 Vo, real4 nFirst, real3 nSecond) {

@@ -40,10 +40,7 @@ layout(std430, SFFD_SET binding = SFFD_BINDING_DEFORM_OUT) SFFD_DEFORM_OUT_ACCES
 #define patches(i) deformOut[params.sections.z + (i)]
 #define samples(i) deformOut[params.sections.w + (i)]
 
-// Control point of corner slot s (2, 1, 3, 7, 8, 5) and of corner c (0, 6, 9), as 4-bit fields of a
-// constant: a constant array indexed by a variable is copied into local memory at every use in the
-// SPIR-V that glslang emits, which made the Vulkan kernels several times slower than GL on lavapipe.
-uint kSlotCp(uint s) { return (0x587312u >> (4u * s)) & 15u; }
+// Control point of corner c (0, 6, 9); kSlotCp (pn_eval.glsl) gives a slot's.
 uint kCornerCp(uint c) { return (0x960u >> (4u * c)) & 15u; }
 
 // a before b in the lexicographic order of their coordinates (a total order both patches agree on).
