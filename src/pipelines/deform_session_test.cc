@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <random>
 #include <sstream>
+#include <tuple>
 
 #include "backends/backend_select.h"
 #include "backends/backend_test_support.h"
@@ -174,6 +175,84 @@ TEST_P(DeformSessionTest, LatticeTooLargeToInlineGivesTheSameOutput) {
   DeformSession s(*b.backend, m, big, o);
   s.deform(big);
   EXPECT_EQ(s.output().tess, reference(m, big, o).out.tess);
+  EXPECT_EQ(vk::validationMessageCount(), 0u);
+}
+
+// A backend that forwards to another, with its kernels compiled to assume nothing about the lattice
+// (KernelVariant::assumptions = 0: the run-time branches of lattice_eval.glsl and smooth_deform.glsl,
+// the path of a caller that states nothing) and, optionally, a smaller storage binding.
+class ForwardingBackend final : public Backend {
+ public:
+  ForwardingBackend(Backend& to, uint64_t maxStorageBufferRange = 0) : to_(to), info_(to.info()) {
+    if (maxStorageBufferRange) info_.limits.maxStorageBufferRange = maxStorageBufferRange;
+  }
+  const DeviceInfo& info() const override { return info_; }
+  BufferId createBuffer(uint64_t bytes) override { return to_.createBuffer(bytes); }
+  void destroyBuffer(BufferId b) override { to_.destroyBuffer(b); }
+  void upload(BufferId b, uint64_t offset, const void* data, uint64_t bytes) override { to_.upload(b, offset, data, bytes); }
+  void download(BufferId b, uint64_t offset, void* data, uint64_t bytes) override { to_.download(b, offset, data, bytes); }
+  void dispatch(const Dispatch& d) override {
+    Dispatch plain = d;
+    assumed |= d.variant.assumptions;
+    plain.variant.assumptions = 0;
+    to_.dispatch(plain);
+  }
+  void barrier() override { to_.barrier(); }
+  void finish() override { to_.finish(); }
+  std::vector<DispatchTiming> takeTimings() override { return to_.takeTimings(); }
+  uint32_t assumed = 0;   // the assumptions the session asked for, taken away
+
+ private:
+  Backend& to_;
+  DeviceInfo info_;
+};
+
+// Kernels compiled with no assumptions give the bits of those compiled for their lattice: degree 2
+// inline, degree 3, a lattice read from the storage buffers, the split kernels.
+TEST_P(DeformSessionTest, KernelsWithoutLatticeAssumptionsGiveTheSameBits) {
+  OpenedBackend b = open();
+  ForwardingBackend plain(*b.backend);
+  Mesh m = readMesh(std::string(SFFD_TEST_DATA) + "/sphere.obj");
+  glm::dvec3 lo(1e300), hi(-1e300);
+  for (const glm::dvec3& p : m.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
+  for (auto [counts, degree, split] : {std::tuple{5, 2, false}, std::tuple{6, 3, true}, std::tuple{12, 2, false}}) {
+    SCOPED_TRACE(std::to_string(counts) + "^3 of degree " + std::to_string(degree) + (split ? ", split" : ""));
+    Lattice L = makeIdentityLattice(lo - 0.01, hi + 0.01, {counts, counts, counts}, {degree, degree, degree});
+    std::mt19937 rng(counts);
+    std::uniform_real_distribution<double> u(-0.05, 0.05);
+    for (auto& p : L.controlPoints) p += glm::dvec3(u(rng), u(rng), u(rng));
+    DeformSessionOptions o;
+    o.variant = {true, false};
+    o.edgeLength = 0.3;
+    o.level = 2;
+    o.split = split;
+    DeformSession assumed(*b.backend, m, L, o), none(plain, m, L, o);
+    assumed.deform(L);
+    none.deform(L);
+    EXPECT_NE(plain.assumed, 0u) << "the deform kernels should state their assumptions";
+    SmoothOutput a = assumed.output(), n = none.output();
+    EXPECT_EQ(n.tess, a.tess);
+    EXPECT_EQ(n.patches, a.patches);
+  }
+  EXPECT_EQ(vk::validationMessageCount(), 0u);
+}
+
+// A device whose storage binding cannot hold the job's vertices and one triangle's pre-compute inputs:
+// an input error that says so.
+TEST_P(DeformSessionTest, RefusesVerticesBeyondOneStorageBinding) {
+  OpenedBackend b = open();
+  ForwardingBackend small(*b.backend, 4096);
+  Mesh m = readMesh(std::string(SFFD_TEST_DATA) + "/sphere.obj");
+  Lattice A = latticeFor(m, 1, 0.1);
+  DeformSessionOptions o;
+  o.edgeLength = 0.3;
+  try {
+    DeformSession s(small, m, A, o);
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Input);
+    EXPECT_NE(std::string(e.what()).find("exceed one storage binding"), std::string::npos) << e.what();
+  }
   EXPECT_EQ(vk::validationMessageCount(), 0u);
 }
 
