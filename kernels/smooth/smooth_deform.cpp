@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
-#include <span>
 
 #include <sffd/error.h>
 #include "kernels/pn/pn_eval.h"
@@ -105,33 +104,14 @@ uint64_t deformOutSections(gpu::DeformParams& params, uint64_t count, int level,
   return split ? samples + (SFFD_SAMPLE_FIXED + uint64_t(fitPoints)) * count : samples;
 }
 
-namespace {
-
-struct DeformStep {
-  const char* kernel;
-  const char* label;
-};
-constexpr DeformStep kFused[] = {{"deform_smooth", "deform"}};
-constexpr DeformStep kSplit[] = {{"deform_step_sample", "deform.sample"},
-                                 {"deform_step_fit", "deform.fit"},
-                                 {"deform_step_adjust", "deform.adjust"},
-                                 {"deform_step_tessellate", "deform.tessellate"}};
-
-std::span<const DeformStep> deformSteps(bool split) {
-  if (split) return kSplit;
-  return kFused;
-}
-
-}  // namespace
-
 void dispatchDeform(Backend& backend, const gpu::DeformParams& params, const DeformBuffers& b, size_t count,
                     KernelVariant variant, bool split) {
   const std::vector<BufferBinding> buffers = {{SFFD_BINDING_LATTICE_COEFFS, b.coeffs}, {SFFD_BINDING_LATTICE_FRAME, b.frame},
                                               {SFFD_BINDING_DEFORM_SUB_RECORDS, b.records}, {SFFD_BINDING_DEFORM_OUT, b.out}};
-  for (const DeformStep& step : deformSteps(split)) {
+  auto dispatch = [&](const char* kernel, const char* label) {
     Dispatch d;
-    d.kernel = step.kernel;
-    d.label = step.label;
+    d.kernel = kernel;
+    d.label = label;
     d.variant = forLattice(variant, params);
     d.params = &params;
     d.paramsSize = sizeof(params);
@@ -139,11 +119,15 @@ void dispatchDeform(Backend& backend, const gpu::DeformParams& params, const Def
     gridFor(count, backend.info().limits, d.groups);
     backend.dispatch(d);
     backend.barrier();
+  };
+  if (split) {
+    dispatch("deform_step_sample", "deform.sample");
+    dispatch("deform_step_fit", "deform.fit");
+    dispatch("deform_step_adjust", "deform.adjust");
+    dispatch("deform_step_tessellate", "deform.tessellate");
+  } else {
+    dispatch("deform_smooth", "deform");
   }
-}
-
-void compileDeformAhead(Backend& backend, const gpu::DeformParams& params, KernelVariant variant, bool split) {
-  for (const DeformStep& step : deformSteps(split)) backend.compileAhead(step.kernel, forLattice(variant, params));
 }
 
 namespace {

@@ -50,8 +50,6 @@ struct DeformBuffers {
 uint64_t deformOutSections(gpu::DeformParams& params, uint64_t count, int level, int fitPoints, bool split);
 void dispatchDeform(Backend& backend, const gpu::DeformParams& params, const DeformBuffers& buffers, size_t count,
                     KernelVariant variant, bool split);
-// Backend::compileAhead of the kernels dispatchDeform will dispatch with these parameters.
-void compileDeformAhead(Backend& backend, const gpu::DeformParams& params, KernelVariant variant, bool split);
 
 // What the patch vertices need of the sub-triangle records: each one's parent and its corners'
 // barycentrics there (76 bytes a sub-triangle instead of the records' 688).

@@ -259,21 +259,6 @@ TEST_P(BackendContract, ClassicIdentityInEveryVariant) {
   EXPECT_TRUE(b.takeTimings().empty());
 }
 
-// compileAhead is a hint: it never throws (an unknown kernel, f64 on a device without it: the dispatch
-// reports those), a variant compiled ahead runs as one compiled at its dispatch, and one compiled
-// ahead but never dispatched is cleaned up with the backend.
-TEST_P(BackendContract, CompileAheadIsOnlyAHint) {
-  Backend& b = backend();
-  b.compileAhead("no_such_kernel", {});
-  b.compileAhead("classic_ffd", {false, true});
-  b.compileAhead("classic_ffd", {});
-  b.compileAhead("classic_ffd", {});   // twice: once is enough
-  b.compileAhead("classic_ffd", {true, false, 1});   // never dispatched
-  ClassicJob<float> job(b, 300, 250);
-  job.dispatch({}, 0, 300, job.vertIn, job.vertOut);
-  job.expectIdentity(0, 300, 250, 1e-6);
-}
-
 // Ranges in the middle of one larger buffer, at aligned offsets; bad dispatches are internal errors.
 TEST_P(BackendContract, BindsRangesAtAlignedOffsetsAndRefusesBadDispatches) {
   Backend& b = backend();

@@ -64,13 +64,6 @@ class Backend {
 
   // Records (or issues) one dispatch; compiles the kernel variant on first use.
   virtual void dispatch(const Dispatch& d) = 0;
-  // A hint that the kernel variant will be dispatched soon: a backend that can compile it on another
-  // thread (Vulkan) starts now, so that the compile overlaps the caller's host work; the others do
-  // nothing. Never throws: what is wrong with the kernel or variant is reported by its dispatch.
-  virtual void compileAhead(std::string_view kernel, KernelVariant variant) {
-    (void)kernel;
-    (void)variant;
-  }
   // Makes the writes of earlier dispatches visible to later dispatches and transfers.
   virtual void barrier() = 0;
   // Submits everything recorded and waits for it.

@@ -55,11 +55,6 @@ struct DeformSession::Impl {
 
 namespace {
 
-// The pre-compute's kernels.
-constexpr const char* kPnKernel = "pn_triangles";
-constexpr const char* kClipCountKernel = "clip_count";
-constexpr const char* kClipWriteKernel = "clip_write";
-
 // The pre-compute's chunks: consecutive parents (and their clip triangles, which follow the parents'
 // order), as many to a chunk as keep both of its input ranges within one storage binding.
 std::vector<ClipRanges> preChunks(const PreparedMesh& mesh, const ClipTriangles& clip, size_t realSize, uint64_t limit,
@@ -116,22 +111,13 @@ void DeformSession::prepare(const Mesh& input, const Lattice& lattice, const Sta
   const bool f64 = options.variant.f64;
   I.realSize = f64 ? 8 : 4;
   I.structure = lattice;
-  int s = options.samples > 0 ? options.samples : lattice.degree[0] + lattice.degree[1] + lattice.degree[2];
-  I.fit = makeFitTable(std::max(3, s));
-  PackedLattice packed = packLattice(lattice);
-  // Every kernel of the session is known now: the backend may compile them while the host prepares the
-  // mesh. The deform kernels first: they take longest to compile and are needed last (the pre-compute's,
-  // if still queued when dispatched, are compiled by this thread meanwhile).
-  compileDeformAhead(backend, deformParamsFor(packed, f64, &I.fit.data), options.variant, options.split);
-  if (!options.knotBoxClip)
-    for (const char* kernel : {kPnKernel, kClipCountKernel, kClipWriteKernel}) backend.compileAhead(kernel, options.variant);
-  else
-    backend.compileAhead(kPnKernel, options.variant);
   Mesh mesh = input;
   if (!mesh.normalsFromFile) applyCreaseAngle(mesh, options.creaseAngleDeg);
   I.mesh = prepareMesh(mesh);
   if (options.knotBoxClip) I.knotBoxSubs = clipAgainstKnotBoxes(mesh, lattice);
   else I.clip = buildClipTriangles(mesh, options.edgeLength, splitPatternTable().nmax());
+  int s = options.samples > 0 ? options.samples : lattice.degree[0] + lattice.degree[1] + lattice.degree[2];
+  I.fit = makeFitTable(std::max(3, s));
 
   auto up = [&](const std::vector<double>& v) {
     std::vector<unsigned char> b = realBytes(v, f64);
@@ -153,6 +139,7 @@ void DeformSession::prepare(const Mesh& input, const Lattice& lattice, const Sta
   I.clipCount = I.clip.triangles.size();
   I.clip = {};
   if (!options.knotBoxClip) I.mesh = {};
+  PackedLattice packed = packLattice(lattice);
   I.frame = up(deformFrameRange(packed, I.fit.data));
   I.coeffs = up(packed.coeffs);
   precompute(progress);
@@ -221,7 +208,7 @@ const SessionTimings& DeformSession::precompute(const StageProgress& progress) {
     if (!R.parents) continue;
     gpu::PnParams params;
     params.range = {0, uint32_t(R.parents), uint32_t(R.normals), 0};
-    dispatch(kPnKernel, "pn", &params, sizeof(params), R.parents,
+    dispatch("pn_triangles", "pn", &params, sizeof(params), R.parents,
              {{SFFD_BINDING_MESH_VERTICES, c.reals, 0, R.byteOf(R.slotNormals)},
               {SFFD_BINDING_MESH_TRIANGLES, c.words, R.triangles * 4, R.parents * 4 * SFFD_MESH_TRIANGLE_STRIDE * 4},
               {SFFD_BINDING_MESH_SLOT_NORMALS, c.reals, R.byteOf(R.slotNormals), R.byteOf(R.pn - R.slotNormals)},
@@ -248,7 +235,7 @@ const SessionTimings& DeformSession::precompute(const StageProgress& progress) {
     for (const Impl::PreChunk& c : I.pre) {
       if (!c.ranges.clips) continue;
       gpu::ClipParams params = clipParams(c.ranges, 0, c.ranges.clips);
-      dispatch(kClipCountKernel, "clip_count", &params, sizeof(params), c.ranges.clips, clipBindings(c, {}));
+      dispatch("clip_count", "clip_count", &params, sizeof(params), c.ranges.clips, clipBindings(c, {}));
       B.download(c.words, c.ranges.counts * 4, &counts[c.ranges.firstClip], c.ranges.clips * 4);
     }
     offsets.assign(clipN + 1, 0);
@@ -325,7 +312,7 @@ const SessionTimings& DeformSession::precompute(const StageProgress& progress) {
       for (size_t i = first; i < last; ++i) chunkOffsets[i] = uint32_t(offsets[i] - offsets[first]);
       B.upload(in.words, (in.ranges.counts + local) * 4, chunkOffsets.data() + first, (last - first) * 4);
       gpu::ClipParams params = clipParams(in.ranges, local, last - first);
-      dispatch(kClipWriteKernel, "clip_write", &params, sizeof(params), last - first,
+      dispatch("clip_write", "clip_write", &params, sizeof(params), last - first,
                clipBindings(in, {{SFFD_BINDING_SUB_HEADERS, cb.headers}, {SFFD_BINDING_SUB_RECORDS, cb.records}}));
     } else if (subs) {
       B.upload(cb.headers, 0, &knotRecords.headers[4 * c.first], subs * 16);

@@ -230,8 +230,6 @@ class VulkanBackend final : public Backend {
     recorder_.endDispatch();
   }
 
-  void compileAhead(std::string_view kernel, KernelVariant variant) override { kernels_.compileAhead(kernel, variant); }
-
   void barrier() override {
     // With nothing recorded, all earlier work has completed and is visible already.
     if (!recorder_.active()) return;

@@ -1,7 +1,5 @@
 #include "backends/vulkan/vk_kernels.h"
 
-#include <system_error>
-
 #include <sffd/error.h>
 #include "core/kernel_registry.h"
 #include "kernels/common/shader_layout.h"
@@ -43,20 +41,6 @@ Kernels::~Kernels() { destroy(); }
 void Kernels::destroy() {
   const Api& api = device_.api();
   VkDevice dev = device_.handle();
-  // The compileAhead thread finishes the pipeline it is creating, then stops; what it created and
-  // nobody used goes with the rest.
-  if (thread_.joinable()) {
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      stopping_ = true;
-      queue_.clear();
-    }
-    changed_.notify_all();
-    thread_.join();
-  }
-  for (auto& [key, a] : ahead_)
-    if (a.done && a.pipeline) api.vkDestroyPipeline(dev, a.pipeline, nullptr);
-  ahead_.clear();
   for (auto& [key, pipeline] : pipelines_) api.vkDestroyPipeline(dev, pipeline, nullptr);
   pipelines_.clear();
   if (cache_) api.vkDestroyPipelineCache(dev, cache_, nullptr);
@@ -67,12 +51,11 @@ void Kernels::destroy() {
   setLayout_ = VK_NULL_HANDLE;
 }
 
-Kernels::Key Kernels::keyOf(std::string_view kernel, KernelVariant variant) {
-  return {std::string(kernel), variantKey(variant)};
-}
-
-const EmbeddedKernel& Kernels::checked(std::string_view kernel, KernelVariant variant) const {
+VkPipeline Kernels::pipeline(std::string_view kernel, KernelVariant variant) {
   const int v = variantIndex(variant);
+  auto key = std::make_pair(std::string(kernel), variantKey(variant));
+  if (auto it = pipelines_.find(key); it != pipelines_.end()) return it->second;
+
   const EmbeddedKernel* k = findKernel(kernel);
   if (!k) throw Error(ErrorKind::Internal, "unknown kernel '" + std::string(kernel) + "'");
   if (variant.f64 && !device_.info().limits.float64)
@@ -80,93 +63,13 @@ const EmbeddedKernel& Kernels::checked(std::string_view kernel, KernelVariant va
                       " has no 64-bit floating point in shaders (shaderFloat64); double precision needs another device.");
   if (!k->spirv[v] || k->spirvWords[v] == 0)
     throw Error(ErrorKind::Internal, "kernel '" + std::string(kernel) + "' has no SPIR-V for variant " + std::to_string(v));
-  return *k;
-}
 
-VkPipeline Kernels::pipeline(std::string_view kernel, KernelVariant variant) {
-  Key key = keyOf(kernel, variant);
-  if (auto it = pipelines_.find(key); it != pipelines_.end()) return it->second;
-  std::unique_lock<std::mutex> lock(mutex_);
-  auto it = ahead_.find(key);
-  VkPipeline pipeline = VK_NULL_HANDLE;
-  if (it != ahead_.end() && it->second.started) {
-    changed_.wait(lock, [&] { return it->second.done; });
-    Ahead done = std::move(it->second);
-    ahead_.erase(it);
-    lock.unlock();
-    if (done.error) std::rethrow_exception(done.error);
-    pipeline = done.pipeline;
-  } else {
-    if (it != ahead_.end()) ahead_.erase(it);   // not begun: created here rather than waited for
-    lock.unlock();
-    pipeline = create(checked(kernel, variant), variant);
-  }
-  pipelines_.emplace(std::move(key), pipeline);
-  return pipeline;
-}
-
-void Kernels::compileAhead(std::string_view kernel, KernelVariant variant) {
-  Key key = keyOf(kernel, variant);
-  if (pipelines_.count(key)) return;
-  const EmbeddedKernel* k = nullptr;
-  try {
-    k = &checked(kernel, variant);
-  } catch (const Error&) {
-    return;   // the dispatch reports it
-  }
-  std::lock_guard<std::mutex> lock(mutex_);
-  if (ahead_.count(key)) return;
-  if (!thread_.joinable()) {
-    try {
-      thread_ = std::thread([this] { createAhead(); });
-    } catch (const std::system_error&) {
-      return;   // no thread to spare: the pipeline is created at its first dispatch
-    }
-  }
-  Ahead& a = ahead_[key];
-  a.kernel = k;
-  a.variant = variant;
-  queue_.push_back(std::move(key));
-  changed_.notify_all();
-}
-
-void Kernels::createAhead() {
-  std::unique_lock<std::mutex> lock(mutex_);
-  for (;;) {
-    changed_.wait(lock, [&] { return stopping_ || !queue_.empty(); });
-    if (stopping_) return;
-    Key key = std::move(queue_.front());
-    queue_.pop_front();
-    auto it = ahead_.find(key);
-    if (it == ahead_.end() || it->second.started) continue;   // taken over by pipeline()
-    Ahead& a = it->second;   // stays put: only pipeline() erases a started entry, after it is done
-    a.started = true;
-    lock.unlock();
-    VkPipeline pipeline = VK_NULL_HANDLE;
-    std::exception_ptr error;
-    try {
-      pipeline = create(*a.kernel, a.variant);
-    } catch (...) {
-      error = std::current_exception();
-    }
-    lock.lock();
-    a.pipeline = pipeline;
-    a.error = error;
-    a.done = true;
-    changed_.notify_all();
-  }
-}
-
-// Creates the variant's pipeline. Called on the backend's thread or on compileAhead's: it reads only
-// what the constructor set up, and Vulkan synchronizes pipeline caches internally.
-VkPipeline Kernels::create(const EmbeddedKernel& k, KernelVariant variant) const {
-  const int v = variantIndex(variant);
   const Api& api = device_.api();
   VkDevice dev = device_.handle();
-  CompileTrace trace("vulkan", k.name, variant);
+  CompileTrace trace("vulkan", kernel, variant);
   auto mi = vkStruct<VkShaderModuleCreateInfo>(VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO);
-  mi.codeSize = k.spirvWords[v] * sizeof(uint32_t);
-  mi.pCode = k.spirv[v];
+  mi.codeSize = k->spirvWords[v] * sizeof(uint32_t);
+  mi.pCode = k->spirv[v];
   VkShaderModule module = VK_NULL_HANDLE;
   check(api.vkCreateShaderModule(dev, &mi, nullptr, &module), "vkCreateShaderModule");
 
@@ -185,6 +88,7 @@ VkPipeline Kernels::create(const EmbeddedKernel& k, KernelVariant variant) const
   VkResult r = api.vkCreateComputePipelines(dev, cache_, 1, &ci, nullptr, &pipeline);
   api.vkDestroyShaderModule(dev, module, nullptr);   // the pipeline keeps what it needs
   check(r, "vkCreateComputePipelines");
+  pipelines_.emplace(std::move(key), pipeline);
   return pipeline;
 }
 
