@@ -11,6 +11,7 @@
 #include <sffd/error.h>
 #include "model/lattice_pack.h"
 #include "kernels/clip/split_pattern_table.h"
+#include "core/huge_pages.h"
 #include "core/wall_clock.h"
 
 namespace sffd {
@@ -159,6 +160,7 @@ const PackedTable& packedTable() {
     const SplitPatternTable& S = splitPatternTable();
     PackedTable t;
     t.nmax = uint32_t(S.nmax());
+    reserveHuge(t.words, 4 * S.patterns().size() + 4 * S.vertices().size() + (S.triangles().size() + 1) / 2);
     for (const SplitPattern& p : S.patterns())
       t.words.insert(t.words.end(), {p.firstVertex, p.vertexCount, p.firstTriangle, p.triangleCount});
     t.vertexWord = uint32_t(t.words.size());
@@ -210,7 +212,8 @@ void ClipRanges::name(gpu::ClipParams& p) const {
 template <class Real>
 std::vector<Real> clipRealRange(const ClipRanges& r, const PreparedMesh& mesh, const std::vector<double>* pnRecords,
                                 const PackedClip& clip) {
-  std::vector<Real> v(4 * r.realElements, Real(0));
+  std::vector<Real> v;
+  resizeHuge(v, 4 * r.realElements, Real(0));
   const std::vector<double> verts = meshVertexRange(mesh);
   std::copy(verts.begin(), verts.end(), v.begin());
   auto part = [&](const std::vector<double>& from, uint64_t stride, uint64_t at) {
@@ -225,7 +228,8 @@ template std::vector<float> clipRealRange<float>(const ClipRanges&, const Prepar
 template std::vector<double> clipRealRange<double>(const ClipRanges&, const PreparedMesh&, const std::vector<double>*, const PackedClip&);
 
 std::vector<uint32_t> clipWordRange(const ClipRanges& r, const PreparedMesh& mesh, const PackedClip& clip) {
-  std::vector<uint32_t> w(r.words, 0);
+  std::vector<uint32_t> w;
+  resizeHuge(w, r.words, 0u);
   const PackedTable& T = packedTable();
   std::copy(T.words.begin(), T.words.end(), w.begin());
   const uint64_t perParent = 4 * SFFD_MESH_TRIANGLE_STRIDE;
