@@ -9,7 +9,7 @@
 namespace sffd {
 
 // Asks the kernel for huge pages on the whole 2 MiB pages inside [data, data + bytes) (madvise
-// MADV_HUGEPAGE). Ranges under a few MiB are left alone; a no-op where the system has no such advice.
+// MADV_HUGEPAGE; a range without one is left alone). A no-op where the system has no such advice.
 void adviseHugePages(const void* data, size_t bytes);
 
 // Reserves room for `count` elements in `v` and advises huge pages on the reserved storage.
