@@ -90,8 +90,10 @@ ClipTriangles buildClipTriangles(const Mesh& mesh, double l, int nmax) {
   uint32_t nextWeld = 0;
   for (uint32_t w : mesh.weldId) nextWeld = std::max(nextWeld, w + 1);
   std::map<std::pair<uint32_t, uint32_t>, SplitPoint> splits;   // by the clip edge's weld pair
+  reserveHuge(out.triangles, mesh.triangles.size());   // at least one a parent: no growth copies below that
+  std::vector<ClipTriangle> work;                       // one parent's, reused
   for (uint32_t t = 0; t < mesh.triangles.size(); ++t) {
-    std::vector<ClipTriangle> work = {parentClipTriangle(mesh, t)};
+    work.assign(1, parentClipTriangle(mesh, t));
     bool split = false;
     for (size_t i = 0; i < work.size();) {
       ClipTriangle& c = work[i];
@@ -135,8 +137,8 @@ PackedClip packClip(const ClipTriangles& clip) { return packClip(clip, 0, clip.t
 PackedClip packClip(const ClipTriangles& clip, size_t first, size_t last) {
   PackedClip P;
   size_t n = last - first;
-  P.headers.assign(8 * n, 0);
-  P.reals.assign(4 * SFFD_CLIP_REAL_STRIDE * n, 0.0);
+  resizeHuge(P.headers, 8 * n, 0u);
+  resizeHuge(P.reals, 4 * SFFD_CLIP_REAL_STRIDE * n, 0.0);
   for (size_t i = 0; i < n; ++i) {
     const ClipTriangle& c = clip.triangles[first + i];
     uint32_t kinds = 0;
