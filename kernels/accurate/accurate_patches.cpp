@@ -293,7 +293,6 @@ template <class Real>
 void appendAccurate(const AccurateJob& job, size_t first, size_t count, const Real* positions, const Real* normals,
                     PatchVertices& pv) {
   const int L = pv.level, nv = tessVertexCount(L);
-  pv.reserve(job.count());
   for (size_t s = first; s < first + count; ++s) {
     const SubTriangle& T = job.subs[s];
     pv.parent.push_back(T.parent);
@@ -325,6 +324,7 @@ void appendAccuratePatchVertices(const AccurateJob& job, size_t first, size_t co
 PatchVertices accuratePatchVertices(const AccurateJob& job, const AccurateOutput& out) {
   PatchVertices pv;
   pv.level = job.level;
+  pv.reserve(job.count());
   appendAccurate(job, 0, job.count(), out.positions.data(), out.normals.data(), pv);
   return pv;
 }

@@ -106,8 +106,8 @@ void dispatchAccurateChunk(Backend& backend, const gpu::LatticeParams& lattice, 
 // Per patch its parent, per tessellation vertex its pre-image barycentrics in the parent
 // (sum_i lambda_i lam_i), its position and normal.
 PatchVertices accuratePatchVertices(const AccurateJob& job, const AccurateOutput& out);
-// The same, a chunk at a time: appends sub-triangles [first, first + count) to `patches` (level set,
-// sub-triangles before `first` appended), their positions and normals (x, y, z, w) a tessellation
+// The same, a chunk at a time: appends sub-triangles [first, first + count) to `patches` (level set, room
+// reserved by the caller: PatchVertices::reserve), their positions and normals (x, y, z, w) a tessellation
 // vertex as the device holds them, widened to double here.
 void appendAccuratePatchVertices(const AccurateJob& job, size_t first, size_t count, const float* positions,
                                  const float* normals, PatchVertices& patches);

@@ -11,6 +11,7 @@
 #include <sffd/error.h>
 #include "model/lattice_pack.h"
 #include "kernels/clip/split_pattern_table.h"
+#include "core/huge_pages.h"
 #include "core/wall_clock.h"
 
 namespace sffd {
@@ -89,8 +90,10 @@ ClipTriangles buildClipTriangles(const Mesh& mesh, double l, int nmax) {
   uint32_t nextWeld = 0;
   for (uint32_t w : mesh.weldId) nextWeld = std::max(nextWeld, w + 1);
   std::map<std::pair<uint32_t, uint32_t>, SplitPoint> splits;   // by the clip edge's weld pair
+  reserveHuge(out.triangles, mesh.triangles.size());   // at least one a parent: no growth copies below that
+  std::vector<ClipTriangle> work;                       // one parent's, reused
   for (uint32_t t = 0; t < mesh.triangles.size(); ++t) {
-    std::vector<ClipTriangle> work = {parentClipTriangle(mesh, t)};
+    work.assign(1, parentClipTriangle(mesh, t));
     bool split = false;
     for (size_t i = 0; i < work.size();) {
       ClipTriangle& c = work[i];
@@ -134,8 +137,8 @@ PackedClip packClip(const ClipTriangles& clip) { return packClip(clip, 0, clip.t
 PackedClip packClip(const ClipTriangles& clip, size_t first, size_t last) {
   PackedClip P;
   size_t n = last - first;
-  P.headers.assign(8 * n, 0);
-  P.reals.assign(4 * SFFD_CLIP_REAL_STRIDE * n, 0.0);
+  resizeHuge(P.headers, 8 * n, 0u);
+  resizeHuge(P.reals, 4 * SFFD_CLIP_REAL_STRIDE * n, 0.0);
   for (size_t i = 0; i < n; ++i) {
     const ClipTriangle& c = clip.triangles[first + i];
     uint32_t kinds = 0;
@@ -159,6 +162,7 @@ const PackedTable& packedTable() {
     const SplitPatternTable& S = splitPatternTable();
     PackedTable t;
     t.nmax = uint32_t(S.nmax());
+    reserveHuge(t.words, 4 * S.patterns().size() + 4 * S.vertices().size() + (S.triangles().size() + 1) / 2);
     for (const SplitPattern& p : S.patterns())
       t.words.insert(t.words.end(), {p.firstVertex, p.vertexCount, p.firstTriangle, p.triangleCount});
     t.vertexWord = uint32_t(t.words.size());
@@ -210,7 +214,8 @@ void ClipRanges::name(gpu::ClipParams& p) const {
 template <class Real>
 std::vector<Real> clipRealRange(const ClipRanges& r, const PreparedMesh& mesh, const std::vector<double>* pnRecords,
                                 const PackedClip& clip) {
-  std::vector<Real> v(4 * r.realElements, Real(0));
+  std::vector<Real> v;
+  resizeHuge(v, 4 * r.realElements, Real(0));
   const std::vector<double> verts = meshVertexRange(mesh);
   std::copy(verts.begin(), verts.end(), v.begin());
   auto part = [&](const std::vector<double>& from, uint64_t stride, uint64_t at) {
@@ -225,7 +230,8 @@ template std::vector<float> clipRealRange<float>(const ClipRanges&, const Prepar
 template std::vector<double> clipRealRange<double>(const ClipRanges&, const PreparedMesh&, const std::vector<double>*, const PackedClip&);
 
 std::vector<uint32_t> clipWordRange(const ClipRanges& r, const PreparedMesh& mesh, const PackedClip& clip) {
-  std::vector<uint32_t> w(r.words, 0);
+  std::vector<uint32_t> w;
+  resizeHuge(w, r.words, 0u);
   const PackedTable& T = packedTable();
   std::copy(T.words.begin(), T.words.end(), w.begin());
   const uint64_t perParent = 4 * SFFD_MESH_TRIANGLE_STRIDE;

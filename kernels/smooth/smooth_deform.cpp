@@ -134,7 +134,6 @@ namespace {
 template <class Real>
 void appendPatchVerticesOf(const SubTrianglePreImages& subs, size_t first, size_t count, const Real* tess, PatchVertices& P) {
   const int L = P.level, nv = tessVertexCount(L);
-  P.reserve(subs.size());
   for (size_t s = first; s < first + count; ++s) {
     P.parent.push_back(subs.parent[s]);
     glm::dvec3 lam[3];
@@ -170,6 +169,7 @@ PatchVertices patchVerticesOf(const SubTriangleRecords& subs, const SmoothOutput
   P.level = out.level;
   SubTrianglePreImages pre;
   pre.append(subs.headers.data(), subs.records.data(), subs.size());
+  P.reserve(pre.size());
   appendPatchVerticesOf(pre, 0, pre.size(), out.tess.data(), P);
   return P;
 }

@@ -71,8 +71,8 @@ struct SubTrianglePreImages {
 // The tessellation with each vertex's pre-image in its parent triangle (for the writers and the
 // error analysis).
 PatchVertices patchVerticesOf(const SubTriangleRecords& subs, const SmoothOutput& out);
-// The same, a chunk at a time: appends sub-triangles [first, first + count) to `patches` (level set,
-// sub-triangles before `first` appended), their tessellation at `tess` as the device holds it (2 nv
+// The same, a chunk at a time: appends sub-triangles [first, first + count) to `patches` (level set, room
+// reserved by the caller: PatchVertices::reserve), their tessellation at `tess` as the device holds it (2 nv
 // (x, y, z, w) a sub-triangle: positions, then normals), widened to double here.
 void appendPatchVertices(const SubTrianglePreImages& subs, size_t first, size_t count, const float* tess, PatchVertices& patches);
 void appendPatchVertices(const SubTrianglePreImages& subs, size_t first, size_t count, const double* tess, PatchVertices& patches);

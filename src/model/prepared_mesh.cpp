@@ -1,5 +1,6 @@
 #include "model/prepared_mesh.h"
 
+#include "core/huge_pages.h"
 #include "kernels/common/shader_layout.h"
 
 namespace sffd {
@@ -9,15 +10,15 @@ PreparedMesh prepareMesh(const Mesh& mesh) {
   PreparedMesh P;
   P.topology = buildTopology(mesh);
   const size_t nv = mesh.positions.size(), nt = mesh.triangles.size();
-  P.positions.resize(4 * nv);
-  P.normals.resize(4 * nv);
+  resizeHuge(P.positions, 4 * nv);
+  resizeHuge(P.normals, 4 * nv);
   for (size_t v = 0; v < nv; ++v) {
     const glm::dvec3 &p = mesh.positions[v], &n = mesh.normals[v];
     P.positions[4 * v] = p.x, P.positions[4 * v + 1] = p.y, P.positions[4 * v + 2] = p.z, P.positions[4 * v + 3] = 1;
     P.normals[4 * v] = n.x, P.normals[4 * v + 1] = n.y, P.normals[4 * v + 2] = n.z, P.normals[4 * v + 3] = 0;
   }
-  P.triangles.resize(8 * nt);
-  P.slotNormals.resize(48 * nt);
+  resizeHuge(P.triangles, 8 * nt);
+  resizeHuge(P.slotNormals, 48 * nt);
   for (size_t t = 0; t < nt; ++t) {
     const auto& tri = mesh.triangles[t];
     for (int c = 0; c < 3; ++c) {

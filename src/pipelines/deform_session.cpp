@@ -17,6 +17,7 @@
 #include "kernels/pn/pn_triangles.h"
 #include "model/prepared_mesh.h"
 #include "kernels/clip/split_pattern_table.h"
+#include "core/huge_pages.h"
 #include "core/kernel_registry.h"
 #include "core/wall_clock.h"
 #include "pipelines/device_reals.h"
@@ -383,7 +384,7 @@ SubTrianglePreImages DeformSession::preImages() {
       const Chunk& c = chunks_[ci];
       if (!c.count) continue;
       headers.resize(4 * c.count);
-      records.resize(c.count * SFFD_SUB_STRIDE * 4);
+      resizeHuge(records, c.count * SFFD_SUB_STRIDE * 4);
       backend_.download(impl_->chunkBuffers[ci].headers, 0, headers.data(), c.count * 16);
       backend_.download(impl_->chunkBuffers[ci].records, 0, records.data(), records.size() * sizeof(records[0]));
       P.append(headers.data(), records.data(), c.count);

@@ -85,35 +85,61 @@ class AccurateRun final : public MethodRun {
     t.steps = stepsOf(dispatches);
   }
 
+  // The patch vertices welded in slices as each chunk comes from the device: none of them held whole.
   Mesh result(const ProgressReporter&) const override {
-    return weldPatchVertices(*patchVertices());
+    PatchWelder weld(job_.level, job_.count());
+    PatchVertices slice;
+    slice.level = job_.level;
+    slice.reserve(kWeldSlice);
+    auto add = [&](size_t first, size_t count, const auto* pos, const auto* nrm) {
+      const size_t reals = size_t(tessVertexCount(job_.level)) * 4;
+      for (size_t s = 0; s < count; s += kWeldSlice) {
+        slice.clear();
+        appendAccuratePatchVertices(job_, first + s, std::min(kWeldSlice, count - s), pos + s * reals, nrm + s * reals, slice);
+        carryPatchAttributes(slice, input_);
+        weld.add(slice);
+      }
+    };
+    variant_.f64 ? forEachChunk<double>(add) : forEachChunk<float>(add);
+    Mesh m = weld.finish();
+    m.materials = input_.materials;
+    m.groups = input_.groups;
+    m.materialLibraries = input_.materialLibraries;
+    return m;
   }
 
   std::optional<PatchVertices> patchVertices() const override {
-    PatchVertices p = variant_.f64 ? downloadPatchVertices<double>() : downloadPatchVertices<float>();
+    PatchVertices p;
+    p.level = job_.level;
+    p.reserve(job_.count());
+    auto add = [&](size_t first, size_t count, const auto* pos, const auto* nrm) {
+      if (first != p.patchCount()) throw std::logic_error("AccurateRun: chunks out of order");
+      appendAccuratePatchVertices(job_, first, count, pos, nrm, p);
+    };
+    variant_.f64 ? forEachChunk<double>(add) : forEachChunk<float>(add);
     carryAttributes(p, input_);
     return p;
   }
 
-  // Each chunk's positions and normals read into one buffer each and widened once, straight into the
-  // patch vertices (no host copy of the whole output).
-  template <class Real>
-  PatchVertices downloadPatchVertices() const {
+  // Calls add(first, count, positions, normals) for each chunk in order, read from the device into one
+  // reused buffer each (no host copy of the whole output).
+  template <class Real, class Add>
+  void forEachChunk(const Add& add) const {
     const size_t nv = size_t(tessVertexCount(job_.level));
-    size_t most = 0;
+    size_t most = 0, done = 0;
     for (const Chunk& c : chunks_) most = std::max(most, c.count);
     std::unique_ptr<Real[]> pos(new Real[most * nv * 4]), nrm(new Real[most * nv * 4]);   // not zero-filled: overwritten
-    PatchVertices p;
-    p.level = job_.level;
+    adviseHugePages(pos.get(), most * nv * 4 * sizeof(Real));
+    adviseHugePages(nrm.get(), most * nv * 4 * sizeof(Real));
     for (const Chunk& c : chunks_) {
       if (!c.count) continue;
-      if (c.first != p.patchCount()) throw std::logic_error("AccurateRun: chunks out of order");
+      if (c.first != done) throw std::logic_error("AccurateRun: chunks out of order");
       B_.download(c.out, 0, pos.get(), c.count * nv * 4 * sizeof(Real));
       B_.download(c.out, c.half, nrm.get(), c.count * nv * 4 * sizeof(Real));
-      appendAccuratePatchVertices(job_, c.first, c.count, pos.get(), nrm.get(), p);
+      add(c.first, c.count, static_cast<const Real*>(pos.get()), static_cast<const Real*>(nrm.get()));
+      done += c.count;
     }
-    if (p.patchCount() != job_.count()) throw std::logic_error("AccurateRun: chunks do not cover the sub-triangles");
-    return p;
+    if (done != job_.count()) throw std::logic_error("AccurateRun: chunks do not cover the sub-triangles");
   }
 
   size_t subTriangles() const override { return job_.count(); }
@@ -125,6 +151,7 @@ class AccurateRun final : public MethodRun {
   }
 
  private:
+  static constexpr size_t kWeldSlice = 64;   // patches a slice: their vertices in double fit the cache
   struct Chunk {
     size_t first = 0, count = 0;
     uint64_t half = 0;   // bytes from the positions to the normals, and from the normals to the corners

@@ -36,35 +36,62 @@ class SmoothRun final : public MethodRun {
     t.steps = stepsOf(s.dispatches);
   }
 
+  // The patch vertices welded in slices as each chunk comes from the device: none of them held whole.
   Mesh result(const ProgressReporter&) const override {
-    return weldPatchVertices(*patchVertices());
+    if (!records_) records_ = session_->preImages();   // fixed by the pre-compute: downloaded once
+    PatchWelder weld(session_->level(), records_->size());
+    PatchVertices slice;
+    slice.level = session_->level();
+    slice.reserve(kWeldSlice);
+    auto add = [&](size_t first, size_t count, const auto* tess) {
+      const size_t tessReals = 2 * size_t(tessVertexCount(session_->level())) * 4;
+      for (size_t s = 0; s < count; s += kWeldSlice) {
+        slice.clear();
+        appendPatchVertices(*records_, first + s, std::min(kWeldSlice, count - s), tess + s * tessReals, slice);
+        carryPatchAttributes(slice, input_);
+        weld.add(slice);
+      }
+    };
+    session_->options().variant.f64 ? forEachChunk<double>(add) : forEachChunk<float>(add);
+    Mesh m = weld.finish();
+    m.materials = input_.materials;
+    m.groups = input_.groups;
+    m.materialLibraries = input_.materialLibraries;
+    return m;
   }
 
   std::optional<PatchVertices> patchVertices() const override {
     if (!records_) records_ = session_->preImages();   // fixed by the pre-compute: downloaded once
-    PatchVertices p = session_->options().variant.f64 ? downloadPatchVertices<double>() : downloadPatchVertices<float>();
+    PatchVertices p;
+    p.level = session_->level();
+    p.reserve(records_->size());
+    auto add = [&](size_t first, size_t count, const auto* tess) {
+      if (first != p.patchCount()) throw std::logic_error("SmoothRun: chunks out of order");
+      appendPatchVertices(*records_, first, count, tess, p);
+    };
+    session_->options().variant.f64 ? forEachChunk<double>(add) : forEachChunk<float>(add);
     carryAttributes(p, input_);
     return p;
   }
 
-  // patchVerticesOf(records, session->output()) without its host copies of the whole output (and of the
-  // patches, which the vertices do not need): each chunk's tessellation read into one buffer and widened once.
-  template <class Real>
-  PatchVertices downloadPatchVertices() const {
+  // Calls add(first, count, tess) for each chunk of sub-triangles in order, its tessellation read from the
+  // device into one reused buffer (no host copy of the whole output, nor of the patches, which the vertices
+  // do not need).
+  template <class Real, class Add>
+  void forEachChunk(const Add& add) const {
     const size_t tessReals = 2 * size_t(tessVertexCount(session_->level())) * 4;
-    size_t most = 0;
+    size_t most = 0, done = 0;
     for (const DeformSession::Chunk& c : session_->chunks()) most = std::max(most, c.count);
     std::unique_ptr<Real[]> tess(new Real[most * tessReals]);   // not zero-filled: each download overwrites it
-    PatchVertices p;
-    p.level = session_->level();
+    adviseHugePages(tess.get(), most * tessReals * sizeof(Real));
     for (const DeformSession::Chunk& c : session_->chunks()) {
       if (!c.count) continue;
-      if (c.first != p.patchCount()) throw std::logic_error("SmoothRun: chunks out of order");
+      if (c.first != done) throw std::logic_error("SmoothRun: chunks out of order");
       session_->backend().download(c.output, 0, tess.get(), c.count * tessReals * sizeof(Real));
-      appendPatchVertices(*records_, c.first, c.count, tess.get(), p);
+      add(c.first, c.count, static_cast<const Real*>(tess.get()));
+      done += c.count;
     }
-    if (p.patchCount() != records_->size()) throw std::logic_error("SmoothRun: chunks do not cover the sub-triangles");
-    return p;
+    if (done != records_->size()) throw std::logic_error("SmoothRun: chunks do not cover the sub-triangles");
   }
 
   std::vector<double> patchControlPoints() const override { return session_->output().patches; }
@@ -88,6 +115,7 @@ class SmoothRun final : public MethodRun {
   DeformSession* session() override { return session_.get(); }
 
  private:
+  static constexpr size_t kWeldSlice = 64;   // patches a slice: their vertices in double fit the cache
   const Mesh& input_;   // Deformer::Impl::input, which outlives the run
   std::unique_ptr<DeformSession> session_;
   mutable std::optional<SubTrianglePreImages> records_;

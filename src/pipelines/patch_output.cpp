@@ -6,6 +6,8 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "core/huge_pages.h"
+
 namespace sffd {
 
 int tessVertexCount(int level) { return (level + 1) * (level + 2) / 2; }
@@ -37,7 +39,7 @@ void interpolate(const std::vector<glm::vec<N, double>>& values, const std::arra
 }
 }  // namespace
 
-void carryAttributes(PatchVertices& P, const Mesh& input) {
+void carryPatchAttributes(PatchVertices& P, const Mesh& input) {
   const size_t nv = size_t(tessVertexCount(P.level));
   const bool uv = !input.texcoords.empty(), rgba = !input.colors.empty();
   P.texcoord.assign(uv ? 2 * P.vertexCount() : 0, 0.0);
@@ -57,6 +59,10 @@ void carryAttributes(PatchVertices& P, const Mesh& input) {
     for (int c = 0; c < 3; ++c) P.parentWeld[3 * p + c] = input.weldId[input.triangles[P.parent[p]][c]];
   perPatch(input.triangleMaterial, P.material);
   perPatch(input.triangleGroup, P.group);
+}
+
+void carryAttributes(PatchVertices& P, const Mesh& input) {
+  carryPatchAttributes(P, input);
   P.materials = input.materials;
   P.groups = input.groups;
   P.materialLibraries = input.materialLibraries;
@@ -67,6 +73,14 @@ uint64_t bitsOf(double x) {
   uint64_t b;
   std::memcpy(&b, &x, 8);
   return b;
+}
+
+// Whether N doubles have the same bits (as memcmp, without its call: the weld asks it for most vertices).
+template <int N>
+bool sameBits(const double* a, const double* b) {
+  bool same = true;
+  for (int i = 0; i < N; ++i) same &= bitsOf(a[i]) == bitsOf(b[i]);
+  return same;
 }
 
 struct Key3Hash {
@@ -86,12 +100,12 @@ class Key3Map {
   explicit Key3Map(size_t expected) {
     size_t n = 16;
     while (n < 2 * expected) n *= 2;
-    slots_.resize(n);
+    resizeHuge(slots_, n);
   }
   uint32_t& of(const std::array<uint64_t, 3>& key, uint32_t fresh) {
     if (2 * (used_ + 1) > slots_.size()) grow();
     Slot* s = find(key);
-    if (s->key == kEmpty) s->key = key, s->value = fresh, ++used_;
+    if (same(s->key, kEmpty)) s->key = key, s->value = fresh, ++used_;
     return s->value;
   }
 
@@ -104,13 +118,18 @@ class Key3Map {
   Slot* find(const std::array<uint64_t, 3>& key) {
     const size_t mask = slots_.size() - 1;
     for (size_t i = Key3Hash()(key) & mask;; i = (i + 1) & mask)
-      if (slots_[i].key == key || slots_[i].key == kEmpty) return &slots_[i];
+      if (same(slots_[i].key, key) || same(slots_[i].key, kEmpty)) return &slots_[i];
   }
   void grow() {
-    std::vector<Slot> old(slots_.size() * 2);
+    std::vector<Slot> old;
+    resizeHuge(old, slots_.size() * 2);
     old.swap(slots_);
     for (const Slot& s : old)
-      if (s.key != kEmpty) *find(s.key) = s;
+      if (!same(s.key, kEmpty)) *find(s.key) = s;
+  }
+  // std::array's == calls memcmp here, a call for each probe.
+  static bool same(const std::array<uint64_t, 3>& a, const std::array<uint64_t, 3>& b) {
+    return ((a[0] ^ b[0]) | (a[1] ^ b[1]) | (a[2] ^ b[2])) == 0;
   }
   std::vector<Slot> slots_;
   size_t used_ = 0;
@@ -122,33 +141,31 @@ class Key3Map {
 // both sides, so the bits agree), a point inside the parent by the parent and its barycentrics.
 class Locations {
  public:
-  explicit Locations(const PatchVertices& P) : P_(P), other_(P.patchCount() * 3 * size_t(P.level) / 2) {
-    uint32_t maxWeld = 0;
-    for (uint32_t w : P.parentWeld) maxWeld = std::max(maxWeld, w);
-    corner_.assign(P.parentWeld.empty() ? 0 : size_t(maxWeld) + 1, kNone);
-  }
+  explicit Locations(size_t patches, int level) : other_(patches * 3 * size_t(level) / 2) {}
   static constexpr uint32_t kNone = ~0u;
 
-  // The slot that holds vertex g's location (kNone when it has none yet).
-  uint32_t& of(size_t p, size_t g) {
-    const double* lam = &P_.lamParent[3 * g];
-    const uint32_t* w = &P_.parentWeld[3 * p];
+  // The slot that holds the location of the vertex at pre-image `lam` of a patch of `parent`, whose
+  // corners have weldIds `w` (kNone when it has none yet).
+  uint32_t& of(uint32_t parent, const uint32_t* w, const double* lam) {
     const int zeros = (lam[0] == 0) + (lam[1] == 0) + (lam[2] == 0);
-    if (zeros == 2) return corner_[w[lam[0] != 0 ? 0 : lam[1] != 0 ? 1 : 2]];
+    if (zeros == 2) return corner(w[lam[0] != 0 ? 0 : lam[1] != 0 ? 1 : 2]);
     if (zeros == 1) {
       const int z = lam[0] == 0 ? 0 : lam[1] == 0 ? 1 : 2, a = (z + 1) % 3, b = (z + 2) % 3;
-      if (w[a] == w[b]) return corner_[w[a]];   // an edge of no length: all of it is that corner
+      if (w[a] == w[b]) return corner(w[a]);   // an edge of no length: all of it is that corner
       const int hi = w[a] < w[b] ? b : a;
       // Never all zero: the two weldIds differ.
       return other_.of({uint64_t(std::min(w[a], w[b])) << 32 | std::max(w[a], w[b]), bitsOf(lam[hi]), 0}, kNone);
     }
     // Apart from the edge keys: their last word is 0, the bits of +0, and inside a parent no barycentric
     // is 0 (so neither is this key all zero).
-    return other_.of({uint64_t(P_.parent[p]), bitsOf(lam[0]), bitsOf(lam[1])}, kNone);
+    return other_.of({uint64_t(parent), bitsOf(lam[0]), bitsOf(lam[1])}, kNone);
   }
 
  private:
-  const PatchVertices& P_;
+  uint32_t& corner(uint32_t weldId) {
+    if (weldId >= corner_.size()) corner_.resize(size_t(weldId) + 1, kNone);
+    return corner_[weldId];
+  }
   std::vector<uint32_t> corner_;
   Key3Map other_;
 };
@@ -159,84 +176,118 @@ bool onPatchBoundary(int v, int L) {
 }
 }  // namespace
 
-Mesh weldPatchVertices(const PatchVertices& P) {
-  if (P.parentWeld.size() != 3 * P.patchCount())
-    throw std::logic_error("weldPatchVertices: parentWeld not filled (carryAttributes)");
+struct PatchWelder::Impl {
+  int level;
+  size_t patches;   // all that will come: the outputs are reserved for them
+  std::vector<uint32_t> local;   // tessTriangles
+  std::vector<char> boundary;    // per patch vertex
   Mesh m;
-  m.normalsFromFile = true;
-  m.weldIdIsLocation = true;
-  const int nv = tessVertexCount(P.level);
-  const std::vector<uint32_t> local = tessTriangles(P.level);
-  std::vector<char> boundary(nv);
-  for (int v = 0; v < nv; ++v) boundary[v] = onPatchBoundary(v, P.level);
   // Per location: its position (from the patch of the lowest parent that reaches it, so that every
   // triangle there uses the same bits where the sides disagree: a fin, a sliver) and first vertex;
   // per vertex: the next vertex of its location (one per distinct normal and carried value).
   struct Location {
     uint32_t parent, first;
-    size_t g;
+    glm::dvec3 position;
   };
   std::vector<Location> locs;
   std::vector<uint32_t> next;
-  Locations where(P);
-  const bool uv = !P.texcoord.empty(), rgba = !P.color.empty();
-  auto sameVertex = [&](uint32_t i, size_t g) {
-    return std::memcmp(&m.normals[i], &P.normal[3 * g], 24) == 0 && (!uv || std::memcmp(&m.texcoords[i], &P.texcoord[2 * g], 16) == 0) &&
-           (!rgba || std::memcmp(&m.colors[i], &P.color[4 * g], 32) == 0);
-  };
-  auto newVertex = [&](size_t g, uint32_t loc) {
-    const uint32_t i = uint32_t(m.normals.size());
-    m.normals.push_back({P.normal[3 * g], P.normal[3 * g + 1], P.normal[3 * g + 2]});
-    if (uv) m.texcoords.push_back({P.texcoord[2 * g], P.texcoord[2 * g + 1]});
-    if (rgba) m.colors.push_back({P.color[4 * g], P.color[4 * g + 1], P.color[4 * g + 2], P.color[4 * g + 3]});
-    m.weldId.push_back(loc);
-    next.push_back(Locations::kNone);
-    return i;
-  };
+  Locations where;
+  bool started = false;
+
+  Impl(int level, size_t patches) : level(level), patches(patches), local(tessTriangles(level)), where(patches, level) {
+    const int nv = tessVertexCount(level);
+    boundary.resize(nv);
+    for (int v = 0; v < nv; ++v) boundary[v] = onPatchBoundary(v, level);
+    m.normalsFromFile = true;
+    m.weldIdIsLocation = true;
+  }
+
   // Reserved for at most every patch vertex and triangle (address space only: no growth copies, and the
-  // pages not reached are never touched).
-  m.normals.reserve(P.vertexCount());
-  if (uv) m.texcoords.reserve(P.vertexCount());
-  if (rgba) m.colors.reserve(P.vertexCount());
-  m.weldId.reserve(P.vertexCount());
-  next.reserve(P.vertexCount());
-  locs.reserve(P.vertexCount());
-  m.triangles.reserve(P.patchCount() * local.size() / 3);
-  if (!P.material.empty()) m.triangleMaterial.reserve(P.patchCount() * local.size() / 3);
-  if (!P.group.empty()) m.triangleGroup.reserve(P.patchCount() * local.size() / 3);
-  std::vector<uint32_t> map(nv);
-  for (size_t p = 0; p < P.patchCount(); ++p) {
-    for (int v = 0; v < nv; ++v) {
-      const size_t g = p * nv + v;
-      uint32_t fresh = Locations::kNone;
-      uint32_t& loc = boundary[v] ? where.of(p, g) : fresh;   // a patch's inner vertices are its own
-      if (loc == Locations::kNone) {
-        loc = uint32_t(locs.size());
-        locs.push_back({P.parent[p], uint32_t(m.normals.size()), g});
-        map[v] = newVertex(g, loc);
-        continue;
+  // pages not reached are never touched), in huge pages (core/huge_pages.h).
+  void reserve(const PatchVertices& P) {
+    const size_t vertices = patches * size_t(tessVertexCount(level)), triangles = patches * local.size() / 3;
+    reserveHuge(m.normals, vertices);
+    if (!P.texcoord.empty()) reserveHuge(m.texcoords, vertices);
+    if (!P.color.empty()) reserveHuge(m.colors, vertices);
+    reserveHuge(m.weldId, vertices);
+    reserveHuge(next, vertices);
+    reserveHuge(locs, vertices);
+    reserveHuge(m.triangles, triangles);
+    if (!P.material.empty()) reserveHuge(m.triangleMaterial, triangles);
+    if (!P.group.empty()) reserveHuge(m.triangleGroup, triangles);
+  }
+
+  void add(const PatchVertices& P) {
+    if (P.parentWeld.size() != 3 * P.patchCount())
+      throw std::logic_error("weldPatchVertices: parentWeld not filled (carryAttributes)");
+    if (P.level != level) throw std::logic_error("PatchWelder: patches of another level");
+    if (!started) reserve(P), started = true;
+    const int nv = tessVertexCount(level);
+    const bool uv = !P.texcoord.empty(), rgba = !P.color.empty();
+    auto sameVertex = [&](uint32_t i, size_t g) {
+      return sameBits<3>(&m.normals[i][0], &P.normal[3 * g]) && (!uv || sameBits<2>(&m.texcoords[i][0], &P.texcoord[2 * g])) &&
+             (!rgba || sameBits<4>(&m.colors[i][0], &P.color[4 * g]));
+    };
+    auto newVertex = [&](size_t g, uint32_t loc) {
+      const uint32_t i = uint32_t(m.normals.size());
+      m.normals.push_back({P.normal[3 * g], P.normal[3 * g + 1], P.normal[3 * g + 2]});
+      if (uv) m.texcoords.push_back({P.texcoord[2 * g], P.texcoord[2 * g + 1]});
+      if (rgba) m.colors.push_back({P.color[4 * g], P.color[4 * g + 1], P.color[4 * g + 2], P.color[4 * g + 3]});
+      m.weldId.push_back(loc);
+      next.push_back(Locations::kNone);
+      return i;
+    };
+    auto positionOf = [&](size_t g) { return glm::dvec3(P.position[3 * g], P.position[3 * g + 1], P.position[3 * g + 2]); };
+    std::vector<uint32_t> map(nv);
+    for (size_t p = 0; p < P.patchCount(); ++p) {
+      const uint32_t parent = P.parent[p];
+      for (int v = 0; v < nv; ++v) {
+        const size_t g = p * nv + v;
+        uint32_t fresh = Locations::kNone;
+        // A patch's inner vertices are its own.
+        uint32_t& loc = boundary[v] ? where.of(parent, &P.parentWeld[3 * p], &P.lamParent[3 * g]) : fresh;
+        if (loc == Locations::kNone) {
+          loc = uint32_t(locs.size());
+          locs.push_back({parent, uint32_t(m.normals.size()), positionOf(g)});
+          map[v] = newVertex(g, loc);
+          continue;
+        }
+        Location& L = locs[loc];
+        if (parent < L.parent) L.parent = parent, L.position = positionOf(g);
+        uint32_t i = L.first;
+        while (!sameVertex(i, g) && next[i] != Locations::kNone) i = next[i];
+        if (!sameVertex(i, g)) i = next[i] = newVertex(g, loc);
+        map[v] = i;
       }
-      Location& L = locs[loc];
-      if (P.parent[p] < L.parent) L.parent = P.parent[p], L.g = g;
-      uint32_t i = L.first;
-      while (!sameVertex(i, g) && next[i] != Locations::kNone) i = next[i];
-      if (!sameVertex(i, g)) i = next[i] = newVertex(g, loc);
-      map[v] = i;
-    }
-    for (size_t i = 0; i < local.size(); i += 3) {
-      std::array<uint32_t, 3> t{map[local[i]], map[local[i + 1]], map[local[i + 2]]};
-      const uint32_t* w = m.weldId.data();
-      if (w[t[0]] == w[t[1]] || w[t[1]] == w[t[2]] || w[t[0]] == w[t[2]]) continue;   // a collapsed corner of a degenerate patch
-      m.triangles.push_back(t);
-      if (!P.material.empty()) m.triangleMaterial.push_back(P.material[p]);
-      if (!P.group.empty()) m.triangleGroup.push_back(P.group[p]);
+      for (size_t i = 0; i < local.size(); i += 3) {
+        std::array<uint32_t, 3> t{map[local[i]], map[local[i + 1]], map[local[i + 2]]};
+        const uint32_t* w = m.weldId.data();
+        if (w[t[0]] == w[t[1]] || w[t[1]] == w[t[2]] || w[t[0]] == w[t[2]]) continue;   // a collapsed corner of a degenerate patch
+        m.triangles.push_back(t);
+        if (!P.material.empty()) m.triangleMaterial.push_back(P.material[p]);
+        if (!P.group.empty()) m.triangleGroup.push_back(P.group[p]);
+      }
     }
   }
-  m.positions.reserve(m.normals.size());
-  for (size_t i = 0; i < m.normals.size(); ++i) {
-    const double* x = &P.position[3 * locs[m.weldId[i]].g];
-    m.positions.push_back({x[0], x[1], x[2]});
+
+  Mesh finish() {
+    reserveHuge(m.positions, m.normals.size());
+    for (size_t i = 0; i < m.normals.size(); ++i) m.positions.push_back(locs[m.weldId[i]].position);
+    locs = {};
+    next = {};
+    return std::move(m);
   }
+};
+
+PatchWelder::PatchWelder(int level, size_t patches) : impl_(std::make_unique<Impl>(level, patches)) {}
+PatchWelder::~PatchWelder() = default;
+void PatchWelder::add(const PatchVertices& patches) { impl_->add(patches); }
+Mesh PatchWelder::finish() { return impl_->finish(); }
+
+Mesh weldPatchVertices(const PatchVertices& P) {
+  PatchWelder weld(P.level, P.patchCount());
+  weld.add(P);
+  Mesh m = weld.finish();
   m.materials = P.materials;
   m.groups = P.groups;
   m.materialLibraries = P.materialLibraries;

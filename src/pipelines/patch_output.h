@@ -3,8 +3,10 @@
 // Plain data; the error analysis (error_metrics.h) and the writers read it.
 #pragma once
 #include <cstdint>
+#include <memory>
 #include <vector>
 
+#include "core/huge_pages.h"
 #include "model/mesh.h"
 
 namespace sffd {
@@ -37,11 +39,16 @@ struct PatchVertices {
   void reserve(size_t patches) {
     const size_t reals = 3 * patches * size_t(tessVertexCount(level));
     parent.reserve(patches);
-    lamParent.reserve(reals);
-    position.reserve(reals);
-    normal.reserve(reals);
+    reserveHuge(lamParent, reals);
+    reserveHuge(position, reals);
+    reserveHuge(normal, reals);
   }
   size_t vertexCount() const { return position.size() / 3; }
+  // Empties the per-patch and per-vertex arrays, keeping their room (a slice reused for the next patches).
+  void clear() {
+    for (auto* v : {&parent, &material, &group, &parentWeld}) v->clear();
+    for (auto* v : {&lamParent, &position, &normal, &texcoord, &color}) v->clear();
+  }
 };
 
 // Fills the carried fields and parentWeld of `patches` from `input` (the mesh its parents index): texture coordinates
@@ -50,6 +57,8 @@ struct PatchVertices {
 // edge or corner of its parent is interpolated from that edge's or corner's values alone, in an order
 // fixed by weldId, so that neighbouring patches give it the same bits.
 void carryAttributes(PatchVertices& patches, const Mesh& input);
+// The same without the tables (materials, groups, materialLibraries): for a slice that a PatchWelder takes.
+void carryPatchAttributes(PatchVertices& patches, const Mesh& input);
 
 // Welds the patch vertices by where they lie on the input surface (parentWeld and the pre-images),
 // not by their bits: a corner of the input is one location, a point on an input edge one location
@@ -61,6 +70,23 @@ void carryAttributes(PatchVertices& patches, const Mesh& input);
 // writers keep locations that round to one position apart). A triangle with two corners at
 // one location (of a degenerate patch) is dropped. The carried fields become the Mesh's.
 Mesh weldPatchVertices(const PatchVertices& patches);
+
+// weldPatchVertices a slice of patches at a time, for a producer that need not hold all the patch
+// vertices at once (the smooth and accurate results weld each downloaded chunk in small slices, whose
+// vertices stay in the cache): the slices, added in order, give the Mesh that weldPatchVertices gives for
+// all of them together, tables left empty (the caller copies them).
+class PatchWelder {
+ public:
+  // `patches`: how many all the slices hold (the outputs are reserved for them).
+  PatchWelder(int level, size_t patches);
+  ~PatchWelder();
+  void add(const PatchVertices& slice);   // carried fields and parentWeld filled (carryPatchAttributes)
+  Mesh finish();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 // The tessellation with every patch vertex its own vertex (so each can carry its own value, e.g. an
 // error for colouring).

@@ -215,4 +215,61 @@ TEST(PatchWeld, ClosedSphereStaysClosed) {
   }
 }
 
+void expectSameMesh(const Mesh& a, const Mesh& b) {
+  EXPECT_EQ(a.positions, b.positions);
+  EXPECT_EQ(a.normals, b.normals);
+  EXPECT_EQ(a.texcoords, b.texcoords);
+  EXPECT_EQ(a.colors, b.colors);
+  EXPECT_EQ(a.weldId, b.weldId);
+  EXPECT_EQ(a.triangles, b.triangles);
+  EXPECT_EQ(a.triangleMaterial, b.triangleMaterial);
+  EXPECT_EQ(a.triangleGroup, b.triangleGroup);
+  EXPECT_EQ(a.weldIdIsLocation, b.weldIdIsLocation);
+  EXPECT_EQ(a.normalsFromFile, b.normalsFromFile);
+}
+
+// Patches [first, last) of `P` as a slice of their own.
+PatchVertices sliceOf(const PatchVertices& P, size_t first, size_t last) {
+  const size_t nv = size_t(tessVertexCount(P.level));
+  auto part = [&](const auto& v, size_t perPatch) {
+    using V = std::decay_t<decltype(v)>;
+    return v.empty() ? V{} : V(v.begin() + first * perPatch, v.begin() + last * perPatch);
+  };
+  PatchVertices s;
+  s.level = P.level;
+  s.parent = part(P.parent, 1), s.material = part(P.material, 1), s.group = part(P.group, 1), s.parentWeld = part(P.parentWeld, 3);
+  s.lamParent = part(P.lamParent, 3 * nv), s.position = part(P.position, 3 * nv), s.normal = part(P.normal, 3 * nv);
+  s.texcoord = part(P.texcoord, 2 * nv), s.color = part(P.color, 4 * nv);
+  return s;
+}
+
+// The results weld the downloaded patches in slices (PatchWelder): the same mesh as all of them welded
+// at once, whatever the slices (the sphere carries texture coordinates).
+TEST(PatchWeld, SlicesWeldAsOne) {
+  const Mesh sphere = readMesh(std::string(SFFD_TEST_DATA) + "/sphere.obj");
+  ASSERT_FALSE(sphere.texcoords.empty());
+  for (Method method : {Method::Smooth, Method::Accurate}) {
+    SCOPED_TRACE(method == Method::Smooth ? "smooth" : "accurate");
+    Lattice lattice = fitLattice(sphere, {5, 5, 5}, {2, 2, 2});
+    applyLatticePreset(lattice, "twist", 0.3);
+    DeviceRequest request;
+    request.name = "cpu";
+    Device d = Device::open(request);
+    DeformOptions o;
+    o.method = method;
+    o.tess = 3;
+    Deformer deformer(d, sphere, lattice, o);
+    deformer.deform(lattice);
+    const PatchVertices P = *deformer.internal().run->patchVertices();
+    const Mesh whole = weldPatchVertices(P);
+    ASSERT_GT(whole.triangles.size(), 0u);
+    expectSameMesh(deformer.result(), whole);
+    for (size_t step : {size_t(1), size_t(7)}) {
+      PatchWelder weld(P.level, P.patchCount());
+      for (size_t first = 0; first < P.patchCount(); first += step) weld.add(sliceOf(P, first, std::min(P.patchCount(), first + step)));
+      expectSameMesh(weld.finish(), whole);
+    }
+  }
+}
+
 }  // namespace

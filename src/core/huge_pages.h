@@ -1,0 +1,29 @@
+// Transparent huge pages for large host arrays. On a machine where the kernel hands out huge pages
+// only when asked (THP "madvise") every first touch of a 4 KiB page is a fault, and on a virtual
+// machine a costly one: a result of a few hundred MiB spent a third of its time in them. Asking for
+// huge pages on a large, freshly reserved array turns 512 of those faults into one.
+#pragma once
+#include <cstddef>
+#include <vector>
+
+namespace sffd {
+
+// Asks the kernel for huge pages on the whole 2 MiB pages inside [data, data + bytes) (madvise
+// MADV_HUGEPAGE; a range without one is left alone). A no-op where the system has no such advice.
+void adviseHugePages(const void* data, size_t bytes);
+
+// Reserves room for `count` elements in `v` and advises huge pages on the reserved storage.
+template <class T>
+void reserveHuge(std::vector<T>& v, size_t count) {
+  v.reserve(count);
+  adviseHugePages(v.data(), v.capacity() * sizeof(T));
+}
+
+// resize(count, value) of a vector in huge pages (reserveHuge first).
+template <class T>
+void resizeHuge(std::vector<T>& v, size_t count, const T& value = T()) {
+  reserveHuge(v, count);
+  v.resize(count, value);
+}
+
+}  // namespace sffd
