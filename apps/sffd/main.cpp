@@ -6,6 +6,7 @@
 #include <string>
 
 #include "apps/sffd/cli.h"
+#include "core/huge_pages.h"
 #include <sffd/sffd.h>
 
 using namespace sffd;
@@ -35,6 +36,7 @@ static void usage(FILE* f) {
 }
 
 int main(int argc, char** argv) {
+  sffd::restartWithHugePages(argv);   // docs/PERFORMANCE.md "Huge pages for the whole process"
   try {
     if (argc < 2) throw Error(ErrorKind::Input, "no command given (sffd --help lists them)");
     if (!std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h") || (!std::strcmp(argv[1], "help") && argc == 2)) {

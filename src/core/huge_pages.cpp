@@ -1,9 +1,12 @@
 #include "core/huge_pages.h"
 
 #include <cstdint>
+#include <cstdlib>
+#include <fstream>
 
 #if defined(__linux__)
 #include <sys/mman.h>
+#include <unistd.h>
 #endif
 
 namespace sffd {
@@ -18,6 +21,34 @@ void adviseHugePages(const void* data, size_t bytes) {
 #else
   (void)data;
   (void)bytes;
+#endif
+}
+
+std::optional<std::string> tunablesForHugePages(const char* current, std::string_view thpMode) {
+  if (thpMode != "madvise") return std::nullopt;   // "always": given anyway; "never": not at all
+  const std::string now = current ? current : "";
+  if (now.find("glibc.malloc.hugetlb") != std::string::npos) return std::nullopt;
+  return now.empty() ? "glibc.malloc.hugetlb=1" : now + ":glibc.malloc.hugetlb=1";
+}
+
+void restartWithHugePages(char** argv) {
+#if defined(__linux__) && defined(__GLIBC__) && (__GLIBC__ > 2 || __GLIBC_MINOR__ >= 35)
+  if (const char* off = std::getenv("SFFD_HUGE_PAGES"); off && std::string_view(off) == "0") return;
+  std::ifstream file("/sys/kernel/mm/transparent_hugepage/enabled");
+  std::string line;
+  std::getline(file, line);
+  const size_t open = line.find('['), close = line.find(']', open);
+  if (open == std::string::npos || close == std::string::npos) return;
+  const char* current = std::getenv("GLIBC_TUNABLES");
+  const std::optional<std::string> before = current ? std::optional<std::string>(current) : std::nullopt;
+  const std::optional<std::string> tunables = tunablesForHugePages(current, line.substr(open + 1, close - open - 1));
+  if (!tunables || setenv("GLIBC_TUNABLES", tunables->c_str(), 1) != 0) return;
+  execv("/proc/self/exe", argv);
+  // The restart failed: go on as before.
+  if (before) setenv("GLIBC_TUNABLES", before->c_str(), 1);
+  else unsetenv("GLIBC_TUNABLES");
+#else
+  (void)argv;
 #endif
 }
 

@@ -4,6 +4,9 @@
 // huge pages on a large, freshly reserved array turns 512 of those faults into one.
 #pragma once
 #include <cstddef>
+#include <optional>
+#include <string>
+#include <string_view>
 #include <vector>
 
 namespace sffd {
@@ -25,5 +28,18 @@ void resizeHuge(std::vector<T>& v, size_t count, const T& value = T()) {
   reserveHuge(v, count);
   v.resize(count, value);
 }
+
+// The GLIBC_TUNABLES value under which glibc's malloc (2.35 on) asks for huge pages itself, for every
+// large allocation of the process, the driver's included: `current` with glibc.malloc.hugetlb=1 added.
+// None where it would change nothing: the kernel's THP mode (the bracketed word of
+// /sys/kernel/mm/transparent_hugepage/enabled) is not "madvise", or `current` already sets the tunable
+// (the caller's choice, or a restart's).
+std::optional<std::string> tunablesForHugePages(const char* current, std::string_view thpMode);
+
+// Starts the program again (execv of /proc/self/exe, same arguments, same process id) with
+// tunablesForHugePages() in its environment: a tunable is read only at start-up. Returns, and the
+// program goes on as it is, where that does not apply (not Linux with glibc 2.35 or later, nothing to
+// change, SFFD_HUGE_PAGES=0) or the restart fails. For a program's main(), before anything else.
+void restartWithHugePages(char** argv);
 
 }  // namespace sffd

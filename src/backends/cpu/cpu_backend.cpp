@@ -14,6 +14,7 @@
 #include <vector>
 
 #include <sffd/error.h>
+#include "core/huge_pages.h"
 #include "core/kernel_registry.h"
 #include "core/wall_clock.h"
 
@@ -142,6 +143,7 @@ class CpuBackend final : public Backend {
   BufferId createBuffer(uint64_t bytes) override {
     BufferId id = nextId_++;
     buffers_[id] = {std::make_unique_for_overwrite<std::byte[]>(bytes), bytes};   // uninitialised, as on a GPU
+    adviseHugePages(buffers_[id].data.get(), bytes);   // untouched yet: the kernels' first writes fault once per 2 MiB
     return id;
   }
 

@@ -4,11 +4,8 @@
 #include <string>
 #include <vector>
 
-#if defined(__linux__)
-#include <sys/mman.h>
-#endif
-
 #include <sffd/error.h>
+#include "core/huge_pages.h"
 
 namespace sffd::vk {
 
@@ -19,22 +16,6 @@ constexpr VkMemoryPropertyFlags kMappable = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT 
 constexpr VkMemoryPropertyFlags kExcluded = VK_MEMORY_PROPERTY_LAZILY_ALLOCATED_BIT | VK_MEMORY_PROPERTY_PROTECTED_BIT |
                                             VK_MEMORY_PROPERTY_DEVICE_COHERENT_BIT_AMD;
 
-// On a CPU device (lavapipe, SwiftShader) device memory is the driver's malloc'd host memory, and
-// each 4 KiB page of it faults at its first touch, by a kernel or an upload; on a virtual machine
-// whose kernel gives huge pages only when asked (THP "madvise") that is the bulk of a large
-// output's first dispatch. Asking for huge pages on the whole 2 MiB pages of a mapping before
-// anything touches it turns 512 faults into one. Advice only: errors leave the pages as they were.
-void adviseHugePages(void* data, uint64_t bytes) {
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
-  constexpr uintptr_t kHuge = uintptr_t(2) << 20;
-  if (!data || bytes < 2 * kHuge) return;   // smaller ones would get at most one huge page
-  const uintptr_t begin = (uintptr_t(data) + kHuge - 1) & ~(kHuge - 1), end = (uintptr_t(data) + bytes) & ~(kHuge - 1);
-  if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
-#else
-  (void)data;
-  (void)bytes;
-#endif
-}
 
 }  // namespace
 
@@ -160,6 +141,8 @@ Allocation Device::allocate(uint64_t bytes, VkBufferUsageFlags usage, MemoryUse 
     if (mappable && (use != MemoryUse::Storage || unified_))
     {
       check(api_.vkMapMemory(device_, a.memory, 0, VK_WHOLE_SIZE, 0, &a.mapped), "vkMapMemory");
+      // On a CPU device (lavapipe, SwiftShader) device memory is the driver's malloc'd host memory:
+      // huge pages asked for before anything touches it (core/huge_pages.h).
       if (info_.type == "cpu") adviseHugePages(a.mapped, bytes);
     }
   } catch (...) {
