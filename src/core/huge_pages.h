@@ -38,8 +38,9 @@ std::optional<std::string> tunablesForHugePages(const char* current, std::string
 
 // Starts the program again (execv of /proc/self/exe, same arguments, same process id) with
 // tunablesForHugePages() in its environment: a tunable is read only at start-up. Returns, and the
-// program goes on as it is, where that does not apply (not Linux with glibc 2.35 or later, nothing to
-// change, SFFD_HUGE_PAGES=0) or the restart fails. For a program's main(), before anything else.
+// program goes on as it is, where that does not apply (not Linux with glibc 2.35 or later, a sanitizer's
+// malloc, nothing to change, SFFD_HUGE_PAGES=0) or the restart fails. For a program's main(), before
+// anything else.
 void restartWithHugePages(char** argv);
 
 }  // namespace sffd

@@ -24,15 +24,18 @@ using namespace sffd;
 
 namespace {
 
-Lattice latticeFor(const Mesh& m, unsigned seed, double amount) {
+// A lattice of counts^3 control points of `degree` around the mesh, each moved by up to `amount`.
+Lattice jitteredLattice(const Mesh& m, int counts, int degree, unsigned seed, double amount) {
   glm::dvec3 lo(1e300), hi(-1e300);
   for (const glm::dvec3& p : m.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
-  Lattice L = makeIdentityLattice(lo - 0.01, hi + 0.01, {5, 5, 5}, {2, 2, 2});
+  Lattice L = makeIdentityLattice(lo - 0.01, hi + 0.01, {counts, counts, counts}, {degree, degree, degree});
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(-amount, amount);
   for (auto& p : L.controlPoints) p += glm::dvec3(u(rng), u(rng), u(rng));
   return L;
 }
+
+Lattice latticeFor(const Mesh& m, unsigned seed, double amount) { return jitteredLattice(m, 5, 2, seed, amount); }
 
 // The whole smooth job stage by stage on the CPU backend, in the strict float order.
 struct Reference {
@@ -161,12 +164,7 @@ TEST_P(DeformSessionTest, PrecomputeChunksGiveTheSameRecordsAndOutput) {
 TEST_P(DeformSessionTest, LatticeTooLargeToInlineGivesTheSameOutput) {
   OpenedBackend b = open();
   Mesh m = readMesh(std::string(SFFD_TEST_DATA) + "/sphere.obj");
-  glm::dvec3 lo(1e300), hi(-1e300);
-  for (const glm::dvec3& p : m.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
-  Lattice big = makeIdentityLattice(lo - 0.01, hi + 0.01, {12, 12, 12}, {2, 2, 2});
-  std::mt19937 rng(7);
-  std::uniform_real_distribution<double> u(-0.03, 0.03);
-  for (auto& p : big.controlPoints) p += glm::dvec3(u(rng), u(rng), u(rng));
+  Lattice big = jitteredLattice(m, 12, 2, 7, 0.03);
   ASSERT_EQ(deformParamsFor(packLattice(big), false).lattice.break_offset.w, 0u) << "the lattice should not fit inline";
   DeformSessionOptions o;
   o.variant = {true, false};
@@ -213,14 +211,9 @@ TEST_P(DeformSessionTest, KernelsWithoutLatticeAssumptionsGiveTheSameBits) {
   OpenedBackend b = open();
   ForwardingBackend plain(*b.backend);
   Mesh m = readMesh(std::string(SFFD_TEST_DATA) + "/sphere.obj");
-  glm::dvec3 lo(1e300), hi(-1e300);
-  for (const glm::dvec3& p : m.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
   for (auto [counts, degree, split] : {std::tuple{5, 2, false}, std::tuple{6, 3, true}, std::tuple{12, 2, false}}) {
     SCOPED_TRACE(std::to_string(counts) + "^3 of degree " + std::to_string(degree) + (split ? ", split" : ""));
-    Lattice L = makeIdentityLattice(lo - 0.01, hi + 0.01, {counts, counts, counts}, {degree, degree, degree});
-    std::mt19937 rng(counts);
-    std::uniform_real_distribution<double> u(-0.05, 0.05);
-    for (auto& p : L.controlPoints) p += glm::dvec3(u(rng), u(rng), u(rng));
+    Lattice L = jitteredLattice(m, counts, degree, unsigned(counts), 0.05);
     DeformSessionOptions o;
     o.variant = {true, false};
     o.edgeLength = 0.3;
