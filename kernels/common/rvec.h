@@ -16,6 +16,13 @@ struct RVec3 {
   static RVec3 from(const glm::dvec3& v) { return {Real(v.x), Real(v.y), Real(v.z)}; }
   glm::dvec3 glm() const { return {double(x), double(y), double(z)}; }
 };
+// x, y, z (and an unused fourth) in the lanes of one GCC / Clang vector, for the CPU twins' hot loops:
+// lane by lane the operations RVec3's would do, in the same order, so the same bits.
+template <class Real>
+struct Lanes4 {
+  typedef Real type __attribute__((vector_size(4 * sizeof(Real))));
+};
+
 template <class Real> RVec3<Real> operator+(RVec3<Real> a, RVec3<Real> b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
 template <class Real> RVec3<Real> operator-(RVec3<Real> a, RVec3<Real> b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
 template <class Real> RVec3<Real> operator*(RVec3<Real> a, Real s) { return {a.x * s, a.y * s, a.z * s}; }

@@ -2,6 +2,8 @@
 // smooth_deform.glsl, one function per step as there, reading the bound ranges (or the lattice and fit
 // table inline in the parameter block) as the kernels do.
 #include <algorithm>
+#include <cmath>
+#include <cstring>
 #include <span>
 
 #include "kernels/common/cpu_kernel.h"
@@ -165,19 +167,31 @@ void adjust(uint32_t creaseBits, const RVec3<Real> adj[3], const RVec3<Real> adj
 
 // Step 6: the tessellation at level Lv, positions then normals; the twin of smoothTessellate (smooth_deform.glsl),
 // one vertex at a time in index order where the kernel has one loop per kind of vertex: the same values.
+// The sums run on x, y, z in the lanes of one vector (Lanes4): the same operations, fewer instructions.
 template <class Real>
 void tessellate(const RVec3<Real> cp[10], const RVec3<Real> ncp[10], int Lv, Real* tessOut) {
+  using V = typename Lanes4<Real>::type;
   const int nv = (Lv + 1) * (Lv + 2) / 2;
-  auto put = [](Real* o, RVec3<Real> v) { o[0] = v.x, o[1] = v.y, o[2] = v.z, o[3] = 0; };
+  V P[10], N[10];
+  for (int q = 0; q < 10; ++q) P[q] = V{cp[q].x, cp[q].y, cp[q].z, 0}, N[q] = V{ncp[q].x, ncp[q].y, ncp[q].z, 0};
+  // snormalize: sqrt of ((x x + y y) + z z), then each lane divided by it.
+  auto normalized = [](V& n) {
+    const Real len = std::sqrt((n[0] * n[0] + n[1] * n[1]) + n[2] * n[2]);
+    n = n / V{len, len, len, len};
+  };
+  auto put = [](Real* o, V& v) {
+    v[3] = 0;
+    std::memcpy(o, &v, sizeof v);
+  };
   for (int r = 0; r <= Lv; ++r)
     for (int t = 0; t <= r; ++t) {
       int i = Lv - r, j = r - t, k = t;
       int v = r * (r + 1) / 2 + t;
-      RVec3<Real> x, n;
+      V x, n;
       if (i == Lv || j == Lv || k == Lv) {
         int c = i == Lv ? 0 : (j == Lv ? 1 : 2);
-        x = cp[kCornerCp[c]];
-        n = snormalize(ncp[kCornerCp[c]]);
+        x = P[kCornerCp[c]];
+        n = N[kCornerCp[c]];
       } else if (i == 0 || j == 0 || k == 0) {
         // Evaluated from the lexicographically smaller corner, so both patches of the edge agree bit for bit.
         int a = k == 0 ? 0 : (i == 0 ? 1 : 2), b = (a + 1) % 3;
@@ -185,18 +199,20 @@ void tessellate(const RVec3<Real> cp[10], const RVec3<Real> ncp[10], int Lv, Rea
         int sa = 2 * a + 1, sb = 2 * b;
         int lo = a, hi = b, steps = stepsFromA, slo = sa, shi = sb;
         if (lexLess(cp[kCornerCp[b]], cp[kCornerCp[a]])) lo = b, hi = a, steps = Lv - stepsFromA, slo = sb, shi = sa;
-        Real u = Real(steps) / Real(Lv);
-        x = pnEdgeCurve(cp[kCornerCp[lo]], cp[kSlotControlPoint[slo]], cp[kSlotControlPoint[shi]], cp[kCornerCp[hi]], u);
-        n = snormalize(pnEdgeCurve(ncp[kCornerCp[lo]], ncp[kSlotControlPoint[slo]], ncp[kSlotControlPoint[shi]], ncp[kCornerCp[hi]], u));
+        // pnEdgeCurve's weights and sums.
+        const Real u = Real(steps) / Real(Lv), s = Real(1) - u;
+        const Real w0 = s * s * s, w1 = Real(3) * s * s * u, w2 = Real(3) * s * u * u, w3 = u * u * u;
+        const int q0 = kCornerCp[lo], q1 = kSlotControlPoint[slo], q2 = kSlotControlPoint[shi], q3 = kCornerCp[hi];
+        x = ((P[q0] * V{w0, w0, w0, w0} + P[q1] * V{w1, w1, w1, w1}) + P[q2] * V{w2, w2, w2, w2}) + P[q3] * V{w3, w3, w3, w3};
+        n = ((N[q0] * V{w0, w0, w0, w0} + N[q1] * V{w1, w1, w1, w1}) + N[q2] * V{w2, w2, w2, w2}) + N[q3] * V{w3, w3, w3, w3};
       } else {
         RVec3<Real> lam = RVec3<Real>{Real(i), Real(j), Real(k)} / Real(Lv);
         Real w[10];
         pnCubicWeights(lam, w);
-        RVec3<Real> xs{}, ns{};
-        for (int q = 0; q < 10; ++q) xs = xs + cp[q] * w[q], ns = ns + ncp[q] * w[q];
-        x = xs;
-        n = snormalize(ns);
+        x = V{}, n = V{};
+        for (int q = 0; q < 10; ++q) x = x + P[q] * V{w[q], w[q], w[q], w[q]}, n = n + N[q] * V{w[q], w[q], w[q], w[q]};
       }
+      normalized(n);
       put(tessOut + 4 * v, x);
       put(tessOut + 4 * (nv + v), n);
     }
