@@ -88,6 +88,23 @@ class AccurateRun final : public MethodRun {
   // The patch vertices welded in slices as each chunk comes from the device: none of them held whole.
   Mesh result(const ProgressReporter&) const override {
     PatchWelder weld(job_.level, job_.count());
+    weldChunks(weld);
+    Mesh m = weld.finish();
+    m.materials = input_.materials;
+    m.groups = input_.groups;
+    m.materialLibraries = input_.materialLibraries;
+    return m;
+  }
+
+  void streamResult(MeshSink& sink, const ProgressReporter&) const override {
+    PatchWelder weld(job_.level, job_.count(), &sink);
+    sink.begin(PatchWelder::tablesOf(input_));
+    weldChunks(weld);
+    sink.end();
+  }
+
+  // Each chunk's patch vertices into `weld`, kWeldSlice patches at a time (their carried fields filled).
+  void weldChunks(PatchWelder& weld) const {
     PatchVertices slice;
     slice.level = job_.level;
     slice.reserve(kWeldSlice);
@@ -101,11 +118,6 @@ class AccurateRun final : public MethodRun {
       }
     };
     variant_.f64 ? forEachChunk<double>(add) : forEachChunk<float>(add);
-    Mesh m = weld.finish();
-    m.materials = input_.materials;
-    m.groups = input_.groups;
-    m.materialLibraries = input_.materialLibraries;
-    return m;
   }
 
   std::optional<PatchVertices> patchVertices() const override {

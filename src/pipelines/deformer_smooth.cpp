@@ -38,8 +38,29 @@ class SmoothRun final : public MethodRun {
 
   // The patch vertices welded in slices as each chunk comes from the device: none of them held whole.
   Mesh result(const ProgressReporter&) const override {
+    PatchWelder weld(session_->level(), preImages().size());
+    weldChunks(weld);
+    Mesh m = weld.finish();
+    m.materials = input_.materials;
+    m.groups = input_.groups;
+    m.materialLibraries = input_.materialLibraries;
+    return m;
+  }
+
+  void streamResult(MeshSink& sink, const ProgressReporter&) const override {
+    PatchWelder weld(session_->level(), preImages().size(), &sink);
+    sink.begin(PatchWelder::tablesOf(input_));
+    weldChunks(weld);
+    sink.end();
+  }
+
+  const SubTrianglePreImages& preImages() const {
     if (!records_) records_ = session_->preImages();   // fixed by the pre-compute: downloaded once
-    PatchWelder weld(session_->level(), records_->size());
+    return *records_;
+  }
+
+  // Each chunk's patch vertices into `weld`, kWeldSlice patches at a time (their carried fields filled).
+  void weldChunks(PatchWelder& weld) const {
     PatchVertices slice;
     slice.level = session_->level();
     slice.reserve(kWeldSlice);
@@ -53,11 +74,6 @@ class SmoothRun final : public MethodRun {
       }
     };
     session_->options().variant.f64 ? forEachChunk<double>(add) : forEachChunk<float>(add);
-    Mesh m = weld.finish();
-    m.materials = input_.materials;
-    m.groups = input_.groups;
-    m.materialLibraries = input_.materialLibraries;
-    return m;
   }
 
   std::optional<PatchVertices> patchVertices() const override {
