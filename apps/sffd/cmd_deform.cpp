@@ -56,8 +56,9 @@ int run(const ParsedArgs& args) {
   const double readMs = lap();
   Device device = openDeviceFromArgs(args);
   const double openMs = lap();
-  // Smooth and accurate results go to a .ply or .stl as they are welded (MeshFileWriter), never held whole.
-  const bool streamed = methodOf(args.get("--method", "smooth")) != Method::Classic &&
+  // Smooth and accurate results go to a .ply or .stl as they are welded (MeshFileWriter), never held whole
+  // (--patches reads the Deformer again afterwards: then the result is taken as before).
+  const bool streamed = methodOf(args.get("--method", "smooth")) != Method::Classic && !args.has("--patches") &&
                         MeshFileWriter::streams(out, {.binary = args.has("--binary")}, !job.mesh.colors.empty());
   std::unique_ptr<MeshFileWriter> writer;
   auto writerFor = [&](const Deformer& d) -> MeshSink& {

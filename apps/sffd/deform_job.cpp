@@ -66,6 +66,7 @@ std::optional<PatchVertices> DeformRun::patches() {
 
 DeformRun runMethod(const ParsedArgs& args, Job& job, Device& device, Method method, const SinkFor& sinkFor) {
   DeformOptions o = deformOptionsOf(args, job, device, method);
+  o.once = bool(sinkFor);   // one deformation, its result streamed once: buffers freed as they are read
   auto line = std::make_shared<ProgressLine>(progressWanted(args));   // cleared also when a call throws
   o.progress = line->callback();
   auto make = [&] { return withToolLimitName([&] { return Deformer(device, job.mesh, job.lattice, o); }); };

@@ -47,6 +47,13 @@ struct DeformSession::Impl {
     owned.push_back(id);
     return id;
   }
+  // Destroys an owned buffer and sets its id to 0 (0: already gone).
+  void drop(Backend& b, BufferId& id) {
+    if (!id) return;
+    b.destroyBuffer(id);
+    owned.erase(std::find(owned.begin(), owned.end(), id));
+    id = 0;
+  }
   BufferId upload(Backend& b, const void* data, uint64_t bytes) {
     BufferId id = make(b, bytes);
     if (bytes) b.upload(id, 0, data, bytes);
@@ -144,6 +151,25 @@ void DeformSession::prepare(const Mesh& input, const Lattice& lattice, const Sta
   I.frame = up(deformFrameRange(packed, I.fit.data));
   I.coeffs = up(packed.coeffs);
   precompute(progress);
+  if (options.once) {   // only a repeated precompute() reads them
+    for (Impl::PreChunk& c : I.pre) I.drop(backend, c.reals), I.drop(backend, c.words);
+    inputsReleased_ = true;
+  }
+}
+
+void DeformSession::requireOnce() const {
+  if (!options_.once) throw std::logic_error("DeformSession: release without options().once");
+}
+
+void DeformSession::releaseRecords() {
+  requireOnce();
+  for (Impl::ChunkBuffers& c : impl_->chunkBuffers) impl_->drop(backend_, c.headers), impl_->drop(backend_, c.records);
+  recordsReleased_ = true;
+}
+
+void DeformSession::releaseOutput(size_t chunk) {
+  requireOnce();
+  impl_->drop(backend_, chunks_.at(chunk).output);
 }
 
 size_t DeformSession::precomputeChunks() const { return impl_->pre.size(); }
@@ -169,6 +195,7 @@ void sumStages(SessionTimings& t) {
 }  // namespace
 
 const SessionTimings& DeformSession::precompute(const StageProgress& progress) {
+  if (inputsReleased_) throw Error(ErrorKind::Input, "the pre-compute's inputs were freed (DeformOptions::once)");
   Impl& I = *impl_;
   Backend& B = backend_;
   const DeviceLimits& lim = B.info().limits;
@@ -337,6 +364,7 @@ const SessionTimings& DeformSession::deform(const Lattice& lattice, const StageP
   Backend& B = backend_;
   if (!sameLatticeStructure(lattice, I.structure))
     throw Error(ErrorKind::Input, "the lattice's degrees, counts, knots or frame differ from the session's");
+  if (recordsReleased_) throw Error(ErrorKind::Input, "the sub-triangle records were freed after one deformation (DeformOptions::once)");
   auto t0 = std::chrono::steady_clock::now();
   timings_ = {};
   PackedLattice packed = packLattice(lattice);
@@ -360,6 +388,7 @@ const SessionTimings& DeformSession::deform(const Lattice& lattice, const StageP
 }
 
 SubTriangleRecords DeformSession::records() {
+  if (recordsReleased_) throw Error(ErrorKind::Input, "the sub-triangle records were freed after one deformation (DeformOptions::once)");
   SubTriangleRecords R;
   R.headers.resize(4 * subCount_);
   R.records.resize(subCount_ * SFFD_SUB_STRIDE * 4);
@@ -375,6 +404,7 @@ SubTriangleRecords DeformSession::records() {
 }
 
 SubTrianglePreImages DeformSession::preImages() {
+  if (recordsReleased_) throw Error(ErrorKind::Input, "the sub-triangle records were freed after one deformation (DeformOptions::once)");
   SubTrianglePreImages P;
   P.parent.reserve(subCount_);
   P.lam.reserve(9 * subCount_);

@@ -32,6 +32,9 @@ struct DeformSessionOptions {
   double creaseAngleDeg = kCreaseAngleAuto;  // for a mesh without normals: applyCreaseAngle's threshold
   size_t maxChunkSubTriangles = 0;   // 0: chunks as large as the device allows (smaller only to test chunking)
   size_t maxChunkParents = 0;        // the same for the pre-compute's chunks of mesh triangles
+  // One deformation (DeformOptions::once): the pre-compute's inputs are freed once it ran (precompute() then
+  // throws); releaseRecords() and releaseOutput() free the rest as the caller reads it.
+  bool once = false;
 };
 
 // Told the stage and the fraction of the call done, at stage boundaries and after each chunk; it may
@@ -84,6 +87,10 @@ class DeformSession {
   SubTriangleRecords records();
   SubTrianglePreImages preImages();   // what of the records the patch vertices need, a chunk at a time
   SmoothOutput output();
+  // With options().once: frees the sub-triangle records (after deform() and preImages(); deform() and
+  // records() then throw), and one chunk's output (after it was read; the chunk's output() too).
+  void releaseRecords();
+  void releaseOutput(size_t chunk);
 
  private:
   void prepare(const Mesh& mesh, const Lattice& lattice, const StageProgress& progress);
@@ -93,6 +100,8 @@ class DeformSession {
   std::unique_ptr<Impl> impl_;
   std::vector<Chunk> chunks_;
   size_t subCount_ = 0;
+  bool inputsReleased_ = false, recordsReleased_ = false;
+  void requireOnce() const;
   SessionTimings timings_;
 };
 

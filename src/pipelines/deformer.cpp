@@ -83,6 +83,7 @@ ResolvedOptions resolve(const DeformOptions& o, const DeviceInfo& info, const Me
   r.creaseAngleDeg = o.creaseAngleDeg;
   r.memoryLimit = o.memoryLimit;
   r.maxChunkElements = o.maxChunkElements;
+  r.once = o.once;
   return r;
 }
 

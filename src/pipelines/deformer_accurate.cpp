@@ -133,22 +133,27 @@ class AccurateRun final : public MethodRun {
     return p;
   }
 
-  // Calls add(first, count, positions, normals) for each chunk in order, read from the device into one
-  // reused buffer each (no host copy of the whole output).
+  // Calls add(first, count, positions, normals) for consecutive runs of patches in order, each chunk read
+  // from the device a block of at most kDownloadBytes at a time into one reused buffer each (no host copy
+  // of the whole output, nor of a whole chunk).
   template <class Real, class Add>
   void forEachChunk(const Add& add) const {
-    const size_t nv = size_t(tessVertexCount(job_.level));
+    const size_t nv = size_t(tessVertexCount(job_.level)), patchBytes = nv * 4 * sizeof(Real);
+    const size_t block = std::max<size_t>(1, kDownloadBytes / (2 * patchBytes) / kWeldSlice) * kWeldSlice;   // whole weld slices
     size_t most = 0, done = 0;
-    for (const Chunk& c : chunks_) most = std::max(most, c.count);
+    for (const Chunk& c : chunks_) most = std::max(most, std::min(c.count, block));
     std::unique_ptr<Real[]> pos(new Real[most * nv * 4]), nrm(new Real[most * nv * 4]);   // not zero-filled: overwritten
-    adviseHugePages(pos.get(), most * nv * 4 * sizeof(Real));
-    adviseHugePages(nrm.get(), most * nv * 4 * sizeof(Real));
+    adviseHugePages(pos.get(), most * patchBytes);
+    adviseHugePages(nrm.get(), most * patchBytes);
     for (const Chunk& c : chunks_) {
       if (!c.count) continue;
       if (c.first != done) throw std::logic_error("AccurateRun: chunks out of order");
-      B_.download(c.out, 0, pos.get(), c.count * nv * 4 * sizeof(Real));
-      B_.download(c.out, c.half, nrm.get(), c.count * nv * 4 * sizeof(Real));
-      add(c.first, c.count, static_cast<const Real*>(pos.get()), static_cast<const Real*>(nrm.get()));
+      for (size_t b = 0; b < c.count; b += block) {
+        const size_t n = std::min(block, c.count - b);
+        B_.download(c.out, b * patchBytes, pos.get(), n * patchBytes);
+        B_.download(c.out, c.half + b * patchBytes, nrm.get(), n * patchBytes);
+        add(c.first + b, n, static_cast<const Real*>(pos.get()), static_cast<const Real*>(nrm.get()));
+      }
       done += c.count;
     }
     if (done != job_.count()) throw std::logic_error("AccurateRun: chunks do not cover the sub-triangles");
@@ -164,6 +169,7 @@ class AccurateRun final : public MethodRun {
 
  private:
   static constexpr size_t kWeldSlice = 64;   // patches a slice: their vertices in double fit the cache
+  static constexpr size_t kDownloadBytes = size_t(16) << 20;   // a download's block (rounded to whole slices)
   struct Chunk {
     size_t first = 0, count = 0;
     uint64_t half = 0;   // bytes from the positions to the normals, and from the normals to the corners

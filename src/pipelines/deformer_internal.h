@@ -46,6 +46,7 @@ struct ResolvedOptions {
   double creaseAngleDeg = kCreaseAngleAuto;
   uint64_t memoryLimit = 0;
   size_t maxChunkElements = 0;
+  bool once = false;
 };
 
 // One method's work on the device: the constructor prepares, deform() runs for a lattice.
