@@ -436,6 +436,7 @@ SmoothOutput DeformSession::output() {
   out.tess.resize(subCount_ * tessReals);
   for (const Chunk& c : chunks_) {
     if (!c.count) continue;
+    if (!c.output) throw Error(ErrorKind::Input, "the outputs were freed after one deformation (DeformOptions::once)");
     downloadRealsInto(backend_, c.output, c.patchesOffset, c.count * patchReals, options_.variant.f64,
                       &out.patches[c.first * patchReals], scratch);
     downloadRealsInto(backend_, c.output, 0, c.count * tessReals, options_.variant.f64, &out.tess[c.first * tessReals], scratch);

@@ -8,6 +8,8 @@
 #include <memory>
 #include <stdexcept>
 
+#include <sffd/error.h>
+
 #include "core/job_budget.h"
 #include "core/wall_clock.h"
 #include "kernels/accurate/accurate_patches.h"
@@ -22,7 +24,7 @@ class AccurateRun final : public MethodRun {
  public:
   AccurateRun(Backend& backend, const Mesh& input, const Lattice& lattice, const ResolvedOptions& r, Timings& t,
               const ProgressReporter& progress)
-      : B_(backend), input_(input), variant_(r.variant) {
+      : B_(backend), input_(input), variant_(r.variant), once_(r.once) {
     const auto t0 = std::chrono::steady_clock::now();
     progress("clip", 0);
     job_ = makeAccurateJob(input, lattice, clipAgainstKnotBoxes(input, lattice), r.tess);
@@ -65,6 +67,7 @@ class AccurateRun final : public MethodRun {
   }
 
   void deform(const Lattice& lattice, Timings& t, const ProgressReporter& progress) override {
+    if (once_ && taken_) throw Error(ErrorKind::Input, "the outputs were freed after one deformation (DeformOptions::once)");
     const auto t0 = std::chrono::steady_clock::now();
     PackedLattice packed = packLattice(lattice);
     std::vector<unsigned char> coeffs = realBytes(packed.coeffs, variant_.f64);
@@ -87,6 +90,7 @@ class AccurateRun final : public MethodRun {
 
   // The patch vertices welded in slices as each chunk comes from the device: none of them held whole.
   Mesh result(const ProgressReporter&) const override {
+    take();
     PatchWelder weld(job_.level, job_.count());
     weldChunks(weld);
     Mesh m = weld.finish();
@@ -97,10 +101,17 @@ class AccurateRun final : public MethodRun {
   }
 
   void streamResult(MeshSink& sink, const ProgressReporter&) const override {
+    take();
     PatchWelder weld(job_.level, job_.count(), &sink);
     sink.begin(PatchWelder::tablesOf(input_));
     weldChunks(weld);
     sink.end();
+  }
+
+  // A one-shot run's result is taken once: each chunk's buffer goes once read (forEachChunk).
+  void take() const {
+    if (once_ && taken_) throw Error(ErrorKind::Input, "the result was already taken (DeformOptions::once)");
+    taken_ = true;
   }
 
   // Each chunk's patch vertices into `weld`, kWeldSlice patches at a time (their carried fields filled).
@@ -145,9 +156,10 @@ class AccurateRun final : public MethodRun {
     std::unique_ptr<Real[]> pos(new Real[most * nv * 4]), nrm(new Real[most * nv * 4]);   // not zero-filled: overwritten
     adviseHugePages(pos.get(), most * patchBytes);
     adviseHugePages(nrm.get(), most * patchBytes);
-    for (const Chunk& c : chunks_) {
+    for (Chunk& c : chunks_) {
       if (!c.count) continue;
       if (c.first != done) throw std::logic_error("AccurateRun: chunks out of order");
+      if (!c.out) throw Error(ErrorKind::Input, "the outputs were freed after one deformation (DeformOptions::once)");
       for (size_t b = 0; b < c.count; b += block) {
         const size_t n = std::min(block, c.count - b);
         B_.download(c.out, b * patchBytes, pos.get(), n * patchBytes);
@@ -155,6 +167,11 @@ class AccurateRun final : public MethodRun {
         add(c.first + b, n, static_cast<const Real*>(pos.get()), static_cast<const Real*>(nrm.get()));
       }
       done += c.count;
+      if (once_) {
+        B_.destroyBuffer(c.out);
+        owned_.ids.erase(std::find(owned_.ids.begin(), owned_.ids.end(), c.out));
+        c.out = 0;
+      }
     }
     if (done != job_.count()) throw std::logic_error("AccurateRun: chunks do not cover the sub-triangles");
   }
@@ -176,7 +193,7 @@ class AccurateRun final : public MethodRun {
     BufferId out = 0;
   };
   Backend& B_;
-  OwnedBuffers owned_{B_};   // first: destroyed last, after everything that names its buffers
+  mutable OwnedBuffers owned_{B_};   // first: destroyed last, after everything that names its buffers
   const Mesh& input_;   // Deformer::Impl::input, which outlives the run
   KernelVariant variant_;
   AccurateJob job_;
@@ -184,7 +201,9 @@ class AccurateRun final : public MethodRun {
   AccurateFrame frame_;
   BufferId frameBuffer_ = 0, coeffs_ = 0, scratch_ = 0;
   uint32_t patchesAt_ = 0;   // the first control point in scratch_, after the samples
-  std::vector<Chunk> chunks_;
+  mutable std::vector<Chunk> chunks_;   // mutable: a one-shot run frees their buffers as they are read
+  bool once_ = false;
+  mutable bool taken_ = false;   // a result was taken (DeformOptions::once allows one)
 };
 
 }  // namespace
