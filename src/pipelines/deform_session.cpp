@@ -63,8 +63,13 @@ struct DeformSession::Impl {
 
 namespace {
 
+// The most bytes of reals a pre-compute chunk takes beyond its first parent: its range is built on the host
+// whole before the upload, so a large mesh in one chunk would hold its inputs twice (host and device) at once.
+constexpr uint64_t kPreChunkHostBytes = uint64_t(64) << 20;
+
 // The pre-compute's chunks: consecutive parents (and their clip triangles, which follow the parents'
-// order), as many to a chunk as keep both of its input ranges within one storage binding.
+// order), as many to a chunk as keep both of its input ranges within one storage binding, and its reals
+// within kPreChunkHostBytes.
 std::vector<ClipRanges> preChunks(const PreparedMesh& mesh, const ClipTriangles& clip, size_t realSize, uint64_t limit,
                                   size_t maxParents) {
   const uint64_t nv = mesh.positions.size() / 4, nt = mesh.triangleCount();
@@ -77,7 +82,7 @@ std::vector<ClipRanges> preChunks(const PreparedMesh& mesh, const ClipTriangles&
     for (uint64_t p1 = p0, c1 = c0; p1 < nt && (!maxParents || p1 - p0 < maxParents); ++p1) {
       while (c1 < ct.size() && ct[c1].parent == p1) ++c1;
       ClipRanges next = clipRanges(nv, p0, p1 + 1 - p0, c0, c1 - c0, realSize);
-      if (!fits(next)) break;
+      if (!fits(next) || (r.parents && next.byteOf(next.realElements) > kPreChunkHostBytes)) break;
       r = next;
     }
     if (!r.parents && p0 < nt) {
