@@ -1,5 +1,6 @@
 #include "io/atomic_file.h"
 
+#include <atomic>
 #include <csignal>
 #include <cerrno>
 #include <cstdio>
@@ -81,7 +82,10 @@ class TemporaryGuard {
 std::string temporaryBeside(const std::string& path) {
   fs::path p(path);
   std::random_device rd;
-  std::string name = "." + p.filename().string() + ".tmp" + std::to_string(::getpid()) + "_" + std::to_string(rd() % 1000000);
+  // The count keeps several temporaries of one target apart within a process (MeshFileWriter's scratch files).
+  static std::atomic<unsigned> count{0};
+  std::string name = "." + p.filename().string() + ".tmp" + std::to_string(::getpid()) + "_" + std::to_string(rd() % 1000000) +
+                     "_" + std::to_string(count++);
   // Keep the extension last: writers that dispatch on it (OpenMesh) still see it.
   name += p.extension().string();
   return (p.parent_path() / name).string();
