@@ -58,12 +58,12 @@ struct DeformOptions {
                                              // edge is a crease, or kCreaseAngleAuto (<sffd/mesh.h>)
   uint64_t memoryLimit = 0;      // bytes of host memory a job may plan for (every method); 0: physical memory
   size_t maxChunkElements = 0;   // 0: chunks as large as the device allows (smaller only to test chunking)
-  // One deform() and one result() or streamResult() (as `sffd deform` does): what only a repeated call
-  // needs is freed as soon as it is used (smooth: the pre-compute's inputs once it ran, the sub-triangle
-  // records once deformed and read, each chunk's output once read), so a large job's peak memory is lower.
-  // A second deform() or result() then throws an input Error; precompute again is refused likewise.
-  bool once = false;
   ProgressCallback progress;     // called during long work; may be empty
+  // A one-shot job, deformed and its result taken once (as `sffd deform` does): what only a repeated call
+  // needs is freed as soon as it is used (smooth: the pre-compute's inputs once it ran, the sub-triangle
+  // records once read; smooth and accurate: each chunk's output once read), so a large job's peak memory
+  // is lower. After its result() or streamResult(), another one or another deform() throws an input Error.
+  bool once = false;
 };
 
 // Times of the last call. GPU time where the device measures it, else host wall time.

@@ -71,6 +71,7 @@ class StreamResult : public ::testing::Test {
       ASSERT_FALSE(want.empty());
       EXPECT_TRUE(want == bytesOf((dir_ / "got").string() + t.name));
       EXPECT_THROW(once.streamResult(out), Error);   // once: the buffers are gone
+      EXPECT_THROW(once.deform(L), Error);
     }
     size_t files = 0;
     for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir_)) ++files;
