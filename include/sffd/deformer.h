@@ -61,8 +61,8 @@ struct DeformOptions {
   ProgressCallback progress;     // called during long work; may be empty
   // A one-shot job, deformed and its result taken once (as `sffd deform` does): what only a repeated call
   // needs is freed as soon as it is used (smooth: the pre-compute's inputs once it ran, the sub-triangle
-  // records once read; smooth and accurate: each chunk's output once read), so a large job's peak memory
-  // is lower. After its result() or streamResult(), another one or another deform() throws an input Error.
+  // records as each chunk is deformed; smooth and accurate: each chunk's output once read), so a large job's
+  // peak memory is lower. A second deform(), or a second result() or streamResult(), throws an input Error.
   bool once = false;
 };
 

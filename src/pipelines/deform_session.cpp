@@ -382,9 +382,15 @@ const SessionTimings& DeformSession::deform(const Lattice& lattice, const StageP
     params.range = {0, uint32_t(c.count), uint32_t(I.fit.points), uint32_t(options_.level)};
     deformOutSections(params, c.count, options_.level, I.fit.points, options_.split);
     dispatchDeform(B, params, {I.coeffs, I.frame, I.chunkBuffers[ci].records, c.output}, c.count, options_.variant, options_.split);
+    if (options_.once) {   // one deformation: the records' pre-images read now, so each chunk's records go at once
+      if (!takenPreImages_) takenPreImages_.emplace(), takenPreImages_->parent.reserve(subCount_), takenPreImages_->lam.reserve(9 * subCount_);
+      appendPreImages(ci, *takenPreImages_);
+      I.drop(B, I.chunkBuffers[ci].headers), I.drop(B, I.chunkBuffers[ci].records);
+    }
     if (progress) progress("deform", double(ci + 1) / double(chunks_.size() + 1));
   }
   B.finish();
+  if (options_.once) recordsReleased_ = true;
   timings_.dispatches = B.takeTimings();
   sumStages(timings_);
   timings_.wallMs = msSince(t0);
@@ -409,26 +415,32 @@ SubTriangleRecords DeformSession::records() {
 }
 
 SubTrianglePreImages DeformSession::preImages() {
+  if (takenPreImages_) {   // one deformation: read as deform() ran
+    SubTrianglePreImages P = std::move(*takenPreImages_);
+    takenPreImages_.reset();
+    return P;
+  }
   if (recordsReleased_) throw Error(ErrorKind::Input, "the sub-triangle records were freed after one deformation (DeformOptions::once)");
   SubTrianglePreImages P;
   P.parent.reserve(subCount_);
   P.lam.reserve(9 * subCount_);
-  std::vector<uint32_t> headers;
+  for (size_t ci = 0; ci < chunks_.size(); ++ci) appendPreImages(ci, P);
+  return P;
+}
+
+void DeformSession::appendPreImages(size_t ci, SubTrianglePreImages& P) {
+  const Chunk& c = chunks_[ci];
+  if (!c.count) return;
+  std::vector<uint32_t> headers(4 * c.count);
   auto load = [&](auto& records) {   // one chunk's records at a time, as the device holds them
-    for (size_t ci = 0; ci < chunks_.size(); ++ci) {
-      const Chunk& c = chunks_[ci];
-      if (!c.count) continue;
-      headers.resize(4 * c.count);
-      resizeHuge(records, c.count * SFFD_SUB_STRIDE * 4);
-      backend_.download(impl_->chunkBuffers[ci].headers, 0, headers.data(), c.count * 16);
-      backend_.download(impl_->chunkBuffers[ci].records, 0, records.data(), records.size() * sizeof(records[0]));
-      P.append(headers.data(), records.data(), c.count);
-    }
+    resizeHuge(records, c.count * SFFD_SUB_STRIDE * 4);
+    backend_.download(impl_->chunkBuffers[ci].headers, 0, headers.data(), c.count * 16);
+    backend_.download(impl_->chunkBuffers[ci].records, 0, records.data(), records.size() * sizeof(records[0]));
+    P.append(headers.data(), records.data(), c.count);
   };
   std::vector<float> f;
   std::vector<double> d;
   options_.variant.f64 ? load(d) : load(f);
-  return P;
 }
 
 SmoothOutput DeformSession::output() {

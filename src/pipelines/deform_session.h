@@ -11,6 +11,7 @@
 #pragma once
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -87,8 +88,9 @@ class DeformSession {
   SubTriangleRecords records();
   SubTrianglePreImages preImages();   // what of the records the patch vertices need, a chunk at a time
   SmoothOutput output();
-  // With options().once: frees the sub-triangle records (after deform() and preImages(); deform() and
-  // records() then throw), and one chunk's output (after it was read; the chunk's output() too).
+  // With options().once, deform() reads each chunk's pre-images once it ran and frees its records (a second
+  // deform() and records() then throw; preImages() hands over what was read, once). releaseRecords() frees
+  // whatever records are left, releaseOutput() one chunk's output (after it was read; output() then throws).
   void releaseRecords();
   void releaseOutput(size_t chunk);
 
@@ -101,6 +103,8 @@ class DeformSession {
   std::vector<Chunk> chunks_;
   size_t subCount_ = 0;
   bool inputsReleased_ = false, recordsReleased_ = false;
+  std::optional<SubTrianglePreImages> takenPreImages_;   // once: read by deform() as each chunk's records went
+  void appendPreImages(size_t chunk, SubTrianglePreImages& to);
   void requireOnce() const;
   SessionTimings timings_;
 };

@@ -67,7 +67,8 @@ class AccurateRun final : public MethodRun {
   }
 
   void deform(const Lattice& lattice, Timings& t, const ProgressReporter& progress) override {
-    if (once_ && taken_) throw Error(ErrorKind::Input, "the outputs were freed after one deformation (DeformOptions::once)");
+    if (once_ && deformed_) throw Error(ErrorKind::Input, "a one-shot Deformer deforms once (DeformOptions::once)");
+    deformed_ = true;
     const auto t0 = std::chrono::steady_clock::now();
     PackedLattice packed = packLattice(lattice);
     std::vector<unsigned char> coeffs = realBytes(packed.coeffs, variant_.f64);
@@ -202,7 +203,7 @@ class AccurateRun final : public MethodRun {
   BufferId frameBuffer_ = 0, coeffs_ = 0, scratch_ = 0;
   uint32_t patchesAt_ = 0;   // the first control point in scratch_, after the samples
   mutable std::vector<Chunk> chunks_;   // mutable: a one-shot run frees their buffers as they are read
-  bool once_ = false;
+  bool once_ = false, deformed_ = false;
   mutable bool taken_ = false;   // a result was taken (DeformOptions::once allows one)
 };
 

@@ -141,7 +141,10 @@ class Key3Map {
 // both sides, so the bits agree), a point inside the parent by the parent and its barycentrics.
 class Locations {
  public:
-  explicit Locations(size_t patches, int level) : other_(patches * 3 * size_t(level) / 2) {}
+  // Keys expected: a patch's 3 (level - 1) edge points, each shared by two patches, and about one corner a
+  // patch off the input's corners (where a parent is split). The table holds twice as many slots (32 B each,
+  // all touched: at 1 M patches of level 3, 8 M slots), and grows if a mesh has more.
+  explicit Locations(size_t patches, int level) : other_(patches * (3 * size_t(level) - 1) / 2) {}
   static constexpr uint32_t kNone = ~0u;
 
   // The slot that holds the location of the vertex at pre-image `lam` of a patch of `parent`, whose
