@@ -1,6 +1,7 @@
 // sffd deform MESH -l LATTICE -o OUT: deforms a mesh and writes the result with vertex normals.
 #include <chrono>
 #include <cstdio>
+#include <memory>
 #include <optional>
 #include <utility>
 
@@ -55,12 +56,24 @@ int run(const ParsedArgs& args) {
   const double readMs = lap();
   Device device = openDeviceFromArgs(args);
   const double openMs = lap();
-  DeformRun run = runDeformJob(args, job, device);
+  // Smooth and accurate results go to a .ply or .stl as they are welded (MeshFileWriter), never held whole
+  // (--patches reads the Deformer again afterwards: then the result is taken as before).
+  const bool streamed = methodOf(args.get("--method", "smooth")) != Method::Classic && !args.has("--patches") &&
+                        MeshFileWriter::streams(out, {.binary = args.has("--binary")}, !job.mesh.colors.empty());
+  std::unique_ptr<MeshFileWriter> writer;
+  auto writerFor = [&](const Deformer& d) -> MeshSink& {
+    writer = std::make_unique<MeshFileWriter>(out, MeshWriteOptions{.significantDigits = outputDigits(d), .binary = args.has("--binary")});
+    return *writer;
+  };
+  DeformRun run = runDeformJob(args, job, device, streamed ? SinkFor(writerFor) : SinkFor());
   const double checksMs = lap() - run.prepareMs - run.deformMs - run.resultMs;   // the lattice's fold, knot and coverage checks
   const Timings& t = run.deformer.timings();
-  Mesh& deformed = run.mesh;
-  writeMesh(out, deformed, MeshWriteOptions{.significantDigits = outputDigits(run.deformer), .binary = args.has("--binary")});
+  const Mesh& deformed = run.mesh;
+  if (!streamed)
+    writeMesh(out, deformed, MeshWriteOptions{.significantDigits = outputDigits(run.deformer), .binary = args.has("--binary")});
   const double writeMs = lap();
+  const size_t outVertices = streamed ? writer->vertexCount() : deformed.positions.size();
+  const size_t outTriangles = streamed ? writer->triangleCount() : deformed.triangles.size();
   if (args.has("--patches")) {
     std::vector<double> controlPoints = run.deformer.patchControlPoints();
     if (controlPoints.empty()) throw Error(ErrorKind::Input, "--patches needs --method smooth");
@@ -78,7 +91,7 @@ int run(const ParsedArgs& args) {
         {"strict", args.has("--strict")},
         {"input", {{"vertices", job.mesh.positions.size()}, {"triangles", job.mesh.triangles.size()}}},
         {"sub_triangles", run.deformer.subTriangles()},
-        {"output", {{"vertices", deformed.positions.size()}, {"triangles", deformed.triangles.size()}}},
+        {"output", {{"vertices", outVertices}, {"triangles", outTriangles}}},
         {"timings_ms", {{"pn", t.pnMs}, {"clip", t.clipMs}, {"deform", t.deformMs}, {"total", totalMs}}},
         // Where the whole run's wall time goes (docs/PERFORMANCE.md "The whole process"): the inputs read,
         // the device opened, the lattice checked, the Deformer made (pre-compute), deformed, its result taken (download,
@@ -101,7 +114,7 @@ int run(const ParsedArgs& args) {
     std::string text = j.dump(1) + "\n";
     writeFileAtomically(args.get("--stats"), [&](std::ostream& o) { o << text; });
   }
-  note(args, "wrote " + out + " (" + std::to_string(deformed.triangles.size()) + " triangles, " + device.label() + ", " +
+  note(args, "wrote " + out + " (" + std::to_string(outTriangles) + " triangles, " + device.label() + ", " +
                  device.info().name + ")");
   return 0;
 }

@@ -64,8 +64,9 @@ std::optional<PatchVertices> DeformRun::patches() {
   return p;
 }
 
-DeformRun runMethod(const ParsedArgs& args, Job& job, Device& device, Method method) {
+DeformRun runMethod(const ParsedArgs& args, Job& job, Device& device, Method method, const SinkFor& sinkFor) {
   DeformOptions o = deformOptionsOf(args, job, device, method);
+  o.once = bool(sinkFor);   // one deformation, its result streamed once: buffers freed as they are read
   auto line = std::make_shared<ProgressLine>(progressWanted(args));   // cleared also when a call throws
   o.progress = line->callback();
   auto make = [&] { return withToolLimitName([&] { return Deformer(device, job.mesh, job.lattice, o); }); };
@@ -79,18 +80,19 @@ DeformRun runMethod(const ParsedArgs& args, Job& job, Device& device, Method met
   run.prepareMs = lap();
   run.deformer.deform(job.lattice);
   run.deformMs = lap();
-  run.mesh = run.deformer.result();
+  if (sinkFor) run.deformer.streamResult(sinkFor(run.deformer));
+  else run.mesh = run.deformer.result();
   run.resultMs = lap();
   line->clear();
   if (method == Method::Smooth) job.mesh = run.deformer.internal().input;
   return run;
 }
 
-DeformRun runDeformJob(const ParsedArgs& args, Job& job, Device& device) {
+DeformRun runDeformJob(const ParsedArgs& args, Job& job, Device& device, const SinkFor& sinkFor) {
   const std::string warnings[] = {foldWarning(checkLatticeFold(packLattice(job.lattice)), job.latticePath),
                                   discontinuityWarning(job.lattice, job.latticePath),
                                   outsideWarning(shareOutsideLattice(job.mesh, job.lattice), job.lattice, job.latticePath)};
-  DeformRun run = runMethod(args, job, device, methodOf(args.get("--method", "smooth")));
+  DeformRun run = runMethod(args, job, device, methodOf(args.get("--method", "smooth")), sinkFor);
   for (const std::string& w : warnings)
     if (!w.empty()) warnOnSuccess(w);
   return run;

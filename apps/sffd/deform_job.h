@@ -1,6 +1,7 @@
 // Running one deformation as the options say, through sffd::Deformer: the part of `sffd deform`
 // that `render`, `error` and `view` share.
 #pragma once
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -26,7 +27,7 @@ struct DeformRun {
   std::string method, clip;   // as the stats and messages name them
   std::shared_ptr<ProgressLine> line;   // what the Deformer's progress callback draws on
   Deformer deformer;
-  Mesh mesh;                  // the result as `deform` writes it
+  Mesh mesh;                  // the result as `deform` writes it (empty when streamed)
   // Wall times of the host phases: the Deformer made (pre-compute included), deform() (the kernels and
   // their waits), result() (download, weld, the move back from local coordinates).
   double prepareMs = 0, deformMs = 0, resultMs = 0;
@@ -37,7 +38,12 @@ struct DeformRun {
 // A Deformer for the job on `device`, deformed once. For smooth, job.mesh becomes the mesh as the
 // method used it (creases split): the pre-images index its triangles. A progress line on stderr shows
 // how far it is (progress_line.h).
-DeformRun runMethod(const ParsedArgs& args, Job& job, Device& device, Method method);
+// Where to stream a result (Deformer::streamResult), asked once the Deformer is made (the writer's digits
+// depend on it); empty: the result is kept in DeformRun::mesh.
+using SinkFor = std::function<MeshSink&(const Deformer&)>;
+// With `sinkFor`, the result is streamed instead of kept (DeformRun::mesh stays empty), and the Deformer is
+// made for one deformation (DeformOptions::once).
+DeformRun runMethod(const ParsedArgs& args, Job& job, Device& device, Method method, const SinkFor& sinkFor = {});
 // Round-trip digits of the results when written as text: 9 for float, 17 for double, or for float
 // results computed around a local origin away from 0 (their float bits are relative to it,
 // docs/ROBUSTNESS.md).
@@ -45,7 +51,7 @@ int outputDigits(const Deformer& deformer);
 
 // runMethod for --method, then the lattice's fold warning (after the work, so a job that fails prints
 // its one error line only; shown even with --quiet: it is about the result).
-DeformRun runDeformJob(const ParsedArgs& args, Job& job, Device& device);
+DeformRun runDeformJob(const ParsedArgs& args, Job& job, Device& device, const SinkFor& sinkFor = {});
 
 // --edge-length, or a tenth of the mesh's largest extent (the reference implementation's l = 0.2 for
 // models in [-1, 1]).

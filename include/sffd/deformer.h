@@ -59,6 +59,11 @@ struct DeformOptions {
   uint64_t memoryLimit = 0;      // bytes of host memory a job may plan for (every method); 0: physical memory
   size_t maxChunkElements = 0;   // 0: chunks as large as the device allows (smaller only to test chunking)
   ProgressCallback progress;     // called during long work; may be empty
+  // A one-shot job, deformed and its result taken once (as `sffd deform` does): what only a repeated call
+  // needs is freed as soon as it is used (smooth: the pre-compute's inputs once it ran, the sub-triangle
+  // records as each chunk is deformed; smooth and accurate: each chunk's output once read), so a large job's
+  // peak memory is lower. A second deform(), or a second result() or streamResult(), throws an input Error.
+  bool once = false;
 };
 
 // Times of the last call. GPU time where the device measures it, else host wall time.
@@ -97,6 +102,14 @@ class Deformer {
   // boundary vertices welded (a closed input gives a closed output); Classic, the input's vertices
   // moved, their normals mapped, its topology kept. Downloaded on each call.
   Mesh result() const;
+  // result() handed to `sink` in pieces as it is made (MeshSink, <sffd/mesh.h>: begin(), the pieces, end()),
+  // for a result too large to hold twice: Smooth and Accurate weld each chunk as it is downloaded and hand
+  // over its vertices and triangles, keeping only what later chunks weld against; Classic hands over its
+  // result in one piece. The pieces appended are result(), bit for bit. With sffd::MeshFileWriter the
+  // result goes to a file as writeMesh would write it:
+  //   sffd::MeshFileWriter out("big.ply", {.binary = true});
+  //   deformer.streamResult(out);
+  void streamResult(MeshSink& sink) const;
   // Smooth: per sub-triangle 20 control points (x, y, z, 0) x 4 doubles: 10 of the geometry patch,
   // then 10 of the normal patch, in the order docs/METHOD.md gives (what `deform --patches` writes).
   std::vector<double> patchControlPoints() const;

@@ -9,6 +9,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -112,5 +113,47 @@ struct MeshWriteOptions {
 // colour factor and texture URI.
 void writeMesh(const std::string& path, const Mesh& mesh, int significantDigits = 9);
 void writeMesh(const std::string& path, const Mesh& mesh, const MeshWriteOptions& options);
+
+// A receiver of a mesh in pieces, for results too large to hold whole (Deformer::streamResult): begin()
+// once with a Mesh that has the tables (materials, groups, materialLibraries) and flags (weldIdIsLocation,
+// normalsFromFile) but no vertices; add() for each piece in order; end() once after the last. A piece's
+// vertices (positions and the per-vertex fields the mesh has) follow those of the pieces before:
+// piece.positions[i] is vertex firstVertex + i. Its triangles (with their triangleMaterial and
+// triangleGroup when the mesh has them) index any vertex given so far, its own included. The pieces'
+// vertices and triangles, appended in order, are the whole mesh. An exception from a sink stops the stream.
+class MeshSink {
+ public:
+  virtual ~MeshSink() = default;
+  virtual void begin(const Mesh& tables) { (void)tables; }
+  virtual void add(const Mesh& piece, size_t firstVertex) = 0;
+  virtual void end() {}
+};
+
+// A MeshSink that writes the file writeMesh(path, mesh, options) writes, byte for byte: .ply (binary and
+// text, without colours) and .stl as the pieces come, holding none of the mesh but what STL's facet normals
+// need (positions, normals); a .ply's vertices and faces go to hidden temporary files beside the output,
+// joined after its header at end(). Other formats, and .ply with colours (whose header depends on the last
+// vertex's alpha), are gathered and written at end(). The file appears at end(), whole; a writer destroyed
+// before (an exception) leaves nothing. Throws as writeMesh does: an input Error for a format it cannot write
+// or a non-finite vertex, which stops the stream.
+class MeshFileWriter final : public MeshSink {
+ public:
+  explicit MeshFileWriter(const std::string& path, const MeshWriteOptions& options = {});
+  ~MeshFileWriter() override;
+  MeshFileWriter(const MeshFileWriter&) = delete;
+  MeshFileWriter& operator=(const MeshFileWriter&) = delete;
+  void begin(const Mesh& tables) override;
+  void add(const Mesh& piece, size_t firstVertex) override;
+  void end() override;
+  size_t vertexCount() const;     // given so far
+  size_t triangleCount() const;
+  // Whether a file of this name and these options is written as the pieces come (not gathered), for a
+  // mesh with colours or without.
+  static bool streams(const std::string& path, const MeshWriteOptions& options, bool colors = false);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 }  // namespace sffd

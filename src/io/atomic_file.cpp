@@ -1,5 +1,6 @@
 #include "io/atomic_file.h"
 
+#include <atomic>
 #include <csignal>
 #include <cerrno>
 #include <cstdio>
@@ -81,13 +82,16 @@ class TemporaryGuard {
 std::string temporaryBeside(const std::string& path) {
   fs::path p(path);
   std::random_device rd;
-  std::string name = "." + p.filename().string() + ".tmp" + std::to_string(::getpid()) + "_" + std::to_string(rd() % 1000000);
+  // The count keeps several temporaries of one target apart within a process (MeshFileWriter's scratch files).
+  static std::atomic<unsigned> count{0};
+  std::string name = "." + p.filename().string() + ".tmp" + std::to_string(::getpid()) + "_" + std::to_string(rd() % 1000000) +
+                     "_" + std::to_string(count++);
   // Keep the extension last: writers that dispatch on it (OpenMesh) still see it.
   name += p.extension().string();
   return (p.parent_path() / name).string();
 }
 
-void commit(const std::string& tmp, const std::string& path) {
+void renameInto(const std::string& tmp, const std::string& path) {
   if (std::rename(tmp.c_str(), path.c_str()) != 0) {
     int e = errno;
     std::remove(tmp.c_str());
@@ -115,7 +119,7 @@ void writePathAtomically(const std::string& path, const std::function<void(const
     std::remove(tmp.c_str());
     throw Error(ErrorKind::Internal, path + ": writer produced no data");
   }
-  commit(tmp, path);
+  renameInto(tmp, path);
 }
 
 void writeFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write, bool binary) {
@@ -126,6 +130,39 @@ void writeFileAtomically(const std::string& path, const std::function<void(std::
     out.flush();
     if (!out) throw inputError(path, 0, "cannot write: write failed (disk full?)");
   });
+}
+
+struct AtomicFile::Impl {
+  std::string path, tmp;
+  TemporaryGuard guard;   // registered before the file exists, released after rename or removal
+  std::ofstream out;
+  bool committed = false;
+  Impl(const std::string& p, std::string t) : path(p), tmp(std::move(t)), guard(tmp) {}
+};
+
+AtomicFile::AtomicFile(const std::string& path, bool binary) {
+  if (fs::is_directory(path)) throw inputError(path, 0, "cannot write: is a directory");
+  impl_ = std::make_unique<Impl>(path, temporaryBeside(path));
+  impl_->out.open(impl_->tmp, binary ? std::ios::binary | std::ios::trunc : std::ios::trunc);
+  if (!impl_->out) throw inputError(path, 0, std::string("cannot write: ") + std::strerror(errno));
+}
+
+AtomicFile::~AtomicFile() {
+  if (impl_->committed) return;
+  impl_->out.close();
+  std::remove(impl_->tmp.c_str());
+}
+
+std::ostream& AtomicFile::stream() { return impl_->out; }
+const std::string& AtomicFile::temporaryPath() const { return impl_->tmp; }
+
+void AtomicFile::commit() {
+  impl_->out.flush();
+  if (!impl_->out) throw inputError(impl_->path, 0, "cannot write: write failed (disk full?)");
+  impl_->out.close();
+  if (!impl_->out) throw inputError(impl_->path, 0, "cannot write: write failed (disk full?)");
+  impl_->committed = true;
+  renameInto(impl_->tmp, impl_->path);   // removes the temporary file itself when the rename fails
 }
 
 }  // namespace sffd

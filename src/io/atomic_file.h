@@ -1,6 +1,7 @@
 // Output files appear whole or not at all: written to a temporary file beside the target, then renamed.
 #pragma once
 #include <functional>
+#include <memory>
 #include <ostream>
 #include <string>
 
@@ -14,5 +15,25 @@ void writeFileAtomically(const std::string& path, const std::function<void(std::
 
 // For writers that need a file name (OpenMesh): the temporary path is passed to write(tmpPath).
 void writePathAtomically(const std::string& path, const std::function<void(const std::string&)>& write);
+
+// The same for a writer that is handed its data in pieces: the temporary file is opened by the constructor
+// (an input Error for an unwritable path, as above), written through stream(), and renamed to `path` by
+// commit(); destroyed uncommitted (an exception), it is removed. Never committed, it is a scratch file
+// beside `path` (readable at temporaryPath() once flushed) that goes with the object.
+class AtomicFile {
+ public:
+  explicit AtomicFile(const std::string& path, bool binary = true);
+  ~AtomicFile();
+  AtomicFile(const AtomicFile&) = delete;
+  AtomicFile& operator=(const AtomicFile&) = delete;
+  std::ostream& stream();
+  const std::string& temporaryPath() const;
+  // Flushes and checks the stream (an input Error for a failed write, e.g. a full disk), then renames.
+  void commit();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 }  // namespace sffd

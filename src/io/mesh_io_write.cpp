@@ -14,6 +14,7 @@
 #include "io/gltf_io.h"
 #include "io/io_util.h"
 #include "io/mesh_io_internal.h"
+#include "io/mesh_write_records.h"
 
 namespace sffd {
 namespace {
@@ -66,18 +67,139 @@ void appendReal(std::string& s, double v, bool f64) {
 
 uint8_t colorByte(double c) { return uint8_t(std::lround(std::clamp(c, 0.0, 1.0) * 255.0)); }
 
-struct Carried {
-  bool normals = false, texcoords = false, colors = false, alpha = false;
-};
+}  // namespace
 
-Carried checkWritable(const std::string& path, const Mesh& mesh) {
+namespace meshio {
+
+void checkFiniteVertex(const std::string& path, size_t v, const glm::dvec3& position, const glm::dvec3* normal) {
+  auto finite = [](const glm::dvec3& x) { return std::isfinite(x.x) && std::isfinite(x.y) && std::isfinite(x.z); };
+  if (finite(position) && (!normal || finite(*normal))) return;
+  throw Error(ErrorKind::Input, path + ": not written: vertex " + std::to_string(v) + " of the result has a " +
+                                    (finite(position) ? "non-finite normal" : "non-finite position") +
+                                    " (the lattice moves it beyond the floating-point range of the computation)");
+}
+
+std::string plyHeader(size_t vertices, size_t faces, int digits, const Carried& has, bool binary) {
+  const char* type = digits > 9 ? "double" : "float";
+  std::string s = binary ? "ply\nformat binary_little_endian 1.0\n" : "ply\nformat ascii 1.0\n";
+  s += "comment written by sffd\n";
+  s += "element vertex " + std::to_string(vertices) + "\n";
+  auto properties = [&](std::initializer_list<const char*> names, const char* t) {
+    for (const char* c : names) s += std::string("property ") + t + " " + c + "\n";
+  };
+  properties({"x", "y", "z"}, type);
+  if (has.normals) properties({"nx", "ny", "nz"}, type);
+  if (has.texcoords) properties({"u", "v"}, type);
+  if (has.colors) properties({"red", "green", "blue"}, "uchar");
+  if (has.alpha) properties({"alpha"}, "uchar");
+  s += "element face " + std::to_string(faces) + "\n";
+  s += "property list uchar int vertex_indices\nend_header\n";
+  return s;
+}
+
+void appendPlyVertex(std::string& s, const Mesh& mesh, size_t v, int digits, const Carried& has, bool binary) {
+  const bool f64 = digits > 9;
+  const int colorChannels = has.alpha ? 4 : 3;
+  if (binary) {
+    for (int c = 0; c < 3; ++c) appendReal(s, mesh.positions[v][c], f64);
+    if (has.normals)
+      for (int c = 0; c < 3; ++c) appendReal(s, mesh.normals[v][c], f64);
+    if (has.texcoords)
+      for (int c = 0; c < 2; ++c) appendReal(s, mesh.texcoords[v][c], f64);
+    if (has.colors)
+      for (int c = 0; c < colorChannels; ++c) appendRaw(s, colorByte(mesh.colors[v][c]));
+    return;
+  }
+  appendVec(s, mesh.positions[v], digits);
+  if (has.normals) {
+    s += ' ';
+    appendVec(s, mesh.normals[v], digits);
+  }
+  for (int c = 0; has.texcoords && c < 2; ++c) {
+    s += ' ';
+    io::appendNumber(s, mesh.texcoords[v][c], digits);
+  }
+  for (int c = 0; has.colors && c < colorChannels; ++c) {
+    s += ' ';
+    appendIndex(s, colorByte(mesh.colors[v][c]));
+  }
+  s += '\n';
+}
+
+void appendPlyFace(std::string& s, const std::array<uint32_t, 3>& t, bool binary) {
+  if (binary) {
+    appendRaw(s, uint8_t(3));
+    for (uint32_t i : t) appendRaw(s, int32_t(i));
+    return;
+  }
+  s += '3';
+  for (uint32_t i : t) {
+    s += ' ';
+    appendIndex(s, i);
+  }
+  s += '\n';
+}
+
+std::string stlHeader(bool binary, size_t triangles) {
+  if (!binary) return "solid sffd\n";
+  std::string header = "binary STL written by sffd";   // not "solid ...": readers would take it for text
+  header.resize(80, ' ');
+  appendRaw(header, uint32_t(triangles));
+  return header;
+}
+
+std::string stlFooter(bool binary) { return binary ? "" : "endsolid sffd\n"; }
+
+namespace {
+// The facet normal STL stores: the geometric one, or the mean vertex normal for a degenerate triangle.
+glm::dvec3 facetNormal(const Mesh& mesh, const std::array<uint32_t, 3>& t, bool withNormals) {
+  const glm::dvec3& a = mesh.positions[t[0]];
+  glm::dvec3 fn = glm::cross(mesh.positions[t[1]] - a, mesh.positions[t[2]] - a);
+  double len = glm::length(fn);
+  if (len > 0 && std::isfinite(len)) return fn / len;
+  if (!withNormals) return glm::dvec3(0.0);
+  fn = mesh.normals[t[0]] + mesh.normals[t[1]] + mesh.normals[t[2]];
+  len = glm::length(fn);
+  return (len > 0 && std::isfinite(len)) ? fn / len : glm::dvec3(0.0);
+}
+}  // namespace
+
+void appendStlFacet(std::string& s, const Mesh& mesh, const std::array<uint32_t, 3>& t, bool withNormals, int digits,
+                    bool binary) {
+  if (binary) {
+    auto vec = [&](const glm::dvec3& v) {
+      for (int c = 0; c < 3; ++c) appendRaw(s, float(v[c]));
+    };
+    vec(facetNormal(mesh, t, withNormals));
+    for (uint32_t i : t) vec(mesh.positions[i]);
+    appendRaw(s, uint16_t(0));   // attribute byte count
+    return;
+  }
+  // Text, so that coordinates keep `digits` digits.
+  s += "  facet normal ";
+  appendVec(s, facetNormal(mesh, t, withNormals), digits);
+  s += "\n    outer loop\n";
+  for (uint32_t i : t) {
+    s += "      vertex ";
+    appendVec(s, mesh.positions[i], digits);
+    s += '\n';
+  }
+  s += "    endloop\n  endfacet\n";
+}
+
+}  // namespace meshio
+
+namespace {
+using namespace meshio;
+
+meshio::Carried checkWritable(const std::string& path, const Mesh& mesh) {
   const size_t n = mesh.positions.size();
   auto sized = [&](size_t count, const char* what) {
     if (count != 0 && count != n)
       throw Error(ErrorKind::Internal, path + ": mesh has " + std::to_string(count) + " " + what + " for " + std::to_string(n) + " vertices");
     return count != 0;
   };
-  Carried c;
+  meshio::Carried c;
   c.normals = sized(mesh.normals.size(), "normals");
   c.texcoords = sized(mesh.texcoords.size(), "texture coordinates");
   c.colors = sized(mesh.colors.size(), "colours");
@@ -95,12 +217,7 @@ Carried checkWritable(const std::string& path, const Mesh& mesh) {
   perTriangle(mesh.triangleGroup, mesh.groups.size(), "groups");
   // A lattice that sends points beyond the floating-point range gives inf or NaN: refuse to write a
   // file of them, and say where (the lattice is the input at fault, so this is an input error).
-  auto finite = [](const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
-  for (size_t v = 0; v < n; ++v)
-    if (!finite(mesh.positions[v]) || (c.normals && !finite(mesh.normals[v])))
-      throw Error(ErrorKind::Input, path + ": not written: vertex " + std::to_string(v) + " of the result has a " +
-                                        (finite(mesh.positions[v]) ? "non-finite normal" : "non-finite position") +
-                                        " (the lattice moves it beyond the floating-point range of the computation)");
+  for (size_t v = 0; v < n; ++v) checkFiniteVertex(path, v, mesh.positions[v], c.normals ? &mesh.normals[v] : nullptr);
   return c;
 }
 
@@ -191,63 +308,15 @@ void writeObj(std::ostream& os, const Mesh& mesh, int digits, const Carried& has
 }
 
 void writePly(std::ostream& os, const Mesh& mesh, int digits, const Carried& has, bool binary) {
-  const bool f64 = digits > 9;
-  const char* type = f64 ? "double" : "float";
   ChunkedWriter w(os);
   std::string& s = w.buf();
-  s += binary ? "ply\nformat binary_little_endian 1.0\n" : "ply\nformat ascii 1.0\n";
-  s += "comment written by sffd\n";
-  s += "element vertex " + std::to_string(mesh.positions.size()) + "\n";
-  auto properties = [&](std::initializer_list<const char*> names, const char* t) {
-    for (const char* c : names) s += std::string("property ") + t + " " + c + "\n";
-  };
-  properties({"x", "y", "z"}, type);
-  if (has.normals) properties({"nx", "ny", "nz"}, type);
-  if (has.texcoords) properties({"u", "v"}, type);
-  if (has.colors) properties({"red", "green", "blue"}, "uchar");
-  if (has.alpha) properties({"alpha"}, "uchar");
-  s += "element face " + std::to_string(mesh.triangles.size()) + "\n";
-  s += "property list uchar int vertex_indices\nend_header\n";
-  const int colorChannels = has.alpha ? 4 : 3;
+  s += plyHeader(mesh.positions.size(), mesh.triangles.size(), digits, has, binary);
   for (size_t v = 0; v < mesh.positions.size(); ++v) {
-    if (binary) {
-      for (int c = 0; c < 3; ++c) appendReal(s, mesh.positions[v][c], f64);
-      if (has.normals)
-        for (int c = 0; c < 3; ++c) appendReal(s, mesh.normals[v][c], f64);
-      if (has.texcoords)
-        for (int c = 0; c < 2; ++c) appendReal(s, mesh.texcoords[v][c], f64);
-      if (has.colors)
-        for (int c = 0; c < colorChannels; ++c) appendRaw(s, colorByte(mesh.colors[v][c]));
-    } else {
-      appendVec(s, mesh.positions[v], digits);
-      if (has.normals) {
-        s += ' ';
-        appendVec(s, mesh.normals[v], digits);
-      }
-      for (int c = 0; has.texcoords && c < 2; ++c) {
-        s += ' ';
-        io::appendNumber(s, mesh.texcoords[v][c], digits);
-      }
-      for (int c = 0; has.colors && c < colorChannels; ++c) {
-        s += ' ';
-        appendIndex(s, colorByte(mesh.colors[v][c]));
-      }
-      s += '\n';
-    }
+    appendPlyVertex(s, mesh, v, digits, has, binary);
     w.maybeFlush();
   }
   for (const auto& t : mesh.triangles) {
-    if (binary) {
-      appendRaw(s, uint8_t(3));
-      for (uint32_t i : t) appendRaw(s, int32_t(i));
-    } else {
-      s += '3';
-      for (uint32_t i : t) {
-        s += ' ';
-        appendIndex(s, i);
-      }
-      s += '\n';
-    }
+    appendPlyFace(s, t, binary);
     w.maybeFlush();
   }
   w.flush();
@@ -280,56 +349,16 @@ void writeOff(std::ostream& os, const Mesh& mesh, int digits) {
   w.flush();
 }
 
-// The facet normal STL stores: the geometric one, or the mean vertex normal for a degenerate triangle.
-glm::dvec3 facetNormal(const Mesh& mesh, const std::array<uint32_t, 3>& t, bool withNormals) {
-  const glm::dvec3& a = mesh.positions[t[0]];
-  glm::dvec3 fn = glm::cross(mesh.positions[t[1]] - a, mesh.positions[t[2]] - a);
-  double len = glm::length(fn);
-  if (len > 0 && std::isfinite(len)) return fn / len;
-  if (!withNormals) return glm::dvec3(0.0);
-  fn = mesh.normals[t[0]] + mesh.normals[t[1]] + mesh.normals[t[2]];
-  len = glm::length(fn);
-  return (len > 0 && std::isfinite(len)) ? fn / len : glm::dvec3(0.0);
-}
-
-void writeStl(std::ostream& os, const Mesh& mesh, int digits, bool withNormals) {
-  // ASCII STL, so that coordinates keep `digits` digits.
+void writeStl(std::ostream& os, const Mesh& mesh, int digits, bool withNormals, bool binary) {
+  if (binary && mesh.triangles.size() > 0xFFFFFFFFull) throw Error(ErrorKind::Input, "binary STL holds at most 2^32 - 1 triangles");
   ChunkedWriter w(os);
   std::string& s = w.buf();
-  s += "solid sffd\n";
+  s += stlHeader(binary, mesh.triangles.size());
   for (const auto& t : mesh.triangles) {
-    s += "  facet normal ";
-    appendVec(s, facetNormal(mesh, t, withNormals), digits);
-    s += "\n    outer loop\n";
-    for (uint32_t i : t) {
-      s += "      vertex ";
-      appendVec(s, mesh.positions[i], digits);
-      s += '\n';
-    }
-    s += "    endloop\n  endfacet\n";
+    appendStlFacet(s, mesh, t, withNormals, digits, binary);
     w.maybeFlush();
   }
-  s += "endsolid sffd\n";
-  w.flush();
-}
-
-void writeStlBinary(std::ostream& os, const Mesh& mesh, bool withNormals) {
-  if (mesh.triangles.size() > 0xFFFFFFFFull) throw Error(ErrorKind::Input, "binary STL holds at most 2^32 - 1 triangles");
-  ChunkedWriter w(os);
-  std::string& s = w.buf();
-  std::string header = "binary STL written by sffd";   // not "solid ...": readers would take it for text
-  header.resize(80, ' ');
-  s += header;
-  appendRaw(s, uint32_t(mesh.triangles.size()));
-  auto vec = [&](const glm::dvec3& v) {
-    for (int c = 0; c < 3; ++c) appendRaw(s, float(v[c]));
-  };
-  for (const auto& t : mesh.triangles) {
-    vec(facetNormal(mesh, t, withNormals));
-    for (uint32_t i : t) vec(mesh.positions[i]);
-    appendRaw(s, uint16_t(0));   // attribute byte count
-    w.maybeFlush();
-  }
+  s += stlFooter(binary);
   w.flush();
 }
 
@@ -339,7 +368,7 @@ void writeMesh(const std::string& path, const Mesh& mesh, int significantDigits)
   writeMesh(path, mesh, MeshWriteOptions{significantDigits, false});
 }
 
-void writeMesh(const std::string& path, const Mesh& mesh, const MeshWriteOptions& options) {
+std::string meshio::checkWriteTarget(const std::string& path, const MeshWriteOptions& options) {
   const std::string ext = io::lowerExtension(path);
   const bool gltf = ext == ".gltf" || ext == ".glb";
   if (ext != ".obj" && ext != ".ply" && ext != ".off" && ext != ".stl" && !gltf)
@@ -348,8 +377,15 @@ void writeMesh(const std::string& path, const Mesh& mesh, const MeshWriteOptions
                          "; expected .obj, .ply, .off, .stl, .gltf or .glb");
   if (options.binary && ext != ".ply" && ext != ".stl")
     throw inputError(path, 0, "binary output is for .ply and .stl (.glb is binary glTF), not " + io::quoted(ext));
+  if (options.significantDigits < 1 || options.significantDigits > 17)
+    throw Error(ErrorKind::Internal, "writeMesh: significant digits must be 1..17");
+  return ext;
+}
+
+void writeMesh(const std::string& path, const Mesh& mesh, const MeshWriteOptions& options) {
+  const std::string ext = meshio::checkWriteTarget(path, options);
+  const bool gltf = ext == ".gltf" || ext == ".glb";
   const int digits = options.significantDigits;
-  if (digits < 1 || digits > 17) throw Error(ErrorKind::Internal, "writeMesh: significant digits must be 1..17");
   const Carried has = checkWritable(path, mesh);
   if (gltf) return meshio::writeGltf(path, mesh);
   writeFileAtomically(
@@ -358,8 +394,7 @@ void writeMesh(const std::string& path, const Mesh& mesh, const MeshWriteOptions
         if (ext == ".obj") writeObj(os, mesh, digits, has);
         else if (ext == ".ply") writePly(os, mesh, digits, has, options.binary);
         else if (ext == ".off") writeOff(os, mesh, digits);
-        else if (options.binary) writeStlBinary(os, mesh, has.normals);
-        else writeStl(os, mesh, digits, has.normals);
+        else writeStl(os, mesh, digits, has.normals, options.binary);
       },
       true);
 }

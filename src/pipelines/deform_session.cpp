@@ -47,6 +47,13 @@ struct DeformSession::Impl {
     owned.push_back(id);
     return id;
   }
+  // Destroys an owned buffer and sets its id to 0 (0: already gone).
+  void drop(Backend& b, BufferId& id) {
+    if (!id) return;
+    b.destroyBuffer(id);
+    owned.erase(std::find(owned.begin(), owned.end(), id));
+    id = 0;
+  }
   BufferId upload(Backend& b, const void* data, uint64_t bytes) {
     BufferId id = make(b, bytes);
     if (bytes) b.upload(id, 0, data, bytes);
@@ -56,8 +63,13 @@ struct DeformSession::Impl {
 
 namespace {
 
+// The most bytes of reals a pre-compute chunk takes beyond its first parent: its range is built on the host
+// whole before the upload, so a large mesh in one chunk would hold its inputs twice (host and device) at once.
+constexpr uint64_t kPreChunkHostBytes = uint64_t(64) << 20;
+
 // The pre-compute's chunks: consecutive parents (and their clip triangles, which follow the parents'
-// order), as many to a chunk as keep both of its input ranges within one storage binding.
+// order), as many to a chunk as keep both of its input ranges within one storage binding, and its reals
+// within kPreChunkHostBytes.
 std::vector<ClipRanges> preChunks(const PreparedMesh& mesh, const ClipTriangles& clip, size_t realSize, uint64_t limit,
                                   size_t maxParents) {
   const uint64_t nv = mesh.positions.size() / 4, nt = mesh.triangleCount();
@@ -70,7 +82,7 @@ std::vector<ClipRanges> preChunks(const PreparedMesh& mesh, const ClipTriangles&
     for (uint64_t p1 = p0, c1 = c0; p1 < nt && (!maxParents || p1 - p0 < maxParents); ++p1) {
       while (c1 < ct.size() && ct[c1].parent == p1) ++c1;
       ClipRanges next = clipRanges(nv, p0, p1 + 1 - p0, c0, c1 - c0, realSize);
-      if (!fits(next)) break;
+      if (!fits(next) || (r.parents && next.byteOf(next.realElements) > kPreChunkHostBytes)) break;
       r = next;
     }
     if (!r.parents && p0 < nt) {
@@ -144,6 +156,25 @@ void DeformSession::prepare(const Mesh& input, const Lattice& lattice, const Sta
   I.frame = up(deformFrameRange(packed, I.fit.data));
   I.coeffs = up(packed.coeffs);
   precompute(progress);
+  if (options.once) {   // only a repeated precompute() reads them
+    for (Impl::PreChunk& c : I.pre) I.drop(backend, c.reals), I.drop(backend, c.words);
+    inputsReleased_ = true;
+  }
+}
+
+void DeformSession::requireOnce() const {
+  if (!options_.once) throw std::logic_error("DeformSession: release without options().once");
+}
+
+void DeformSession::releaseRecords() {
+  requireOnce();
+  for (Impl::ChunkBuffers& c : impl_->chunkBuffers) impl_->drop(backend_, c.headers), impl_->drop(backend_, c.records);
+  recordsReleased_ = true;
+}
+
+void DeformSession::releaseOutput(size_t chunk) {
+  requireOnce();
+  impl_->drop(backend_, chunks_.at(chunk).output);
 }
 
 size_t DeformSession::precomputeChunks() const { return impl_->pre.size(); }
@@ -169,6 +200,7 @@ void sumStages(SessionTimings& t) {
 }  // namespace
 
 const SessionTimings& DeformSession::precompute(const StageProgress& progress) {
+  if (inputsReleased_) throw Error(ErrorKind::Input, "the pre-compute's inputs were freed (DeformOptions::once)");
   Impl& I = *impl_;
   Backend& B = backend_;
   const DeviceLimits& lim = B.info().limits;
@@ -337,6 +369,7 @@ const SessionTimings& DeformSession::deform(const Lattice& lattice, const StageP
   Backend& B = backend_;
   if (!sameLatticeStructure(lattice, I.structure))
     throw Error(ErrorKind::Input, "the lattice's degrees, counts, knots or frame differ from the session's");
+  if (recordsReleased_) throw Error(ErrorKind::Input, "the sub-triangle records were freed after one deformation (DeformOptions::once)");
   auto t0 = std::chrono::steady_clock::now();
   timings_ = {};
   PackedLattice packed = packLattice(lattice);
@@ -349,9 +382,15 @@ const SessionTimings& DeformSession::deform(const Lattice& lattice, const StageP
     params.range = {0, uint32_t(c.count), uint32_t(I.fit.points), uint32_t(options_.level)};
     deformOutSections(params, c.count, options_.level, I.fit.points, options_.split);
     dispatchDeform(B, params, {I.coeffs, I.frame, I.chunkBuffers[ci].records, c.output}, c.count, options_.variant, options_.split);
+    if (options_.once) {   // one deformation: the records' pre-images read now, so each chunk's records go at once
+      if (!takenPreImages_) takenPreImages_.emplace(), takenPreImages_->parent.reserve(subCount_), takenPreImages_->lam.reserve(9 * subCount_);
+      appendPreImages(ci, *takenPreImages_);
+      I.drop(B, I.chunkBuffers[ci].headers), I.drop(B, I.chunkBuffers[ci].records);
+    }
     if (progress) progress("deform", double(ci + 1) / double(chunks_.size() + 1));
   }
   B.finish();
+  if (options_.once) recordsReleased_ = true;
   timings_.dispatches = B.takeTimings();
   sumStages(timings_);
   timings_.wallMs = msSince(t0);
@@ -360,6 +399,7 @@ const SessionTimings& DeformSession::deform(const Lattice& lattice, const StageP
 }
 
 SubTriangleRecords DeformSession::records() {
+  if (recordsReleased_) throw Error(ErrorKind::Input, "the sub-triangle records were freed after one deformation (DeformOptions::once)");
   SubTriangleRecords R;
   R.headers.resize(4 * subCount_);
   R.records.resize(subCount_ * SFFD_SUB_STRIDE * 4);
@@ -375,25 +415,32 @@ SubTriangleRecords DeformSession::records() {
 }
 
 SubTrianglePreImages DeformSession::preImages() {
+  if (takenPreImages_) {   // one deformation: read as deform() ran
+    SubTrianglePreImages P = std::move(*takenPreImages_);
+    takenPreImages_.reset();
+    return P;
+  }
+  if (recordsReleased_) throw Error(ErrorKind::Input, "the sub-triangle records were freed after one deformation (DeformOptions::once)");
   SubTrianglePreImages P;
   P.parent.reserve(subCount_);
   P.lam.reserve(9 * subCount_);
-  std::vector<uint32_t> headers;
+  for (size_t ci = 0; ci < chunks_.size(); ++ci) appendPreImages(ci, P);
+  return P;
+}
+
+void DeformSession::appendPreImages(size_t ci, SubTrianglePreImages& P) {
+  const Chunk& c = chunks_[ci];
+  if (!c.count) return;
+  std::vector<uint32_t> headers(4 * c.count);
   auto load = [&](auto& records) {   // one chunk's records at a time, as the device holds them
-    for (size_t ci = 0; ci < chunks_.size(); ++ci) {
-      const Chunk& c = chunks_[ci];
-      if (!c.count) continue;
-      headers.resize(4 * c.count);
-      resizeHuge(records, c.count * SFFD_SUB_STRIDE * 4);
-      backend_.download(impl_->chunkBuffers[ci].headers, 0, headers.data(), c.count * 16);
-      backend_.download(impl_->chunkBuffers[ci].records, 0, records.data(), records.size() * sizeof(records[0]));
-      P.append(headers.data(), records.data(), c.count);
-    }
+    resizeHuge(records, c.count * SFFD_SUB_STRIDE * 4);
+    backend_.download(impl_->chunkBuffers[ci].headers, 0, headers.data(), c.count * 16);
+    backend_.download(impl_->chunkBuffers[ci].records, 0, records.data(), records.size() * sizeof(records[0]));
+    P.append(headers.data(), records.data(), c.count);
   };
   std::vector<float> f;
   std::vector<double> d;
   options_.variant.f64 ? load(d) : load(f);
-  return P;
 }
 
 SmoothOutput DeformSession::output() {
@@ -406,6 +453,7 @@ SmoothOutput DeformSession::output() {
   out.tess.resize(subCount_ * tessReals);
   for (const Chunk& c : chunks_) {
     if (!c.count) continue;
+    if (!c.output) throw Error(ErrorKind::Input, "the outputs were freed after one deformation (DeformOptions::once)");
     downloadRealsInto(backend_, c.output, c.patchesOffset, c.count * patchReals, options_.variant.f64,
                       &out.patches[c.first * patchReals], scratch);
     downloadRealsInto(backend_, c.output, 0, c.count * tessReals, options_.variant.f64, &out.tess[c.first * tessReals], scratch);

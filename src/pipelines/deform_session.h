@@ -11,6 +11,7 @@
 #pragma once
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,9 @@ struct DeformSessionOptions {
   double creaseAngleDeg = kCreaseAngleAuto;  // for a mesh without normals: applyCreaseAngle's threshold
   size_t maxChunkSubTriangles = 0;   // 0: chunks as large as the device allows (smaller only to test chunking)
   size_t maxChunkParents = 0;        // the same for the pre-compute's chunks of mesh triangles
+  // One deformation (DeformOptions::once): the pre-compute's inputs are freed once it ran (precompute() then
+  // throws); releaseRecords() and releaseOutput() free the rest as the caller reads it.
+  bool once = false;
 };
 
 // Told the stage and the fraction of the call done, at stage boundaries and after each chunk; it may
@@ -84,6 +88,11 @@ class DeformSession {
   SubTriangleRecords records();
   SubTrianglePreImages preImages();   // what of the records the patch vertices need, a chunk at a time
   SmoothOutput output();
+  // With options().once, deform() reads each chunk's pre-images once it ran and frees its records (a second
+  // deform() and records() then throw; preImages() hands over what was read, once). releaseRecords() frees
+  // whatever records are left, releaseOutput() one chunk's output (after it was read; output() then throws).
+  void releaseRecords();
+  void releaseOutput(size_t chunk);
 
  private:
   void prepare(const Mesh& mesh, const Lattice& lattice, const StageProgress& progress);
@@ -93,6 +102,10 @@ class DeformSession {
   std::unique_ptr<Impl> impl_;
   std::vector<Chunk> chunks_;
   size_t subCount_ = 0;
+  bool inputsReleased_ = false, recordsReleased_ = false;
+  std::optional<SubTrianglePreImages> takenPreImages_;   // once: read by deform() as each chunk's records went
+  void appendPreImages(size_t chunk, SubTrianglePreImages& to);
+  void requireOnce() const;
   SessionTimings timings_;
 };
 

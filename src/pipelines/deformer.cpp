@@ -83,6 +83,7 @@ ResolvedOptions resolve(const DeformOptions& o, const DeviceInfo& info, const Me
   r.creaseAngleDeg = o.creaseAngleDeg;
   r.memoryLimit = o.memoryLimit;
   r.maxChunkElements = o.maxChunkElements;
+  r.once = o.once;
   return r;
 }
 
@@ -161,6 +162,26 @@ Mesh Deformer::result() const {
   Mesh mesh = impl_->run->result(progress);
   progress("download", 1);
   return mesh;
+}
+
+void Deformer::streamResult(MeshSink& sink) const {
+  ProgressReporter progress(impl_->options.progress, &impl_->device->backend());
+  progress("download", 0);
+  impl_->run->streamResult(sink, progress);
+  progress("download", 1);
+}
+
+void MethodRun::streamResult(MeshSink& sink, const ProgressReporter& progress) const {
+  const Mesh mesh = result(progress);
+  Mesh tables;
+  tables.materials = mesh.materials;
+  tables.groups = mesh.groups;
+  tables.materialLibraries = mesh.materialLibraries;
+  tables.weldIdIsLocation = mesh.weldIdIsLocation;
+  tables.normalsFromFile = mesh.normalsFromFile;
+  sink.begin(tables);
+  sink.add(mesh, 0);
+  sink.end();
 }
 
 std::vector<double> Deformer::patchControlPoints() const { return impl_->run->patchControlPoints(); }

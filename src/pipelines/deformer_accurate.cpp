@@ -8,6 +8,8 @@
 #include <memory>
 #include <stdexcept>
 
+#include <sffd/error.h>
+
 #include "core/job_budget.h"
 #include "core/wall_clock.h"
 #include "kernels/accurate/accurate_patches.h"
@@ -22,7 +24,7 @@ class AccurateRun final : public MethodRun {
  public:
   AccurateRun(Backend& backend, const Mesh& input, const Lattice& lattice, const ResolvedOptions& r, Timings& t,
               const ProgressReporter& progress)
-      : B_(backend), input_(input), variant_(r.variant) {
+      : B_(backend), input_(input), variant_(r.variant), once_(r.once) {
     const auto t0 = std::chrono::steady_clock::now();
     progress("clip", 0);
     job_ = makeAccurateJob(input, lattice, clipAgainstKnotBoxes(input, lattice), r.tess);
@@ -65,6 +67,8 @@ class AccurateRun final : public MethodRun {
   }
 
   void deform(const Lattice& lattice, Timings& t, const ProgressReporter& progress) override {
+    if (once_ && deformed_) throw Error(ErrorKind::Input, "a one-shot Deformer deforms once (DeformOptions::once)");
+    deformed_ = true;
     const auto t0 = std::chrono::steady_clock::now();
     PackedLattice packed = packLattice(lattice);
     std::vector<unsigned char> coeffs = realBytes(packed.coeffs, variant_.f64);
@@ -87,7 +91,32 @@ class AccurateRun final : public MethodRun {
 
   // The patch vertices welded in slices as each chunk comes from the device: none of them held whole.
   Mesh result(const ProgressReporter&) const override {
+    take();
     PatchWelder weld(job_.level, job_.count());
+    weldChunks(weld);
+    Mesh m = weld.finish();
+    m.materials = input_.materials;
+    m.groups = input_.groups;
+    m.materialLibraries = input_.materialLibraries;
+    return m;
+  }
+
+  void streamResult(MeshSink& sink, const ProgressReporter&) const override {
+    take();
+    PatchWelder weld(job_.level, job_.count(), &sink);
+    sink.begin(PatchWelder::tablesOf(input_));
+    weldChunks(weld);
+    sink.end();
+  }
+
+  // A one-shot run's result is taken once: each chunk's buffer goes once read (forEachChunk).
+  void take() const {
+    if (once_ && taken_) throw Error(ErrorKind::Input, "the result was already taken (DeformOptions::once)");
+    taken_ = true;
+  }
+
+  // Each chunk's patch vertices into `weld`, kWeldSlice patches at a time (their carried fields filled).
+  void weldChunks(PatchWelder& weld) const {
     PatchVertices slice;
     slice.level = job_.level;
     slice.reserve(kWeldSlice);
@@ -101,11 +130,6 @@ class AccurateRun final : public MethodRun {
       }
     };
     variant_.f64 ? forEachChunk<double>(add) : forEachChunk<float>(add);
-    Mesh m = weld.finish();
-    m.materials = input_.materials;
-    m.groups = input_.groups;
-    m.materialLibraries = input_.materialLibraries;
-    return m;
   }
 
   std::optional<PatchVertices> patchVertices() const override {
@@ -121,23 +145,34 @@ class AccurateRun final : public MethodRun {
     return p;
   }
 
-  // Calls add(first, count, positions, normals) for each chunk in order, read from the device into one
-  // reused buffer each (no host copy of the whole output).
+  // Calls add(first, count, positions, normals) for consecutive runs of patches in order, each chunk read
+  // from the device a block of at most kDownloadBytes at a time into one reused buffer each (no host copy
+  // of the whole output, nor of a whole chunk).
   template <class Real, class Add>
   void forEachChunk(const Add& add) const {
-    const size_t nv = size_t(tessVertexCount(job_.level));
+    const size_t nv = size_t(tessVertexCount(job_.level)), patchBytes = nv * 4 * sizeof(Real);
+    const size_t block = std::max<size_t>(1, kDownloadBytes / (2 * patchBytes) / kWeldSlice) * kWeldSlice;   // whole weld slices
     size_t most = 0, done = 0;
-    for (const Chunk& c : chunks_) most = std::max(most, c.count);
+    for (const Chunk& c : chunks_) most = std::max(most, std::min(c.count, block));
     std::unique_ptr<Real[]> pos(new Real[most * nv * 4]), nrm(new Real[most * nv * 4]);   // not zero-filled: overwritten
-    adviseHugePages(pos.get(), most * nv * 4 * sizeof(Real));
-    adviseHugePages(nrm.get(), most * nv * 4 * sizeof(Real));
-    for (const Chunk& c : chunks_) {
+    adviseHugePages(pos.get(), most * patchBytes);
+    adviseHugePages(nrm.get(), most * patchBytes);
+    for (Chunk& c : chunks_) {
       if (!c.count) continue;
       if (c.first != done) throw std::logic_error("AccurateRun: chunks out of order");
-      B_.download(c.out, 0, pos.get(), c.count * nv * 4 * sizeof(Real));
-      B_.download(c.out, c.half, nrm.get(), c.count * nv * 4 * sizeof(Real));
-      add(c.first, c.count, static_cast<const Real*>(pos.get()), static_cast<const Real*>(nrm.get()));
+      if (!c.out) throw Error(ErrorKind::Input, "the outputs were freed after one deformation (DeformOptions::once)");
+      for (size_t b = 0; b < c.count; b += block) {
+        const size_t n = std::min(block, c.count - b);
+        B_.download(c.out, b * patchBytes, pos.get(), n * patchBytes);
+        B_.download(c.out, c.half + b * patchBytes, nrm.get(), n * patchBytes);
+        add(c.first + b, n, static_cast<const Real*>(pos.get()), static_cast<const Real*>(nrm.get()));
+      }
       done += c.count;
+      if (once_) {
+        B_.destroyBuffer(c.out);
+        owned_.ids.erase(std::find(owned_.ids.begin(), owned_.ids.end(), c.out));
+        c.out = 0;
+      }
     }
     if (done != job_.count()) throw std::logic_error("AccurateRun: chunks do not cover the sub-triangles");
   }
@@ -152,13 +187,14 @@ class AccurateRun final : public MethodRun {
 
  private:
   static constexpr size_t kWeldSlice = 64;   // patches a slice: their vertices in double fit the cache
+  static constexpr size_t kDownloadBytes = size_t(16) << 20;   // a download's block (rounded to whole slices)
   struct Chunk {
     size_t first = 0, count = 0;
     uint64_t half = 0;   // bytes from the positions to the normals, and from the normals to the corners
     BufferId out = 0;
   };
   Backend& B_;
-  OwnedBuffers owned_{B_};   // first: destroyed last, after everything that names its buffers
+  mutable OwnedBuffers owned_{B_};   // first: destroyed last, after everything that names its buffers
   const Mesh& input_;   // Deformer::Impl::input, which outlives the run
   KernelVariant variant_;
   AccurateJob job_;
@@ -166,7 +202,9 @@ class AccurateRun final : public MethodRun {
   AccurateFrame frame_;
   BufferId frameBuffer_ = 0, coeffs_ = 0, scratch_ = 0;
   uint32_t patchesAt_ = 0;   // the first control point in scratch_, after the samples
-  std::vector<Chunk> chunks_;
+  mutable std::vector<Chunk> chunks_;   // mutable: a one-shot run frees their buffers as they are read
+  bool once_ = false, deformed_ = false;
+  mutable bool taken_ = false;   // a result was taken (DeformOptions::once allows one)
 };
 
 }  // namespace

@@ -46,6 +46,7 @@ struct ResolvedOptions {
   double creaseAngleDeg = kCreaseAngleAuto;
   uint64_t memoryLimit = 0;
   size_t maxChunkElements = 0;
+  bool once = false;
 };
 
 // One method's work on the device: the constructor prepares, deform() runs for a lattice.
@@ -55,6 +56,8 @@ class MethodRun {
   // Uploads the lattice's control points and runs the kernels; fills deformMs and steps.
   virtual void deform(const Lattice& lattice, Timings& timings, const ProgressReporter& progress) = 0;
   virtual Mesh result(const ProgressReporter& progress) const = 0;
+  // result() handed to `sink`, begin() to end() (Deformer::streamResult); by default in one piece.
+  virtual void streamResult(MeshSink& sink, const ProgressReporter& progress) const;
   virtual std::vector<OutputChunk> deviceOutput() const = 0;
   virtual size_t subTriangles() const { return 0; }
   // Smooth: the patches' control points (deformer.h); others: empty.

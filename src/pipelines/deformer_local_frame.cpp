@@ -56,6 +56,24 @@ Mesh translatedMesh(Mesh mesh, glm::dvec3 by) {
 
 namespace {
 
+// Hands each piece to `to` with its positions moved by `by` (as translatedMesh).
+class TranslatingSink final : public MeshSink {
+ public:
+  TranslatingSink(MeshSink& to, glm::dvec3 by) : to_(to), by_(by) {}
+  void begin(const Mesh& tables) override { to_.begin(tables); }
+  void add(const Mesh& piece, size_t firstVertex) override {
+    moved_ = piece;
+    for (glm::dvec3& p : moved_.positions) p += by_;
+    to_.add(moved_, firstVertex);
+  }
+  void end() override { to_.end(); }
+
+ private:
+  MeshSink& to_;
+  glm::dvec3 by_;
+  Mesh moved_;
+};
+
 // A method run on local inputs whose results are handed out in world coordinates (except
 // deviceOutput(), which stays on the device in local coordinates: Deformer::localOrigin()).
 class LocalFrameRun final : public MethodRun {
@@ -66,6 +84,10 @@ class LocalFrameRun final : public MethodRun {
     local_->deform(localLattice(lattice, origin_), timings, progress);
   }
   Mesh result(const ProgressReporter& progress) const override { return translatedMesh(local_->result(progress), origin_); }
+  void streamResult(MeshSink& sink, const ProgressReporter& progress) const override {
+    TranslatingSink moved(sink, origin_);
+    local_->streamResult(moved, progress);
+  }
   std::vector<OutputChunk> deviceOutput() const override { return local_->deviceOutput(); }
   size_t subTriangles() const override { return local_->subTriangles(); }
   std::vector<double> patchControlPoints() const override {

@@ -4,6 +4,8 @@
 #include <memory>
 #include <stdexcept>
 
+#include <sffd/error.h>
+
 #include "kernels/smooth/smooth_deform.h"
 #include "pipelines/deform_session.h"
 #include "pipelines/deformer_internal.h"
@@ -25,6 +27,7 @@ class SmoothRun final : public MethodRun {
     o.split = r.split;
     o.creaseAngleDeg = r.creaseAngleDeg;
     o.maxChunkSubTriangles = r.maxChunkElements;
+    o.once = r.once;
     session_ = std::make_unique<DeformSession>(backend, input, lattice, o, progress);
     t.pnMs = session_->timings().pnMs;
     t.clipMs = session_->timings().clipMs;
@@ -38,8 +41,34 @@ class SmoothRun final : public MethodRun {
 
   // The patch vertices welded in slices as each chunk comes from the device: none of them held whole.
   Mesh result(const ProgressReporter&) const override {
-    if (!records_) records_ = session_->preImages();   // fixed by the pre-compute: downloaded once
-    PatchWelder weld(session_->level(), records_->size());
+    PatchWelder weld(session_->level(), preImages().size());
+    weldChunks(weld);
+    Mesh m = weld.finish();
+    m.materials = input_.materials;
+    m.groups = input_.groups;
+    m.materialLibraries = input_.materialLibraries;
+    return m;
+  }
+
+  void streamResult(MeshSink& sink, const ProgressReporter&) const override {
+    PatchWelder weld(session_->level(), preImages().size(), &sink);
+    sink.begin(PatchWelder::tablesOf(input_));
+    weldChunks(weld);
+    sink.end();
+  }
+
+  // The records' pre-images, downloaded once (fixed by the pre-compute). A one-shot run takes its result
+  // once: the records go from the device as soon as read, each chunk's output once welded (forEachChunk).
+  const SubTrianglePreImages& preImages() const {
+    if (session_->options().once && taken_) throw Error(ErrorKind::Input, "the result was already taken (DeformOptions::once)");
+    taken_ = true;
+    if (!records_) records_ = session_->preImages();
+    if (session_->options().once) session_->releaseRecords();
+    return *records_;
+  }
+
+  // Each chunk's patch vertices into `weld`, kWeldSlice patches at a time (their carried fields filled).
+  void weldChunks(PatchWelder& weld) const {
     PatchVertices slice;
     slice.level = session_->level();
     slice.reserve(kWeldSlice);
@@ -53,15 +82,10 @@ class SmoothRun final : public MethodRun {
       }
     };
     session_->options().variant.f64 ? forEachChunk<double>(add) : forEachChunk<float>(add);
-    Mesh m = weld.finish();
-    m.materials = input_.materials;
-    m.groups = input_.groups;
-    m.materialLibraries = input_.materialLibraries;
-    return m;
   }
 
   std::optional<PatchVertices> patchVertices() const override {
-    if (!records_) records_ = session_->preImages();   // fixed by the pre-compute: downloaded once
+    preImages();
     PatchVertices p;
     p.level = session_->level();
     p.reserve(records_->size());
@@ -74,22 +98,28 @@ class SmoothRun final : public MethodRun {
     return p;
   }
 
-  // Calls add(first, count, tess) for each chunk of sub-triangles in order, its tessellation read from the
-  // device into one reused buffer (no host copy of the whole output, nor of the patches, which the vertices
-  // do not need).
+  // Calls add(first, count, tess) for consecutive runs of sub-triangles in order, each chunk's tessellation
+  // read from the device a block of at most kDownloadBytes at a time into one reused buffer (no host copy of
+  // the whole output, nor of a whole chunk, nor of the patches, which the vertices do not need).
   template <class Real, class Add>
   void forEachChunk(const Add& add) const {
-    const size_t tessReals = 2 * size_t(tessVertexCount(session_->level())) * 4;
+    const size_t tessReals = 2 * size_t(tessVertexCount(session_->level())) * 4, patchBytes = tessReals * sizeof(Real);
+    const size_t block = std::max<size_t>(1, kDownloadBytes / patchBytes / kWeldSlice) * kWeldSlice;   // whole weld slices
     size_t most = 0, done = 0;
-    for (const DeformSession::Chunk& c : session_->chunks()) most = std::max(most, c.count);
+    for (const DeformSession::Chunk& c : session_->chunks()) most = std::max(most, std::min(c.count, block));
     std::unique_ptr<Real[]> tess(new Real[most * tessReals]);   // not zero-filled: each download overwrites it
     adviseHugePages(tess.get(), most * tessReals * sizeof(Real));
-    for (const DeformSession::Chunk& c : session_->chunks()) {
+    for (size_t ci = 0; ci < session_->chunks().size(); ++ci) {
+      const DeformSession::Chunk& c = session_->chunks()[ci];
       if (!c.count) continue;
       if (c.first != done) throw std::logic_error("SmoothRun: chunks out of order");
-      session_->backend().download(c.output, 0, tess.get(), c.count * tessReals * sizeof(Real));
-      add(c.first, c.count, static_cast<const Real*>(tess.get()));
+      for (size_t b = 0; b < c.count; b += block) {
+        const size_t n = std::min(block, c.count - b);
+        session_->backend().download(c.output, b * patchBytes, tess.get(), n * patchBytes);
+        add(c.first + b, n, static_cast<const Real*>(tess.get()));
+      }
       done += c.count;
+      if (session_->options().once) session_->releaseOutput(ci);
     }
     if (done != records_->size()) throw std::logic_error("SmoothRun: chunks do not cover the sub-triangles");
   }
@@ -116,9 +146,11 @@ class SmoothRun final : public MethodRun {
 
  private:
   static constexpr size_t kWeldSlice = 64;   // patches a slice: their vertices in double fit the cache
+  static constexpr size_t kDownloadBytes = size_t(16) << 20;   // a download's block (rounded to whole slices)
   const Mesh& input_;   // Deformer::Impl::input, which outlives the run
   std::unique_ptr<DeformSession> session_;
   mutable std::optional<SubTrianglePreImages> records_;
+  mutable bool taken_ = false;   // a result was taken (DeformOptions::once allows one)
 };
 
 }  // namespace

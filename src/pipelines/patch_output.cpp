@@ -141,7 +141,10 @@ class Key3Map {
 // both sides, so the bits agree), a point inside the parent by the parent and its barycentrics.
 class Locations {
  public:
-  explicit Locations(size_t patches, int level) : other_(patches * 3 * size_t(level) / 2) {}
+  // Keys expected: a patch's 3 (level - 1) edge points, each shared by two patches, and about one corner a
+  // patch off the input's corners (where a parent is split). The table holds twice as many slots (32 B each,
+  // all touched: at 1 M patches of level 3, 8 M slots), and grows if a mesh has more.
+  explicit Locations(size_t patches, int level) : other_(patches * (3 * size_t(level) - 1) / 2) {}
   static constexpr uint32_t kNone = ~0u;
 
   // The slot that holds the location of the vertex at pre-image `lam` of a patch of `parent`, whose
@@ -193,8 +196,13 @@ struct PatchWelder::Impl {
   std::vector<uint32_t> next;
   Locations where;
   bool started = false;
+  MeshSink* sink;       // streamed: the pieces go here
+  Mesh piece;           // streamed: the vertices and triangles of the last add()
+  size_t emitted = 0;   // streamed: the vertices handed over
+  uint32_t lastParent = 0;
 
-  Impl(int level, size_t patches) : level(level), patches(patches), local(tessTriangles(level)), where(patches, level) {
+  Impl(int level, size_t patches, MeshSink* sink)
+      : level(level), patches(patches), local(tessTriangles(level)), where(patches, level), sink(sink) {
     const int nv = tessVertexCount(level);
     boundary.resize(nv);
     for (int v = 0; v < nv; ++v) boundary[v] = onPatchBoundary(v, level);
@@ -212,6 +220,7 @@ struct PatchWelder::Impl {
     reserveHuge(m.weldId, vertices);
     reserveHuge(next, vertices);
     reserveHuge(locs, vertices);
+    if (sink) return;   // the triangles go with each piece
     reserveHuge(m.triangles, triangles);
     if (!P.material.empty()) reserveHuge(m.triangleMaterial, triangles);
     if (!P.group.empty()) reserveHuge(m.triangleGroup, triangles);
@@ -241,6 +250,8 @@ struct PatchWelder::Impl {
     std::vector<uint32_t> map(nv);
     for (size_t p = 0; p < P.patchCount(); ++p) {
       const uint32_t parent = P.parent[p];
+      if (sink && parent < lastParent) throw std::logic_error("PatchWelder: streamed patches out of parent order");
+      lastParent = parent;
       for (int v = 0; v < nv; ++v) {
         const size_t g = p * nv + v;
         uint32_t fresh = Locations::kNone;
@@ -268,6 +279,26 @@ struct PatchWelder::Impl {
         if (!P.group.empty()) m.triangleGroup.push_back(P.group[p]);
       }
     }
+    if (sink) emit();
+  }
+
+  // The vertices made since the last piece (each location's position final: parents do not decrease) and
+  // the triangles, to the sink; the triangles are not kept.
+  void emit() {
+    const size_t n = m.normals.size();
+    piece.positions.clear();
+    for (size_t i = emitted; i < n; ++i) piece.positions.push_back(locs[m.weldId[i]].position);
+    auto tail = [&](const auto& from, auto& to) { to.assign(from.begin() + std::ptrdiff_t(std::min(emitted, from.size())), from.end()); };
+    tail(m.normals, piece.normals);
+    tail(m.texcoords, piece.texcoords);
+    tail(m.colors, piece.colors);
+    tail(m.weldId, piece.weldId);
+    piece.triangles.swap(m.triangles);
+    piece.triangleMaterial.swap(m.triangleMaterial);
+    piece.triangleGroup.swap(m.triangleGroup);
+    m.triangles.clear(), m.triangleMaterial.clear(), m.triangleGroup.clear();
+    sink->add(piece, emitted);
+    emitted = n;
   }
 
   Mesh finish() {
@@ -279,10 +310,20 @@ struct PatchWelder::Impl {
   }
 };
 
-PatchWelder::PatchWelder(int level, size_t patches) : impl_(std::make_unique<Impl>(level, patches)) {}
+PatchWelder::PatchWelder(int level, size_t patches, MeshSink* sink) : impl_(std::make_unique<Impl>(level, patches, sink)) {}
 PatchWelder::~PatchWelder() = default;
 void PatchWelder::add(const PatchVertices& patches) { impl_->add(patches); }
 Mesh PatchWelder::finish() { return impl_->finish(); }
+
+Mesh PatchWelder::tablesOf(const Mesh& input) {
+  Mesh m;
+  m.normalsFromFile = true;
+  m.weldIdIsLocation = true;
+  m.materials = input.materials;
+  m.groups = input.groups;
+  m.materialLibraries = input.materialLibraries;
+  return m;
+}
 
 Mesh weldPatchVertices(const PatchVertices& P) {
   PatchWelder weld(P.level, P.patchCount());

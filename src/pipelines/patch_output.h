@@ -75,13 +75,21 @@ Mesh weldPatchVertices(const PatchVertices& patches);
 // vertices at once (the smooth and accurate results weld each downloaded chunk in small slices, whose
 // vertices stay in the cache): the slices, added in order, give the Mesh that weldPatchVertices gives for
 // all of them together, tables left empty (the caller copies them).
+//
+// Streamed (a sink given): each add() hands the vertices and triangles it made to the sink as one piece
+// (MeshSink::add; begin() and end() are the caller's), keeping only what later slices weld against (per
+// vertex its normal and carried values, per location its position), not the Mesh; finish() is not called.
+// The pieces, appended, are finish()'s Mesh. The parents must not decrease from patch to patch (as the
+// smooth and accurate runs make them): a location's position is then final when it is made.
 class PatchWelder {
  public:
   // `patches`: how many all the slices hold (the outputs are reserved for them).
-  PatchWelder(int level, size_t patches);
+  PatchWelder(int level, size_t patches, MeshSink* sink = nullptr);
   ~PatchWelder();
   void add(const PatchVertices& slice);   // carried fields and parentWeld filled (carryPatchAttributes)
   Mesh finish();
+  // The Mesh of no vertices with the tables of `input` and the flags of a welded result (MeshSink::begin).
+  static Mesh tablesOf(const Mesh& input);
 
  private:
   struct Impl;

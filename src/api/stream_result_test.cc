@@ -1,0 +1,119 @@
+// Deformer::streamResult into MeshFileWriter gives the bytes writeMesh writes of result(), for every
+// format (streamed: .ply and .stl, text and binary; gathered: the others, and .ply with colours), every
+// method, several chunks, a model far from the origin, and a one-shot Deformer (DeformOptions::once).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+
+#include <sffd/sffd.h>
+
+#include "api/api_test_support.h"
+
+namespace {
+
+using namespace sffd;
+namespace fs = std::filesystem;
+
+std::string bytesOf(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), {}};
+}
+
+struct Target {
+  const char* name;
+  bool binary;
+};
+const Target kTargets[] = {{"a.ply", true}, {"a.ply", false}, {"a.stl", true}, {"a.stl", false}, {"a.obj", false}};
+
+class StreamResult : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("sffd_stream_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    // A small sphere (360 triangles) cut from the test data's, with texture coordinates.
+    mesh_ = readMesh(std::string(SFFD_TEST_DATA) + "/sphere.obj");
+    mesh_.texcoords.resize(mesh_.positions.size());
+    for (size_t v = 0; v < mesh_.positions.size(); ++v) mesh_.texcoords[v] = {mesh_.positions[v].x, mesh_.positions[v].z};
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  Lattice twisted(const Mesh& mesh) const {
+    Lattice L = fitLattice(mesh, {4, 4, 5}, {2, 2, 2});
+    applyLatticePreset(L, "twist", 0.4);
+    return L;
+  }
+
+  // Every target written both ways by Deformers made with `o`: result() then writeMesh, and a fresh
+  // Deformer's streamResult (a one-shot Deformer streams once).
+  void expectSameFiles(const Mesh& mesh, DeformOptions o) {
+    Device device = sffd::testing::openTestDevice("cpu");
+    const Lattice L = twisted(mesh);
+    Deformer classic(device, mesh, L, o);
+    classic.deform(L);
+    const Mesh whole = classic.result();
+    const int digits = classic.doublePrecision() || classic.localOrigin() != glm::dvec3(0.0) ? 17 : 9;
+    for (const Target& t : kTargets) {
+      SCOPED_TRACE(std::string(t.name) + (t.binary ? " binary" : " text"));
+      const MeshWriteOptions w{digits, t.binary};
+      writeMesh((dir_ / "want").string() + t.name, whole, w);
+      o.once = true;
+      Deformer once(device, mesh, L, o);
+      once.deform(L);
+      MeshFileWriter out((dir_ / "got").string() + t.name, w);
+      once.streamResult(out);
+      EXPECT_EQ(out.triangleCount(), whole.triangles.size());
+      const std::string want = bytesOf((dir_ / "want").string() + t.name);
+      ASSERT_FALSE(want.empty());
+      EXPECT_TRUE(want == bytesOf((dir_ / "got").string() + t.name));
+      EXPECT_THROW(once.streamResult(out), Error);   // once: the buffers are gone
+      EXPECT_THROW(once.deform(L), Error);
+    }
+    size_t files = 0;
+    for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir_)) ++files;
+    EXPECT_EQ(files, 6u);   // want and got of a.ply, a.stl, a.obj: no temporary file left
+  }
+
+  fs::path dir_;
+  Mesh mesh_;
+};
+
+TEST_F(StreamResult, SmoothFilesAreWriteMeshsBytes) {
+  DeformOptions o;
+  o.tess = 3;
+  o.edgeLength = 0.5;
+  o.maxChunkElements = 37;   // several chunks
+  expectSameFiles(mesh_, o);
+}
+
+TEST_F(StreamResult, AccurateAndFarFromTheOriginAndColoursToo) {
+  DeformOptions o;
+  o.method = Method::Accurate;
+  o.tess = 2;
+  o.maxChunkElements = 50;
+  expectSameFiles(mesh_, o);
+  Mesh far = mesh_;
+  for (glm::dvec3& p : far.positions) p += glm::dvec3(4096, 0, 0);
+  far.colors.assign(far.positions.size(), glm::dvec4(0.25, 0.5, 0.75, 0.5));   // .ply gathered (alpha)
+  o.method = Method::Smooth;
+  o.edgeLength = 0.5;
+  expectSameFiles(far, o);
+}
+
+TEST_F(StreamResult, NonFiniteVertexLeavesNoFile) {
+  {
+    MeshFileWriter out((dir_ / "bad.ply").string(), {9, true});
+    Mesh piece;
+    piece.positions = {{0, 0, 0}, {1, 0, 0}, {0, NAN, 0}};
+    piece.triangles = {{0, 1, 2}};
+    out.begin(Mesh{});
+    EXPECT_THROW(out.add(piece, 0), Error);
+  }   // the writer gone uncommitted: its scratch files with it
+  EXPECT_TRUE(fs::is_empty(dir_));
+}
+
+}  // namespace

@@ -1,0 +1,194 @@
+// MeshFileWriter (<sffd/mesh.h>): writeMesh's file from a mesh handed over in pieces. PLY's header names
+// the vertex and face counts, known only at the end: vertices and faces go to two scratch files beside the
+// output, copied after the header into the output's temporary file at end(). STL's facets go straight to
+// the output (binary: the triangle count written over its placeholder at the end).
+#include <algorithm>
+#include <fstream>
+
+#include <sffd/error.h>
+
+#include "io/atomic_file.h"
+#include "io/mesh_write_records.h"
+
+namespace sffd {
+namespace {
+
+enum class Mode { Gather, Ply, Stl };
+
+constexpr size_t kFlushBytes = 1 << 20;
+
+void flushTo(std::string& buf, std::ostream& os) {
+  os.write(buf.data(), std::streamsize(buf.size()));
+  buf.clear();
+}
+
+// Appends the file at `from` (a flushed scratch file) to `to`, a block at a time.
+void copyFile(const std::string& from, std::ostream& to, const std::string& path) {
+  std::ifstream in(from, std::ios::binary);
+  std::string block(kFlushBytes, '\0');
+  while (in) {
+    in.read(block.data(), std::streamsize(block.size()));
+    to.write(block.data(), in.gcount());
+  }
+  if (!in.eof()) throw inputError(path, 0, "cannot write: reading back a temporary file failed");
+}
+
+template <class T>
+void append(std::vector<T>& to, const std::vector<T>& from) {
+  to.insert(to.end(), from.begin(), from.end());
+}
+
+}  // namespace
+
+struct MeshFileWriter::Impl {
+  std::string path, ext;
+  MeshWriteOptions options;
+  Mode mode = Mode::Gather;
+  bool begun = false, modeKnown = false, ended = false;
+  Mesh held;                      // Gather: the whole mesh; Stl: positions and normals (the facet normals); tables
+  meshio::Carried has;            // from the first piece with vertices
+  size_t vertices = 0, triangles = 0;
+  std::unique_ptr<AtomicFile> out, vertexSpill, faceSpill;
+  std::string vbuf, fbuf;
+
+  // The fields of the file, fixed by the first piece that has vertices (an empty mesh has none).
+  void choose(const Mesh& piece) {
+    modeKnown = true;
+    has.normals = !piece.normals.empty();
+    has.texcoords = !piece.texcoords.empty();
+    has.colors = !piece.colors.empty();
+    if (!streams(path, options, has.colors)) return;   // gathered: writeMesh decides at the end
+    mode = ext == ".ply" ? Mode::Ply : Mode::Stl;
+    if (mode == Mode::Ply) {
+      vertexSpill = std::make_unique<AtomicFile>(path);
+      faceSpill = std::make_unique<AtomicFile>(path);
+    } else {
+      out = std::make_unique<AtomicFile>(path, options.binary);
+      out->stream() << meshio::stlHeader(options.binary, 0);   // binary: the count set at the end
+    }
+  }
+
+  void check(const Mesh& piece, size_t first) {
+    if (!begun || ended) throw Error(ErrorKind::Internal, "MeshFileWriter: add() outside begin() and end()");
+    if (first != vertices) throw Error(ErrorKind::Internal, path + ": mesh pieces out of order");
+    const size_t n = piece.positions.size();
+    auto sized = [&](size_t count, bool want, const char* what) {
+      if (count != (want && n ? n : 0))
+        throw Error(ErrorKind::Internal, path + ": mesh piece has " + std::to_string(count) + " " + what + " for " +
+                                             std::to_string(n) + " vertices");
+    };
+    sized(piece.normals.size(), has.normals, "normals");
+    sized(piece.texcoords.size(), has.texcoords, "texture coordinates");
+    sized(piece.colors.size(), has.colors, "colours");
+    for (const auto& t : piece.triangles)
+      for (uint32_t i : t)
+        if (i >= vertices + n) throw Error(ErrorKind::Internal, path + ": mesh triangle index out of range");
+    auto perTriangle = [&](const std::vector<uint32_t>& index, size_t tableSize, const char* what) {
+      if (index.empty()) return;
+      if (index.size() != piece.triangles.size()) throw Error(ErrorKind::Internal, path + ": mesh " + what + " not one per triangle");
+      for (uint32_t i : index)
+        if (i != Mesh::kNoIndex && i >= tableSize) throw Error(ErrorKind::Internal, path + ": mesh " + what + " index out of range");
+    };
+    perTriangle(piece.triangleMaterial, held.materials.size(), "materials");
+    perTriangle(piece.triangleGroup, held.groups.size(), "groups");
+    for (size_t v = 0; v < n; ++v)
+      meshio::checkFiniteVertex(path, vertices + v, piece.positions[v], has.normals ? &piece.normals[v] : nullptr);
+  }
+
+  void add(const Mesh& piece) {
+    const int digits = options.significantDigits;
+    const size_t n = piece.positions.size();
+    switch (mode) {
+      case Mode::Gather:
+        append(held.positions, piece.positions), append(held.normals, piece.normals), append(held.weldId, piece.weldId);
+        append(held.texcoords, piece.texcoords), append(held.colors, piece.colors);
+        append(held.triangles, piece.triangles);
+        append(held.triangleMaterial, piece.triangleMaterial), append(held.triangleGroup, piece.triangleGroup);
+        break;
+      case Mode::Ply:
+        for (size_t v = 0; v < n; ++v) meshio::appendPlyVertex(vbuf, piece, v, digits, has, options.binary);
+        for (const auto& t : piece.triangles) meshio::appendPlyFace(fbuf, t, options.binary);
+        if (vbuf.size() >= kFlushBytes) flushTo(vbuf, vertexSpill->stream());
+        if (fbuf.size() >= kFlushBytes) flushTo(fbuf, faceSpill->stream());
+        break;
+      case Mode::Stl:
+        append(held.positions, piece.positions);
+        append(held.normals, piece.normals);
+        for (const auto& t : piece.triangles) meshio::appendStlFacet(vbuf, held, t, has.normals, digits, options.binary);
+        if (vbuf.size() >= kFlushBytes) flushTo(vbuf, out->stream());
+        break;
+    }
+    vertices += n;
+    triangles += piece.triangles.size();
+  }
+
+  void end() {
+    if (mode == Mode::Gather) return writeMesh(path, held, options);
+    if (mode == Mode::Ply) {
+      flushTo(vbuf, vertexSpill->stream());
+      flushTo(fbuf, faceSpill->stream());
+      for (AtomicFile* f : {vertexSpill.get(), faceSpill.get()})
+        if (!f->stream().flush()) throw inputError(path, 0, "cannot write: write failed (disk full?)");
+      out = std::make_unique<AtomicFile>(path, options.binary);
+      out->stream() << meshio::plyHeader(vertices, triangles, options.significantDigits, has, options.binary);
+      copyFile(vertexSpill->temporaryPath(), out->stream(), path);
+      vertexSpill.reset();
+      copyFile(faceSpill->temporaryPath(), out->stream(), path);
+      faceSpill.reset();
+    } else {
+      if (options.binary && triangles > 0xFFFFFFFFull) throw Error(ErrorKind::Input, "binary STL holds at most 2^32 - 1 triangles");
+      flushTo(vbuf, out->stream());
+      out->stream() << meshio::stlFooter(options.binary);
+      if (options.binary) {
+        const std::string header = meshio::stlHeader(true, triangles);
+        out->stream().seekp(0);
+        out->stream().write(header.data(), std::streamsize(header.size()));
+      }
+    }
+    out->commit();
+  }
+};
+
+MeshFileWriter::MeshFileWriter(const std::string& path, const MeshWriteOptions& options) : impl_(std::make_unique<Impl>()) {
+  impl_->path = path;
+  impl_->options = options;
+  impl_->ext = meshio::checkWriteTarget(path, options);
+}
+
+MeshFileWriter::~MeshFileWriter() = default;
+
+void MeshFileWriter::begin(const Mesh& tables) {
+  Impl& I = *impl_;
+  if (I.begun) throw Error(ErrorKind::Internal, "MeshFileWriter: begin() called twice");
+  I.begun = true;
+  I.held.materials = tables.materials;
+  I.held.groups = tables.groups;
+  I.held.materialLibraries = tables.materialLibraries;
+  I.held.weldIdIsLocation = tables.weldIdIsLocation;
+  I.held.normalsFromFile = tables.normalsFromFile;
+}
+
+void MeshFileWriter::add(const Mesh& piece, size_t firstVertex) {
+  Impl& I = *impl_;
+  if (!I.modeKnown && !piece.positions.empty()) I.choose(piece);
+  I.check(piece, firstVertex);
+  I.add(piece);
+}
+
+void MeshFileWriter::end() {
+  Impl& I = *impl_;
+  if (!I.begun || I.ended) throw Error(ErrorKind::Internal, "MeshFileWriter: end() without begin(), or twice");
+  I.ended = true;
+  if (!I.modeKnown) I.choose(Mesh{});   // no vertices at all
+  I.end();
+}
+
+size_t MeshFileWriter::vertexCount() const { return impl_->vertices; }
+size_t MeshFileWriter::triangleCount() const { return impl_->triangles; }
+
+bool MeshFileWriter::streams(const std::string& path, const MeshWriteOptions& options, bool colors) {
+  const std::string ext = meshio::checkWriteTarget(path, options);
+  return ext == ".stl" || (ext == ".ply" && !colors);
+}
+
+}  // namespace sffd

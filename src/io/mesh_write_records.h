@@ -1,0 +1,36 @@
+// The file records that writeMesh and MeshFileWriter share (mesh_io_write.cpp), so that a file written as
+// its pieces come has writeMesh's bytes.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <string>
+
+#include <sffd/mesh.h>
+
+namespace sffd::meshio {
+
+// What a mesh's vertices carry into the file (checkWritable): fields present, and any colour alpha != 1.
+struct Carried {
+  bool normals = false, texcoords = false, colors = false, alpha = false;
+};
+
+// The lower-case extension of `path` after writeMesh's checks of the format and options (an input Error
+// naming what is wrong; an internal one for digits outside 1..17).
+std::string checkWriteTarget(const std::string& path, const MeshWriteOptions& options);
+
+// An input Error naming vertex `v` when its position or its normal (null: none) is not finite.
+void checkFiniteVertex(const std::string& path, size_t v, const glm::dvec3& position, const glm::dvec3* normal);
+
+// PLY: float properties for `digits` <= 9, double above (the text header's rule too).
+std::string plyHeader(size_t vertices, size_t faces, int digits, const Carried& has, bool binary);
+void appendPlyVertex(std::string& s, const Mesh& mesh, size_t v, int digits, const Carried& has, bool binary);
+void appendPlyFace(std::string& s, const std::array<uint32_t, 3>& t, bool binary);
+
+// STL: the header (binary: its triangle count), each facet (the normal from mesh.positions, or for a degenerate
+// triangle the mean of mesh.normals when `withNormals`), the footer.
+std::string stlHeader(bool binary, size_t triangles);
+void appendStlFacet(std::string& s, const Mesh& mesh, const std::array<uint32_t, 3>& t, bool withNormals, int digits,
+                    bool binary);
+std::string stlFooter(bool binary);
+
+}  // namespace sffd::meshio
