@@ -124,8 +124,13 @@ void DeformSession::prepare(const Mesh& input, const Lattice& lattice, const Sta
   const bool f64 = options.variant.f64;
   I.realSize = f64 ? 8 : 4;
   I.structure = lattice;
-  Mesh mesh = input;
-  if (!mesh.normalsFromFile) applyCreaseAngle(mesh, options.creaseAngleDeg);
+  // A copy only where the creases are still to be applied.
+  Mesh withCreases;
+  if (!input.normalsFromFile && !options.creasesApplied) {
+    withCreases = input;
+    applyCreaseAngle(withCreases, options.creaseAngleDeg);
+  }
+  const Mesh& mesh = input.normalsFromFile || options.creasesApplied ? input : withCreases;
   I.mesh = prepareMesh(mesh);
   if (options.knotBoxClip) I.knotBoxSubs = clipAgainstKnotBoxes(mesh, lattice);
   else I.clip = buildClipTriangles(mesh, options.edgeLength, splitPatternTable().nmax());

@@ -31,6 +31,7 @@ struct DeformSessionOptions {
   bool knotBoxClip = false;    // the 2015 clipping (computed on the CPU, records uploaded once)
   bool split = false;          // deform as four dispatches (per-step timings) instead of the fused kernel
   double creaseAngleDeg = kCreaseAngleAuto;  // for a mesh without normals: applyCreaseAngle's threshold
+  bool creasesApplied = false;  // the mesh's normals are applyCreaseAngle's already (the Deformer's copy): not again
   size_t maxChunkSubTriangles = 0;   // 0: chunks as large as the device allows (smaller only to test chunking)
   size_t maxChunkParents = 0;        // the same for the pre-compute's chunks of mesh triangles
   // One deformation (DeformOptions::once): the pre-compute's inputs are freed once it ran (precompute() then

@@ -26,6 +26,7 @@ class SmoothRun final : public MethodRun {
     o.knotBoxClip = r.knotBoxClip;
     o.split = r.split;
     o.creaseAngleDeg = r.creaseAngleDeg;
+    o.creasesApplied = true;   // Deformer applied them to its copy of the mesh (deformer.cpp)
     o.maxChunkSubTriangles = r.maxChunkElements;
     o.once = r.once;
     session_ = std::make_unique<DeformSession>(backend, input, lattice, o, progress);
