@@ -221,7 +221,7 @@ std::vector<Real> clipRealRange(const ClipRanges& r, const PreparedMesh& mesh, c
   auto part = [&](const std::vector<double>& from, uint64_t stride, uint64_t at) {
     std::copy_n(from.begin() + 4 * stride * r.firstParent, 4 * stride * r.parents, v.begin() + 4 * at);
   };
-  part(mesh.slotNormals, SFFD_SLOT_NORMAL_STRIDE, r.slotNormals);
+  mesh.slotNormals(r.firstParent, r.parents, v.data() + 4 * r.slotNormals);
   if (pnRecords) part(*pnRecords, SFFD_PN_STRIDE, r.pn);
   std::copy(clip.reals.begin(), clip.reals.end(), v.begin() + 4 * r.clipReals);
   return v;
@@ -360,7 +360,8 @@ bool siteOnEdge(SubVertexKind kind, int e) {
 template <class Real>
 SubTriangleRecords recordsCpu(const PreparedMesh& M, const PnOutput& pn, const std::vector<SubTriangle>& subs) {
   std::vector<Real> pos = convertReals<Real>(M.positions), nrm = convertReals<Real>(M.normals),
-                    slots = convertReals<Real>(M.slotNormals), rec = convertReals<Real>(pn.records);
+                    slots(48 * M.triangleCount()), rec = convertReals<Real>(pn.records);
+  M.slotNormals(0, M.triangleCount(), slots.data());
   SubTriangleRecords R;
   R.headers.assign(4 * subs.size(), 0);
   R.records.assign(subs.size() * SFFD_SUB_STRIDE * 4, 0.0);

@@ -79,7 +79,7 @@ void pnRun(Backend& backend, const PreparedMesh& M, KernelVariant variant, size_
   std::vector<Real> slot(chunk * 48), rec(chunk * SFFD_PN_STRIDE * 4);
   for (size_t first = 0; first < nt; first += chunk) {
     size_t count = std::min(chunk, nt - first);
-    for (size_t i = 0; i < 48 * count; ++i) slot[i] = Real(M.slotNormals[48 * first + i]);
+    M.slotNormals(first, count, slot.data());
     backend.upload(bTri, 0, &M.triangles[8 * first], count * 8 * sizeof(uint32_t));
     backend.upload(bSlot, 0, slot.data(), count * 48 * sizeof(Real));
     gpu::PnParams params;

@@ -144,7 +144,6 @@ MeshTopology buildTopology(const Mesh& mesh) {
   topo.neighbourEdge = std::move(adj.neighbourEdge);
   topo.boundaryEdges = adj.boundaryEdges;
   topo.nonManifoldEdges = adj.nonManifoldEdges;
-  topo.neighbourNormal.resize(T);
   topo.creaseSlot.resize(T);
   topo.neighbourVertex.resize(T);
 
@@ -166,7 +165,6 @@ MeshTopology buildTopology(const Mesh& mesh) {
         w = ut[cornerOnEdgeAt(mesh, ut, topo.neighbourEdge[t][e], mesh.weldId[v])];
       }
       topo.neighbourVertex[t][s] = w;
-      topo.neighbourNormal[t][s] = mesh.normals[w];
       topo.creaseSlot[t][s] = uint8_t(w != v && differs(mesh.normals[v], mesh.normals[w]));
     }
   }

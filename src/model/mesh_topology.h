@@ -18,12 +18,12 @@ struct MeshTopology {
   // the neighbour's local index of that edge (-1 when none).
   std::vector<std::array<int32_t, 3>> neighbour;
   std::vector<std::array<int8_t, 3>> neighbourEdge;
-  // Per triangle and slot: the neighbour's normal at that corner across that edge (the corner's own
-  // normal when there is no neighbour), and whether the two differ (a crease at this corner).
-  std::vector<std::array<glm::dvec3, 6>> neighbourNormal;
+  // Per triangle and slot: whether the neighbour's normal at that corner across that edge differs
+  // from the corner's own (a crease at this corner).
   std::vector<std::array<uint8_t, 6>> creaseSlot;
-  // Per triangle and slot: the vertex index the neighbour normal belongs to (the corner's own
-  // vertex when none). Lets both sides of an edge order the two normals the same way.
+  // Per triangle and slot: the neighbour's vertex at that corner across that edge (the corner's own
+  // vertex when there is no neighbour), whose normal is the neighbour normal. Lets both sides of an
+  // edge order the two normals the same way.
   std::vector<std::array<uint32_t, 6>> neighbourVertex;
   // Counts for the statistics.
   size_t boundaryEdges = 0, nonManifoldEdges = 0, creaseEdges = 0, degenerateTriangles = 0;

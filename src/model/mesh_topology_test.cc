@@ -59,7 +59,6 @@ void expectConsistent(const Mesh& m, const MeshTopology& topo) {
   const size_t T = m.triangles.size();
   ASSERT_EQ(topo.neighbour.size(), T);
   ASSERT_EQ(topo.neighbourEdge.size(), T);
-  ASSERT_EQ(topo.neighbourNormal.size(), T);
   ASSERT_EQ(topo.creaseSlot.size(), T);
   ASSERT_EQ(topo.neighbourVertex.size(), T);
   size_t creaseEdges = 0;
@@ -84,7 +83,6 @@ void expectConsistent(const Mesh& m, const MeshTopology& topo) {
         uint32_t v = m.triangles[t][c];
         uint32_t w = topo.neighbourVertex[t][s];
         EXPECT_EQ(m.weldId[w], m.weldId[v]);
-        EXPECT_EQ(topo.neighbourNormal[t][s], m.normals[w]);
         int uc = m.weldId[m.triangles[size_t(u)][f]] == m.weldId[v] ? f : (f + 1) % 3;
         EXPECT_EQ(m.triangles[size_t(u)][uc], w);
         int us = uc == f ? 2 * uc + 1 : 2 * uc;
@@ -99,7 +97,6 @@ void expectConsistent(const Mesh& m, const MeshTopology& topo) {
       // No neighbour: the corner's own normal, own vertex, no crease.
       uint32_t v = m.triangles[t][slotCorner(s)];
       EXPECT_EQ(topo.neighbourVertex[t][s], v);
-      EXPECT_EQ(topo.neighbourNormal[t][s], m.normals[v]);
       EXPECT_EQ(topo.creaseSlot[t][s], 0);
     }
   }
@@ -153,7 +150,7 @@ TEST(MeshTopology, Cube2SplitNormalsMakeEveryCubeEdgeACrease) {
         EXPECT_EQ(a, 1) << t << " " << e;
         EXPECT_EQ(b, 1) << t << " " << e;
         // Across a cube edge the neighbour's normal is the other face's: perpendicular to ours.
-        EXPECT_NEAR(glm::dot(topo.neighbourNormal[t][2 * e + 1], m.normals[tri[e]]), 0.0, 1e-12);
+        EXPECT_NEAR(glm::dot(m.normals[topo.neighbourVertex[t][2 * e + 1]], m.normals[tri[e]]), 0.0, 1e-12);
       }
     }
   EXPECT_EQ(diagonals, 12u);   // 6 diagonal edges seen from both sides
@@ -218,7 +215,6 @@ TEST(MeshTopology, AdjacencyIsByWeldedPositionNotVertexIndex) {
   EXPECT_EQ(topo.creaseEdges, 1u);
   // Corner 0 of triangle 0 on edge 0 is slot 1: its neighbour vertex is vertex 3, at the same place.
   EXPECT_EQ(topo.neighbourVertex[0][1], 3u);
-  EXPECT_EQ(topo.neighbourNormal[0][1], m.normals[3]);
   EXPECT_EQ(topo.creaseSlot[0][1], 1);
   EXPECT_EQ(topo.creaseSlot[0][2], 1);   // corner 1 on edge 0
   EXPECT_EQ(topo.creaseSlot[0][0], 0);   // corner 0 on the boundary edge 2

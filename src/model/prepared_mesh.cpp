@@ -18,26 +18,30 @@ PreparedMesh prepareMesh(const Mesh& mesh) {
     P.normals[4 * v] = n.x, P.normals[4 * v + 1] = n.y, P.normals[4 * v + 2] = n.z, P.normals[4 * v + 3] = 0;
   }
   resizeHuge(P.triangles, 8 * nt);
-  resizeHuge(P.slotNormals, 48 * nt);
   for (size_t t = 0; t < nt; ++t) {
     const auto& tri = mesh.triangles[t];
     for (int c = 0; c < 3; ++c) {
       P.triangles[8 * t + c] = tri[c];
       P.triangles[8 * t + 4 + c] = mesh.weldId[tri[c]];
     }
-    for (int s = 0; s < 6; ++s) {
-      uint32_t own = tri[slotCorner(s)], other = P.topology.neighbourVertex[t][s];
-      glm::dvec3 nOwn = mesh.normals[own], nOther = P.topology.neighbourNormal[t][s];
-      // The pair in vertex-id order: the neighbour computes the same first and second.
-      bool ownFirst = own <= other;
-      const glm::dvec3& a = ownFirst ? nOwn : nOther;
-      const glm::dvec3& b = ownFirst ? nOther : nOwn;
-      double* d = &P.slotNormals[48 * t + 8 * s];
-      d[0] = a.x, d[1] = a.y, d[2] = a.z, d[3] = P.topology.creaseSlot[t][s] ? 1 : 0;
-      d[4] = b.x, d[5] = b.y, d[6] = b.z, d[7] = ownFirst ? 1 : 0;
-    }
   }
   return P;
 }
+
+template <class Real>
+void PreparedMesh::slotNormals(size_t first, size_t count, Real* out) const {
+  for (size_t t = first; t < first + count; ++t)
+    for (int s = 0; s < 6; ++s) {
+      const uint32_t own = triangles[8 * t + slotCorner(s)], other = topology.neighbourVertex[t][s];
+      const bool ownFirst = own <= other;
+      const double* a = &normals[4 * size_t(ownFirst ? own : other)];
+      const double* b = &normals[4 * size_t(ownFirst ? other : own)];
+      Real* d = out + 48 * (t - first) + 8 * s;
+      d[0] = Real(a[0]), d[1] = Real(a[1]), d[2] = Real(a[2]), d[3] = topology.creaseSlot[t][s] ? Real(1) : Real(0);
+      d[4] = Real(b[0]), d[5] = Real(b[1]), d[6] = Real(b[2]), d[7] = ownFirst ? Real(1) : Real(0);
+    }
+}
+template void PreparedMesh::slotNormals<float>(size_t, size_t, float*) const;
+template void PreparedMesh::slotNormals<double>(size_t, size_t, double*) const;
 
 }  // namespace sffd
