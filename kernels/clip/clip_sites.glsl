@@ -27,7 +27,12 @@ layout(std430, SFFD_SET binding = SFFD_BINDING_CLIP_WORDS) readonly buffer ClipI
 #define clipReals(i) clipInReals[params.sections.z + (i)]
 #define splitTable(i) clipInWords[i]
 #define counts(i) clipInWords[params.words.z + (i)]
-uvec4 clipWords4(uint w) { return uvec4(clipInWords[w], clipInWords[w + 1u], clipInWords[w + 2u], clipInWords[w + 3u]); }
+// Four words, read in a rolled loop (see loadParent).
+uvec4 clipWords4(uint w) {
+  uvec4 r;
+  for (uint i = 0u; i < sffdRolled(4u); ++i) r = uvec4(r.yzw, clipInWords[w + i]);
+  return r;
+}
 #define triangles(i) clipWords4(params.words.x + 4u * (i))
 #define clipHeaders(i) clipWords4(params.words.y + 4u * (i))
 
@@ -43,8 +48,12 @@ struct ClipSetup {
 
 ClipSetup clipSetup(uint ct) {
   uvec4 welds = clipHeaders(SFFD_CLIP_HEADER_STRIDE * ct + 1u);
-  real3 corner[3];
-  for (uint c = 0u; c < 3u; ++c) corner[c] = clipReals(SFFD_CLIP_REAL_STRIDE * ct + 3u + c).xyz;
+  real3 corner[3];   // a rolled read into a shift register (see loadParent)
+  for (uint c = 0u; c < sffdRolled(3u); ++c) {
+    corner[0] = corner[1];
+    corner[1] = corner[2];
+    corner[2] = clipReals(SFFD_CLIP_REAL_STRIDE * ct + 3u + c).xyz;
+  }
   uint n[3];
   uint nmax = params.table.x;
   for (uint e = 0u; e < 3u; ++e) {
@@ -76,7 +85,7 @@ ClipSetup clipSetup(uint ct) {
   // Float lengths of a flat triangle may break a + b >= c by one segment: fall back to c = a + b.
   uint cc = min(S.count[2], S.count[0] + S.count[1]);
   uint key = ((S.count[0] - 1u) * nmax + (S.count[1] - 1u)) * nmax + (cc - 1u);
-  S.entry = uvec4(splitTable(4u * key), splitTable(4u * key + 1u), splitTable(4u * key + 2u), splitTable(4u * key + 3u));
+  S.entry = clipWords4(4u * key);
   return S;
 }
 
@@ -104,19 +113,28 @@ struct Parent {
   real3 n[6];   // the PN normal control points
 };
 
+// Reads in rolled loops into shift registers (q[j] = q[j + 1], constant indices, so registers): Mesa
+// 25.0 writes each storage read out per lane and component with a branch, so every read written in the
+// kernel (or by an unrolled loop) adds machine code to generate at the first dispatch; one read in a
+// rolled loop adds it once. Same values, same bits.
 Parent loadParent(uint id) {
   Parent p;
   p.id = id;
   p.local = id - params.range.w;
   p.verts = triangles(SFFD_MESH_TRIANGLE_STRIDE * p.local);
   p.welds = triangles(SFFD_MESH_TRIANGLE_STRIDE * p.local + 1u);
-  for (uint c = 0u; c < 3u; ++c) {
-    p.V[c] = positions(p.verts[c]).xyz;
-    p.N[c] = normals(p.verts[c]).xyz;
+  // 0..2 positions, 3..5 normals, 6..21 the PN record (10 control points, 6 normal control points).
+  real3 q[22];
+  uint base = params.sections.y + SFFD_PN_STRIDE * p.local;
+  for (uint i = 0u; i < sffdRolled(22u); ++i) {
+    uint a = i < 3u ? p.verts[i] : (i < 6u ? params.range.z + p.verts[i - 3u] : base + (i - 6u));
+    for (uint j = 0u; j < 21u; ++j) q[j] = q[j + 1u];
+    q[21] = clipInReals[a].xyz;
   }
-  uint base = SFFD_PN_STRIDE * p.local;
-  for (uint i = 0u; i < 10u; ++i) p.b[i] = pn(base + i).xyz;
-  for (uint i = 0u; i < 6u; ++i) p.n[i] = pn(base + SFFD_PN_NORMALS + i).xyz;
+  p.V[0] = q[0]; p.V[1] = q[1]; p.V[2] = q[2];
+  p.N[0] = q[3]; p.N[1] = q[4]; p.N[2] = q[5];
+  for (uint i = 0u; i < 10u; ++i) p.b[i] = q[6u + i];
+  for (uint i = 0u; i < 6u; ++i) p.n[i] = q[16u + i];
   return p;
 }
 
@@ -248,11 +266,15 @@ ClipTriangle loadClipTriangle(uint ct) {
   T.parent = h.x;
   T.kinds = h.y;
   T.welds = clipHeaders(SFFD_CLIP_HEADER_STRIDE * ct + 1u);
+  // Corners 0..2 and edge params 6..8 in one rolled loop (see loadParent).
+  real4 q[6];
   uint base = SFFD_CLIP_REAL_STRIDE * ct;
-  for (uint c = 0u; c < 3u; ++c) {
-    T.lam[c] = clipReals(base + c);
-    T.edgeParams[c] = clipReals(base + 6u + c);
+  for (uint i = 0u; i < sffdRolled(6u); ++i) {
+    for (uint j = 0u; j < 5u; ++j) q[j] = q[j + 1u];
+    q[5] = clipReals(base + (i < 3u ? i : i + 3u));
   }
+  T.lam[0] = q[0]; T.lam[1] = q[1]; T.lam[2] = q[2];
+  T.edgeParams[0] = q[3]; T.edgeParams[1] = q[4]; T.edgeParams[2] = q[5];
   return T;
 }
 

@@ -16,8 +16,13 @@ void main() {
   ClipTriangle T = loadClipTriangle(ct);
   Parent par = loadParent(T.parent);
   // Per local clip edge: the parent edge it lies on and the neighbour's normal there (crease edges).
-  EdgeNeighbour nbr[3];
-  for (uint le = 0u; le < 3u; ++le) nbr[le] = edgeNeighbour(par, T.edgeParams[le].x);
+  // A rolled loop into a shift register: one copy of the reads (see loadParent).
+  EdgeNeighbour nbr0, nbr1, nbr2;
+  for (uint le = 0u; le < sffdRolled(3u); ++le) {
+    nbr0 = nbr1;
+    nbr1 = nbr2;
+    nbr2 = edgeNeighbour(par, clipEdgeParams(T, le).x);
+  }
   uint out0 = counts(ct);
   for (uint k = 0u; k < S.entry.w; ++k) {
     // Per corner c of the sub-triangle: its pattern vertex's edge and step, and its site's kind and
@@ -41,27 +46,29 @@ void main() {
       kind[c] = site.kind;
       siteT[c] = site.t;
       SiteValue val = evaluateSite(par, site);
-      subRecords[rec + SFFD_SUB_LAM + c] = real4(val.lam, 0);
-      subRecords[rec + SFFD_SUB_XPN + c] = real4(val.xpn, 0);
-      subRecords[rec + SFFD_SUB_XFLAT + c] = real4(val.xflat, 0);
-      subRecords[rec + SFFD_SUB_NLIN + c] = real4(val.nlin, 0);
-      subRecords[rec + SFFD_SUB_NPN + c] = real4(val.npn, 0);
+      // LAM, XPN, XFLAT, NLIN, NPN (layout.h: 3 apart) by one store in a rolled loop (see loadParent).
+      real3 f[5] = real3[5](val.lam, val.xpn, val.xflat, val.nlin, val.npn);
+      for (uint j = 0u; j < sffdRolled(5u); ++j) {
+        subRecords[rec + SFFD_SUB_LAM + 3u * j + c] = real4(f[0], 0);
+        for (uint m = 0u; m < 4u; ++m) f[m] = f[m + 1u];
+      }
       if (c == 0u) lam0 = val.lam, npn0 = val.npn;
       if (c == 1u) npn1 = val.npn;
       if (c == 2u) npn2 = val.npn;
     }
     uint creaseBits = 0u;
-    for (uint c = 0u; c < sffdRolled(3u); ++c) {
+    for (uint slot = 0u; slot < sffdRolled(6u); ++slot) {
       // Slots 2c (towards corner c+2) and 2c+1 (towards c+1): the neighbour's normal where the
-      // sub-edge lies on a crease edge of the parent.
-      for (uint h = 0u; h < 2u; ++h) {
+      // sub-edge lies on a crease edge of the parent. One rolled loop over the six: one copy of it.
+      {
+        uint c = slot / 2u, h = slot % 2u;
         uint d = h == 0u ? (c + 2u) % 3u : (c + 1u) % 3u;
         real4 nn = real4(c == 0u ? npn0 : (c == 1u ? npn1 : npn2), 0);
         uint ce = sharedCanonicalEdge(edge[c], step[c], edge[d], step[d]);
         if (ce < 3u) {
           uint a = S.perm[ce], b = S.perm[(ce + 1u) % 3u];
           uint le = (b == (a + 1u) % 3u) ? a : b;
-          EdgeNeighbour n = le == 0u ? nbr[0] : (le == 1u ? nbr[1] : nbr[2]);
+          EdgeNeighbour n = le == 0u ? nbr0 : (le == 1u ? nbr1 : nbr2);
           if (n.crease) {
             nn = real4(neighbourNormalAt(n, siteParamOnEdge(par, kind[c], siteT[c], n.e)), 1);   // w = 1: a crease
             creaseBits |= 1u << (2u * c + h);

@@ -13,49 +13,55 @@ layout(std430, SFFD_SET binding = SFFD_BINDING_MESH_TRIANGLES) readonly buffer T
 layout(std430, SFFD_SET binding = SFFD_BINDING_MESH_SLOT_NORMALS) readonly buffer SlotNormals { real4 slotNormals[]; };
 layout(std430, SFFD_SET binding = SFFD_BINDING_PN_OUT) writeonly buffer PnOut { real4 pn[]; };
 
-// Control point of each slot in the cubic linear index order (METHOD.md 3.3).
-const uint kSlotControlPoint[6] = uint[6](2u, 1u, 3u, 7u, 8u, 5u);
-
+// Reads, stores and the per-slot and per-edge work in rolled loops (prelude.glsl sffdRolled), values
+// passed through shift registers (arrays indexed by constants only, so registers): Mesa 25.0 writes
+// each storage access out per lane and component with a branch, so each one written in the kernel (or
+// by an unrolled loop) adds machine code to generate at the first dispatch. Same arithmetic, same bits.
 void main() {
   uint t = sffdThreadIndex();
   if (t >= params.range.y) return;
   uint tri = params.range.x + t;
   uvec4 ids = triangles[SFFD_MESH_TRIANGLE_STRIDE * tri];
   uvec4 welds = triangles[SFFD_MESH_TRIANGLE_STRIDE * tri + 1u];
-  real3 V[3], N[3];
-  for (uint c = 0u; c < 3u; ++c) {
-    V[c] = positions(ids[c]).xyz;
-    N[c] = normals(ids[c]).xyz;
+  real3 q[6];   // V0 V1 V2 N0 N1 N2
+  for (uint i = 0u; i < sffdRolled(6u); ++i) {
+    for (uint j = 0u; j < 5u; ++j) q[j] = q[j + 1u];
+    q[5] = vertices[i < 3u ? ids[i] : params.range.z + ids[i - 3u]].xyz;
   }
-  real3 cp[10];
-  cp[0] = V[0];
-  cp[6] = V[1];
-  cp[9] = V[2];
+  real3 V0 = q[0], V1 = q[1], V2 = q[2], N0 = q[3], N1 = q[4], N2 = q[5];
+  // The edge control points of slots 0..5 (control points 2, 1, 3, 7, 8, 5).
+  real3 b[6];
   P real3 edgeSum = real3(0);
-  for (uint s = 0u; s < 6u; ++s) {
+  for (uint s = 0u; s < sffdRolled(6u); ++s) {
     uint c = s / 2u;
     uint other = (s % 2u == 1u) ? (c + 1u) % 3u : (c + 2u) % 3u;
     real4 nFirst = slotNormals[SFFD_SLOT_NORMAL_STRIDE * tri + 2u * s];
     real3 nSecond = slotNormals[SFFD_SLOT_NORMAL_STRIDE * tri + 2u * s + 1u].xyz;
-    real3 b = pnEdgePoint(V[c], V[other], nFirst, nSecond);
-    cp[kSlotControlPoint[s]] = b;
-    edgeSum = edgeSum + b;
+    real3 Vc = c == 0u ? V0 : (c == 1u ? V1 : V2), Vo = other == 0u ? V0 : (other == 1u ? V1 : V2);
+    real3 e = pnEdgePoint(Vc, Vo, nFirst, nSecond);
+    for (uint j = 0u; j < 5u; ++j) b[j] = b[j + 1u];
+    b[5] = e;
+    edgeSum = edgeSum + e;
   }
   P real3 E = edgeSum / real(6);
-  P real3 Vm = ((V[0] + V[1]) + V[2]) / real(3);
+  P real3 Vm = ((V0 + V1) + V2) / real(3);
   P real3 centre = E + (E - Vm) / real(2);
-  cp[4] = centre;
-
+  // Each edge's middle normal control point, computed in weld-id order: edges (0,1) -> 110, (1,2) -> 011, (2,0) -> 101.
+  real3 en[3];
+  for (uint e = 0u; e < sffdRolled(3u); ++e) {
+    uint a = e, c = (e + 1u) % 3u;
+    if (welds[c] < welds[a]) { uint x = a; a = c; c = x; }
+    real3 Va = a == 0u ? V0 : (a == 1u ? V1 : V2), Vb = c == 0u ? V0 : (c == 1u ? V1 : V2);
+    real3 Na = a == 0u ? N0 : (a == 1u ? N1 : N2), Nb = c == 0u ? N0 : (c == 1u ? N1 : N2);
+    en[0] = en[1];
+    en[1] = en[2];
+    en[2] = pnEdgeNormal(Va, Vb, Na, Nb);
+  }
+  // The record: control points 0..9, then the normal control points 200, 110, 101, 020, 011, 002.
+  real3 r[16] = real3[16](V0, b[1], b[0], b[2], centre, b[5], V1, b[3], b[4], V2, N0, en[0], en[2], N1, en[1], N2);
   uint base = SFFD_PN_STRIDE * tri;
-  for (uint i = 0u; i < 10u; ++i) pn[base + i] = real4(cp[i], 0);
-  // Normal control points; each edge's middle one computed in weld-id order.
-  pn[base + SFFD_PN_NORMALS + 0u] = real4(N[0], 0);
-  pn[base + SFFD_PN_NORMALS + 3u] = real4(N[1], 0);
-  pn[base + SFFD_PN_NORMALS + 5u] = real4(N[2], 0);
-  const uint kEdgeNormalIndex[3] = uint[3](1u, 4u, 2u);   // edges (0,1) -> 110, (1,2) -> 011, (2,0) -> 101
-  for (uint e = 0u; e < 3u; ++e) {
-    uint a = e, b = (e + 1u) % 3u;
-    if (welds[b] < welds[a]) { uint x = a; a = b; b = x; }
-    pn[base + SFFD_PN_NORMALS + kEdgeNormalIndex[e]] = real4(pnEdgeNormal(V[a], V[b], N[a], N[b]), 0);
+  for (uint i = 0u; i < sffdRolled(16u); ++i) {
+    pn[base + i] = real4(r[0], 0);
+    for (uint j = 0u; j < 15u; ++j) r[j] = r[j + 1u];
   }
 }

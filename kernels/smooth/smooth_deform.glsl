@@ -61,15 +61,24 @@ real3 nearControlPoint(real3 q0, real3 q1, real3 q2, real3 q3) {
 struct SubCorners {
   real3 x0, x1, x2, n0, n1, n2;
 };
+// One read in a rolled loop (prelude.glsl sffdRolled), the values through a shift register (an array
+// indexed by constants only, so registers): Mesa 25.0 writes each storage access out per lane and
+// component with a branch, so each one written in the kernel (or by an unrolled loop) adds machine code
+// to generate at the first dispatch.
 SubCorners smoothSubCorners(uint st) {
   uint rec = SFFD_SUB_STRIDE * st;
+  real3 q[6];   // XPN 0..2, then NLIN 0..2 (layout.h: NLIN = XPN + 6)
+  for (uint i = 0u; i < sffdRolled(6u); ++i) {
+    for (uint j = 0u; j < 5u; ++j) q[j] = q[j + 1u];
+    q[5] = subRecords[rec + SFFD_SUB_XPN + (i < 3u ? i : i + 3u)].xyz;
+  }
   SubCorners C;
-  C.x0 = subRecords[rec + SFFD_SUB_XPN].xyz;
-  C.x1 = subRecords[rec + SFFD_SUB_XPN + 1u].xyz;
-  C.x2 = subRecords[rec + SFFD_SUB_XPN + 2u].xyz;
-  C.n0 = subRecords[rec + SFFD_SUB_NLIN].xyz;
-  C.n1 = subRecords[rec + SFFD_SUB_NLIN + 1u].xyz;
-  C.n2 = subRecords[rec + SFFD_SUB_NLIN + 2u].xyz;
+  C.x0 = q[0];
+  C.x1 = q[1];
+  C.x2 = q[2];
+  C.n0 = q[3];
+  C.n1 = q[4];
+  C.n2 = q[5];
   return C;
 }
 
@@ -210,7 +219,7 @@ void smoothAdjust(uint creaseBits, real3 adj[3], real3 adjNbr[6], inout real3 cp
 void smoothTessellate(real3 cp[10], real3 ncp[10], uint L, uint tbase) {
   uint nv = (L + 1u) * (L + 2u) / 2u;
   uint lastRow = L * (L + 1u) / 2u;
-  for (uint c = 0u; c < 3u; ++c) {
+  for (uint c = 0u; c < sffdRolled(3u); ++c) {   // rolled: one copy of the stores (smoothSubCorners)
     uint v = c == 0u ? 0u : (c == 1u ? lastRow : lastRow + L);
     real3 xc = c == 0u ? cp[0] : (c == 1u ? cp[6] : cp[9]);
     real3 nc = c == 0u ? ncp[0] : (c == 1u ? ncp[6] : ncp[9]);
