@@ -233,8 +233,12 @@ EdgeNeighbour edgeNeighbour(Parent p, real pe) {
   edgeEnds(p, e, lo, hi);
   uint sLo = SFFD_SLOT_NORMAL_STRIDE * p.local + 2u * slotOf(lo, e);
   uint sHi = SFFD_SLOT_NORMAL_STRIDE * p.local + 2u * slotOf(hi, e);
-  real4 fLo = slotNormals(sLo), gLo = slotNormals(sLo + 1u);
-  real4 fHi = slotNormals(sHi), gHi = slotNormals(sHi + 1u);
+  real4 q[4];   // fLo gLo fHi gHi, a rolled read into a shift register (see loadParent)
+  for (uint i = 0u; i < sffdRolled(4u); ++i) {
+    for (uint j = 0u; j < 3u; ++j) q[j] = q[j + 1u];
+    q[3] = slotNormals((i < 2u ? sLo : sHi) + i % 2u);
+  }
+  real4 fLo = q[0], gLo = q[1], fHi = q[2], gHi = q[3];
   r.e = e;
   r.crease = !(fLo.w < real(0.5) && fHi.w < real(0.5));
   r.nLo = gLo.w > real(0.5) ? gLo.xyz : fLo.xyz;   // the one that is not this triangle's own

@@ -38,8 +38,9 @@ void main() {
       uint word = splitTable(params.table.z + i / 2u);
       uint idx = (i % 2u == 0u) ? (word & 65535u) : (word >> 16u);
       uint v = params.table.y + 4u * (S.entry.x + idx);
-      real3 lamCanon = real3(uintBitsToFloat(splitTable(v)), uintBitsToFloat(splitTable(v + 1u)), uintBitsToFloat(splitTable(v + 2u)));
-      uint w = splitTable(v + 3u);
+      uvec4 vw = clipWords4(v);
+      real3 lamCanon = real3(uintBitsToFloat(vw.x), uintBitsToFloat(vw.y), uintBitsToFloat(vw.z));
+      uint w = vw.w;
       edge[c] = w & 255u;
       step[c] = w >> 16u;
       Site site = patternSite(T, S, edge[c], step[c], lamCanon);
