@@ -16,7 +16,8 @@ void main() {
   uint st = params.range.x + tid;
   real3 Q[3], QN[3], adj[3], adjNbr[6], E[6], EN[6];
   SubCorners corners = smoothSubCorners(st);
-  smoothBoundarySamples(st, corners, Q, QN, adj, adjNbr, E, EN);
+  smoothCornerSamples(st, corners, Q, QN, adj, adjNbr);
+  smoothEdgeSamples(corners, E, EN);
   real3 cp[10], ncp[10];
   smoothBoundaryControlPoints(Q, QN, E, EN, cp, ncp);
   P real3 centreN = real3(0);

@@ -82,47 +82,61 @@ SubCorners smoothSubCorners(uint st) {
   return C;
 }
 
+// Steps 1 and 2 at corner c (and step 4, which needs the same Jacobian): the deformed corner, its
+// deformed normal, and the adjusting normals of the corner and of its two slots (crease slots only).
+void smoothCornerSample(uint st, uint c, uint creaseBits, real3 x, real3 nlin, out real3 Q, out real3 QN, out real3 adj,
+                        out real3 adjA, out real3 adjB) {
+  uint rec = SFFD_SUB_STRIDE * st;
+  LatticeSample S = latticeEvaluate(params.lattice, x);
+  Q = S.value;
+  QN = snormalize(latticeCofactorNormal(S, nlin));
+  adj = snormalize(latticeCofactorNormal(S, subRecords[rec + SFFD_SUB_NPN + c].xyz));
+  adjA = adj;
+  adjB = adj;
+  if (((creaseBits >> (2u * c)) & 1u) != 0u) adjA = snormalize(latticeCofactorNormal(S, subRecords[rec + SFFD_SUB_NNBR + 2u * c].xyz));
+  if (((creaseBits >> (2u * c + 1u)) & 1u) != 0u) adjB = snormalize(latticeCofactorNormal(S, subRecords[rec + SFFD_SUB_NNBR + 2u * c + 1u].xyz));
+}
+
 // Corner c's lifted point and linear normal (selects, not an indexed array).
 real3 subCornerX(SubCorners C, uint c) { return c == 0u ? C.x0 : (c == 1u ? C.x1 : C.x2); }
 real3 subCornerN(SubCorners C, uint c) { return c == 0u ? C.n0 : (c == 1u ? C.n1 : C.n2); }
 
-// Steps 1 and 2 on the boundary, and step 4, which needs the corners' Jacobians: sample j = 0..2 is
-// corner j (the deformed corner Q, its deformed normal QN, and the adjusting normals of the corner and
-// of its two slots, crease slots only), j = 3..8 the edge sample E[j - 3] at one third from each end
-// (E[2e] near corner e, E[2e+1] near e+1). One rolled loop for both kinds: each lattice evaluation
-// written in the kernel is much machine code to generate at the first dispatch (Mesa 25.0).
-void smoothBoundarySamples(uint st, SubCorners C, out real3 Q[3], out real3 QN[3], out real3 adj[3], out real3 adjNbr[6],
-                           out real3 E[6], out real3 EN[6]) {
+// Loops rather than calls written out: every call inlines a whole lattice evaluation, and the
+// kernels' compile time grows with their number.
+void smoothCornerSamples(uint st, SubCorners C, out real3 Q[3], out real3 QN[3], out real3 adj[3], out real3 adjNbr[6]) {
   uint creaseBits = smoothCreaseBits(st);
-  uint rec = SFFD_SUB_STRIDE * st;
+  for (uint c = 0u; c < 3u; ++c) {
+    real3 q, qn, ad, a0, a1;
+    smoothCornerSample(st, c, creaseBits, subCornerX(C, c), subCornerN(C, c), q, qn, ad, a0, a1);
+    Q[c] = q;
+    QN[c] = qn;
+    adj[c] = ad;
+    adjNbr[2u * c] = a0;
+    adjNbr[2u * c + 1u] = a1;
+  }
+}
+
+// Step 2 on an edge: the sample at wa * a + wb * b.
+void smoothEdgeSample(real3 xa, real3 xb, real3 na, real3 nb, real wa, real wb, out real3 E, out real3 EN) {
+  P real3 x = xa * wa + xb * wb;
+  P real3 n = na * wa + nb * wb;
+  LatticeSample S = latticeEvaluate(params.lattice, x);
+  E = S.value;
+  EN = snormalize(latticeCofactorNormal(S, snormalize(n)));
+}
+
+// Step 2 on the edges: samples at one third from each end, E[2e] near corner e, E[2e+1] near e+1.
+void smoothEdgeSamples(SubCorners C, out real3 E[6], out real3 EN[6]) {
   P real third = real(1) / real(3);
   P real twoThirds = real(2) / real(3);
-  for (uint j = 0u; j < sffdRolled(9u); ++j) {
-    bool corner = j < 3u;
-    uint k = corner ? 0u : j - 3u;
+  for (uint k = 0u; k < 6u; ++k) {
     uint e = k / 2u, b = e == 2u ? 0u : e + 1u;
     P real wa = k % 2u == 0u ? twoThirds : third;
     P real wb = k % 2u == 0u ? third : twoThirds;
-    P real3 xe = subCornerX(C, e) * wa + subCornerX(C, b) * wb;
-    P real3 ne = subCornerN(C, e) * wa + subCornerN(C, b) * wb;
-    real3 x = corner ? subCornerX(C, j) : xe;
-    real3 n = corner ? subCornerN(C, j) : snormalize(ne);
-    LatticeSample S = latticeEvaluate(params.lattice, x);
-    real3 normal = snormalize(latticeCofactorNormal(S, n));
-    if (corner) {
-      Q[j] = S.value;
-      QN[j] = normal;
-      real3 ad = snormalize(latticeCofactorNormal(S, subRecords[rec + SFFD_SUB_NPN + j].xyz));
-      real3 a0 = ad, a1 = ad;
-      if (((creaseBits >> (2u * j)) & 1u) != 0u) a0 = snormalize(latticeCofactorNormal(S, subRecords[rec + SFFD_SUB_NNBR + 2u * j].xyz));
-      if (((creaseBits >> (2u * j + 1u)) & 1u) != 0u) a1 = snormalize(latticeCofactorNormal(S, subRecords[rec + SFFD_SUB_NNBR + 2u * j + 1u].xyz));
-      adj[j] = ad;
-      adjNbr[2u * j] = a0;
-      adjNbr[2u * j + 1u] = a1;
-    } else {
-      E[k] = S.value;
-      EN[k] = normal;
-    }
+    real3 x, n;
+    smoothEdgeSample(subCornerX(C, e), subCornerX(C, b), subCornerN(C, e), subCornerN(C, b), wa, wb, x, n);
+    E[k] = x;
+    EN[k] = n;
   }
 }
 
