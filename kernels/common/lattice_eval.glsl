@@ -124,25 +124,14 @@ void latticeVolume2(uint base, real su, real sv, real sw, out real3 R, out real3
   latticeBernstein2(su, bu, dbu);
   latticeBernstein2(sv, bv, dbv);
   latticeBernstein2(sw, bw, dbw);
-  // The three slabs in a rolled loop (prelude.glsl sffdRolled): one copy of the nine coefficient reads
-  // per evaluation instead of three, less machine code to generate at the first dispatch. The sums keep
-  // their order, ((z + s0 bu.x) + s1 bu.y) + s2 bu.z; z is +0 in the strict variant, as written there,
-  // and -0 in the fast one, where the compilers drop the written-out form's "0 +" (-0 + x is x).
-#if SFFD_STRICT
-  real3 z = real3(0);
-#else
-  real3 z = real3(-0.0);
-#endif
-  P real3 r = z, ru = z, rv = z, rw = z;
-  for (uint i = 0u; i < sffdRolled(3u); ++i) {
-    real3 sp, spv, spw;
-    latticeSlab2(base + 9u * i, bv, dbv, bw, dbw, sp, spv, spw);
-    real b = i == 0u ? bu.x : (i == 1u ? bu.y : bu.z), db = i == 0u ? dbu.x : (i == 1u ? dbu.y : dbu.z);
-    r = r + sp * b;
-    ru = ru + sp * db;
-    rv = rv + spv * b;
-    rw = rw + spw * b;
-  }
+  real3 s0, s0v, s0w, s1, s1v, s1w, s2, s2v, s2w;
+  latticeSlab2(base, bv, dbv, bw, dbw, s0, s0v, s0w);
+  latticeSlab2(base + 9u, bv, dbv, bw, dbw, s1, s1v, s1w);
+  latticeSlab2(base + 18u, bv, dbv, bw, dbw, s2, s2v, s2w);
+  P real3 r = ((real3(0) + s0 * bu.x) + s1 * bu.y) + s2 * bu.z;
+  P real3 ru = ((real3(0) + s0 * dbu.x) + s1 * dbu.y) + s2 * dbu.z;
+  P real3 rv = ((real3(0) + s0v * bu.x) + s1v * bu.y) + s2v * bu.z;
+  P real3 rw = ((real3(0) + s0w * bu.x) + s1w * bu.y) + s2w * bu.z;
   R = r;
   Ru = ru;
   Rv = rv;

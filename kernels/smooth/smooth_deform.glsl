@@ -61,16 +61,17 @@ real3 nearControlPoint(real3 q0, real3 q1, real3 q2, real3 q3) {
 struct SubCorners {
   real3 x0, x1, x2, n0, n1, n2;
 };
-// One read in a rolled loop (prelude.glsl sffdRolled), the values through a shift register (an array
-// indexed by constants only, so registers): Mesa 25.0 writes each storage access out per lane and
+// Reads in a rolled loop of two (prelude.glsl sffdRolled), the values through a shift register (an
+// array indexed by constants only: registers): Mesa 25.0 writes each storage access out per lane and
 // component with a branch, so each one written in the kernel (or by an unrolled loop) adds machine code
-// to generate at the first dispatch.
+// to generate at the first dispatch; lavapipe 22.3 pays a few hundred instructions a loop iteration, so
+// few iterations of several accesses each.
 SubCorners smoothSubCorners(uint st) {
   uint rec = SFFD_SUB_STRIDE * st;
   real3 q[6];   // XPN 0..2, then NLIN 0..2 (layout.h: NLIN = XPN + 6)
-  for (uint i = 0u; i < sffdRolled(6u); ++i) {
-    for (uint j = 0u; j < 5u; ++j) q[j] = q[j + 1u];
-    q[5] = subRecords[rec + SFFD_SUB_XPN + (i < 3u ? i : i + 3u)].xyz;
+  for (uint h = 0u; h < sffdRolled(2u); ++h) {
+    for (uint j = 0u; j < 3u; ++j) q[j] = q[j + 3u];
+    for (uint j = 0u; j < 3u; ++j) q[3u + j] = subRecords[rec + SFFD_SUB_XPN + 6u * h + j].xyz;
   }
   SubCorners C;
   C.x0 = q[0];
