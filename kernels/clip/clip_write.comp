@@ -59,22 +59,20 @@ void main() {
     for (uint slot = 0u; slot < sffdRolled(6u); ++slot) {
       // Slots 2c (towards corner c+2) and 2c+1 (towards c+1): the neighbour's normal where the
       // sub-edge lies on a crease edge of the parent. One rolled loop over the six: one copy of it.
-      {
-        uint c = slot / 2u, h = slot % 2u;
-        uint d = h == 0u ? (c + 2u) % 3u : (c + 1u) % 3u;
-        real4 nn = real4(c == 0u ? npn0 : (c == 1u ? npn1 : npn2), 0);
-        uint ce = sharedCanonicalEdge(edge[c], step[c], edge[d], step[d]);
-        if (ce < 3u) {
-          uint a = S.perm[ce], b = S.perm[(ce + 1u) % 3u];
-          uint le = (b == (a + 1u) % 3u) ? a : b;
-          EdgeNeighbour n = le == 0u ? nbr0 : (le == 1u ? nbr1 : nbr2);
-          if (n.crease) {
-            nn = real4(neighbourNormalAt(n, siteParamOnEdge(par, kind[c], siteT[c], n.e)), 1);   // w = 1: a crease
-            creaseBits |= 1u << (2u * c + h);
-          }
+      uint c = slot / 2u, h = slot % 2u;
+      uint d = h == 0u ? (c + 2u) % 3u : (c + 1u) % 3u;
+      real4 nn = real4(c == 0u ? npn0 : (c == 1u ? npn1 : npn2), 0);
+      uint ce = sharedCanonicalEdge(edge[c], step[c], edge[d], step[d]);
+      if (ce < 3u) {
+        uint a = S.perm[ce], b = S.perm[(ce + 1u) % 3u];
+        uint le = (b == (a + 1u) % 3u) ? a : b;
+        EdgeNeighbour n = le == 0u ? nbr0 : (le == 1u ? nbr1 : nbr2);
+        if (n.crease) {
+          nn = real4(neighbourNormalAt(n, siteParamOnEdge(par, kind[c], siteT[c], n.e)), 1);   // w = 1: a crease
+          creaseBits |= 1u << (2u * c + h);
         }
-        subRecords[rec + SFFD_SUB_NNBR + 2u * c + h] = nn;
       }
+      subRecords[rec + SFFD_SUB_NNBR + 2u * c + h] = nn;
     }
     subRecords[rec + SFFD_SUB_CREASE_BITS] = real4(lam0, real(creaseBits));
     subHeaders[o] = uvec4(par.id, creaseBits, 0u, 0u);
