@@ -104,19 +104,33 @@ struct Parent {
   real3 n[6];   // the PN normal control points
 };
 
+// Mesa 25.0 writes each storage read out per lane and component with a branch, so every read written in
+// the kernel (or by an unrolled loop) adds machine code to generate at the first dispatch, and a rolled
+// loop (prelude.glsl sffdRolled) holds one copy. But lavapipe 22.3 pays a few hundred instructions a
+// loop iteration, so the reads go in few iterations of several reads, the values through a shift
+// register (an array indexed by constants only: registers). Same values, same bits.
 Parent loadParent(uint id) {
   Parent p;
   p.id = id;
   p.local = id - params.range.w;
   p.verts = triangles(SFFD_MESH_TRIANGLE_STRIDE * p.local);
   p.welds = triangles(SFFD_MESH_TRIANGLE_STRIDE * p.local + 1u);
-  for (uint c = 0u; c < 3u; ++c) {
-    p.V[c] = positions(p.verts[c]).xyz;
-    p.N[c] = normals(p.verts[c]).xyz;
+  // 0..2 positions, 3..5 normals, 6..21 the PN record (10 control points, 6 normal control points):
+  // two iterations of eleven reads.
+  real3 q[22];
+  uint base = params.sections.y + SFFD_PN_STRIDE * p.local;
+  for (uint h = 0u; h < sffdRolled(2u); ++h) {
+    for (uint j = 0u; j < 11u; ++j) q[j] = q[j + 11u];
+    for (uint j = 0u; j < 11u; ++j) {
+      uint i = 11u * h + j;
+      uint a = i < 3u ? p.verts[i] : (i < 6u ? params.range.z + p.verts[i - 3u] : base + (i - 6u));
+      q[11u + j] = clipInReals[a].xyz;
+    }
   }
-  uint base = SFFD_PN_STRIDE * p.local;
-  for (uint i = 0u; i < 10u; ++i) p.b[i] = pn(base + i).xyz;
-  for (uint i = 0u; i < 6u; ++i) p.n[i] = pn(base + SFFD_PN_NORMALS + i).xyz;
+  p.V[0] = q[0]; p.V[1] = q[1]; p.V[2] = q[2];
+  p.N[0] = q[3]; p.N[1] = q[4]; p.N[2] = q[5];
+  for (uint i = 0u; i < 10u; ++i) p.b[i] = q[6u + i];
+  for (uint i = 0u; i < 6u; ++i) p.n[i] = q[16u + i];
   return p;
 }
 
@@ -248,11 +262,15 @@ ClipTriangle loadClipTriangle(uint ct) {
   T.parent = h.x;
   T.kinds = h.y;
   T.welds = clipHeaders(SFFD_CLIP_HEADER_STRIDE * ct + 1u);
+  // Corners 0..2, then edge params 6..8: two iterations of three reads (see loadParent).
+  real4 q[6];
   uint base = SFFD_CLIP_REAL_STRIDE * ct;
-  for (uint c = 0u; c < 3u; ++c) {
-    T.lam[c] = clipReals(base + c);
-    T.edgeParams[c] = clipReals(base + 6u + c);
+  for (uint h = 0u; h < sffdRolled(2u); ++h) {
+    for (uint j = 0u; j < 3u; ++j) q[j] = q[j + 3u];
+    for (uint j = 0u; j < 3u; ++j) q[3u + j] = clipReals(base + 6u * h + j);
   }
+  T.lam[0] = q[0]; T.lam[1] = q[1]; T.lam[2] = q[2];
+  T.edgeParams[0] = q[3]; T.edgeParams[1] = q[4]; T.edgeParams[2] = q[5];
   return T;
 }
 

@@ -16,8 +16,13 @@ void main() {
   ClipTriangle T = loadClipTriangle(ct);
   Parent par = loadParent(T.parent);
   // Per local clip edge: the parent edge it lies on and the neighbour's normal there (crease edges).
-  EdgeNeighbour nbr[3];
-  for (uint le = 0u; le < 3u; ++le) nbr[le] = edgeNeighbour(par, T.edgeParams[le].x);
+  // A rolled loop (one copy of the reads, see loadParent), the results through a shift register.
+  EdgeNeighbour nbr0, nbr1, nbr2;
+  for (uint le = 0u; le < sffdRolled(3u); ++le) {
+    nbr0 = nbr1;
+    nbr1 = nbr2;
+    nbr2 = edgeNeighbour(par, clipEdgeParams(T, le).x);
+  }
   uint out0 = counts(ct);
   for (uint k = 0u; k < S.entry.w; ++k) {
     // Per corner c of the sub-triangle: its pattern vertex's edge and step, and its site's kind and
@@ -50,27 +55,24 @@ void main() {
       if (c == 1u) npn1 = val.npn;
       if (c == 2u) npn2 = val.npn;
     }
-    // Sub-edge j joins corners j and d = j + 2: slot 2j (at corner j, towards d) and slot 2d + 1 (at d,
-    // towards j). Where it lies on a crease edge of the parent, each slot holds the neighbour's normal
-    // at its corner's site (w = 1), else the corner's own PN normal. The shared edge and the neighbour
-    // are found once a sub-edge.
     uint creaseBits = 0u;
-    for (uint j = 0u; j < sffdRolled(3u); ++j) {
-      uint d = (j + 2u) % 3u;
-      uint ce = sharedCanonicalEdge(edge[j], step[j], edge[d], step[d]);
-      uint a = S.perm[ce % 3u], b = S.perm[(ce + 1u) % 3u];
-      uint le = (b == (a + 1u) % 3u) ? a : b;
-      EdgeNeighbour n = le == 0u ? nbr[0] : (le == 1u ? nbr[1] : nbr[2]);
-      bool crease = ce < 3u && n.crease;
-      real4 nj = real4(j == 0u ? npn0 : (j == 1u ? npn1 : npn2), 0);
-      real4 nd = real4(d == 0u ? npn0 : (d == 1u ? npn1 : npn2), 0);
-      if (crease) {
-        nj = real4(neighbourNormalAt(n, siteParamOnEdge(par, kind[j], siteT[j], n.e)), 1);
-        nd = real4(neighbourNormalAt(n, siteParamOnEdge(par, kind[d], siteT[d], n.e)), 1);
-        creaseBits |= (1u << (2u * j)) | (1u << (2u * d + 1u));
+    for (uint slot = 0u; slot < sffdRolled(6u); ++slot) {
+      // Slots 2c (towards corner c+2) and 2c+1 (towards c+1): the neighbour's normal where the
+      // sub-edge lies on a crease edge of the parent. One rolled loop over the six: one copy of it.
+      uint c = slot / 2u, h = slot % 2u;
+      uint d = h == 0u ? (c + 2u) % 3u : (c + 1u) % 3u;
+      real4 nn = real4(c == 0u ? npn0 : (c == 1u ? npn1 : npn2), 0);
+      uint ce = sharedCanonicalEdge(edge[c], step[c], edge[d], step[d]);
+      if (ce < 3u) {
+        uint a = S.perm[ce], b = S.perm[(ce + 1u) % 3u];
+        uint le = (b == (a + 1u) % 3u) ? a : b;
+        EdgeNeighbour n = le == 0u ? nbr0 : (le == 1u ? nbr1 : nbr2);
+        if (n.crease) {
+          nn = real4(neighbourNormalAt(n, siteParamOnEdge(par, kind[c], siteT[c], n.e)), 1);   // w = 1: a crease
+          creaseBits |= 1u << (2u * c + h);
+        }
       }
-      subRecords[rec + SFFD_SUB_NNBR + 2u * j] = nj;
-      subRecords[rec + SFFD_SUB_NNBR + 2u * d + 1u] = nd;
+      subRecords[rec + SFFD_SUB_NNBR + 2u * c + h] = nn;
     }
     subRecords[rec + SFFD_SUB_CREASE_BITS] = real4(lam0, real(creaseBits));
     subHeaders[o] = uvec4(par.id, creaseBits, 0u, 0u);

@@ -87,10 +87,11 @@ const uint sffdAssumptions = SFFD_ASSUMPTIONS;
 #endif
 bool sffdAssumes(uint bit) { return (sffdAssumptions & bit) != 0u; }
 
-// n, in a form no shader compiler can fold (gl_NumWorkGroups.z is at least 1): a loop bounded by it is
-// compiled as one copy of its body, not unrolled. For loops whose body is large: llvmpipe and lavapipe
-// generate machine code at a kernel's first dispatch, and unrolled bodies made that take seconds.
-uint sffdRolled(uint n) { return min(n, n + gl_NumWorkGroups.z - 1u); }
+// n, in a form no shader compiler can fold (gl_NumWorkGroups.z is at most 65535, and 1 here): a loop
+// bounded by it is compiled as one copy of its body, not unrolled. llvmpipe and lavapipe generate
+// machine code at a kernel's first dispatch, and unrolled bodies made that take seconds. Not
+// min(n, ...): Mesa 25.0's NIR takes a min's constant as the trip count and unrolls small bodies.
+uint sffdRolled(uint n) { return n + (gl_NumWorkGroups.z >> 16u); }
 
 #if SFFD_STRICT
 real sdot(real3 a, real3 b) {

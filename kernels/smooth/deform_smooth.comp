@@ -25,11 +25,10 @@ void main() {
   ncp[4] = centreN;
   smoothAdjust(smoothCreaseBits(st), adj, adjNbr, cp);
 
+  // The geometry patch, then the normal patch: ten stores in a rolled loop of two (as smoothSubCorners).
   uint pbase = SFFD_PATCH_STRIDE * st;
-  for (uint k = 0u; k < 10u; ++k) {
-    patches(pbase + k) = real4(cp[k], 0);
-    patches(pbase + 10u + k) = real4(ncp[k], 0);
-  }
+  for (uint h = 0u; h < sffdRolled(2u); ++h)
+    for (uint k = 0u; k < 10u; ++k) patches(pbase + 10u * h + k) = real4(h == 0u ? cp[k] : ncp[k], 0);
   uint L = params.range.w;
   smoothTessellate(cp, ncp, L, (L + 1u) * (L + 2u) * st);   // 2 * vertex count * st
 }

@@ -61,15 +61,25 @@ real3 nearControlPoint(real3 q0, real3 q1, real3 q2, real3 q3) {
 struct SubCorners {
   real3 x0, x1, x2, n0, n1, n2;
 };
+// Reads in a rolled loop of two (prelude.glsl sffdRolled), the values through a shift register (an
+// array indexed by constants only: registers): Mesa 25.0 writes each storage access out per lane and
+// component with a branch, so each one written in the kernel (or by an unrolled loop) adds machine code
+// to generate at the first dispatch; lavapipe 22.3 pays a few hundred instructions a loop iteration, so
+// few iterations of several accesses each.
 SubCorners smoothSubCorners(uint st) {
   uint rec = SFFD_SUB_STRIDE * st;
+  real3 q[6];   // XPN 0..2, then NLIN 0..2 (layout.h: NLIN = XPN + 6)
+  for (uint h = 0u; h < sffdRolled(2u); ++h) {
+    for (uint j = 0u; j < 3u; ++j) q[j] = q[j + 3u];
+    for (uint j = 0u; j < 3u; ++j) q[3u + j] = subRecords[rec + SFFD_SUB_XPN + 6u * h + j].xyz;
+  }
   SubCorners C;
-  C.x0 = subRecords[rec + SFFD_SUB_XPN].xyz;
-  C.x1 = subRecords[rec + SFFD_SUB_XPN + 1u].xyz;
-  C.x2 = subRecords[rec + SFFD_SUB_XPN + 2u].xyz;
-  C.n0 = subRecords[rec + SFFD_SUB_NLIN].xyz;
-  C.n1 = subRecords[rec + SFFD_SUB_NLIN + 1u].xyz;
-  C.n2 = subRecords[rec + SFFD_SUB_NLIN + 2u].xyz;
+  C.x0 = q[0];
+  C.x1 = q[1];
+  C.x2 = q[2];
+  C.n0 = q[3];
+  C.n1 = q[4];
+  C.n2 = q[5];
   return C;
 }
 
@@ -210,7 +220,7 @@ void smoothAdjust(uint creaseBits, real3 adj[3], real3 adjNbr[6], inout real3 cp
 void smoothTessellate(real3 cp[10], real3 ncp[10], uint L, uint tbase) {
   uint nv = (L + 1u) * (L + 2u) / 2u;
   uint lastRow = L * (L + 1u) / 2u;
-  for (uint c = 0u; c < 3u; ++c) {
+  for (uint c = 0u; c < sffdRolled(3u); ++c) {   // rolled: one copy of the stores (smoothSubCorners)
     uint v = c == 0u ? 0u : (c == 1u ? lastRow : lastRow + L);
     real3 xc = c == 0u ? cp[0] : (c == 1u ? cp[6] : cp[9]);
     real3 nc = c == 0u ? ncp[0] : (c == 1u ? ncp[6] : ncp[9]);
