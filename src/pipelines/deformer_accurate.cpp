@@ -94,11 +94,7 @@ class AccurateRun final : public MethodRun {
     take();
     PatchWelder weld(job_.level, job_.count());
     weldChunks(weld);
-    Mesh m = weld.finish();
-    m.materials = input_.materials;
-    m.groups = input_.groups;
-    m.materialLibraries = input_.materialLibraries;
-    return m;
+    return weld.finish(input_);
   }
 
   void streamResult(MeshSink& sink, const ProgressReporter&) const override {

@@ -44,11 +44,7 @@ class SmoothRun final : public MethodRun {
   Mesh result(const ProgressReporter&) const override {
     PatchWelder weld(session_->level(), preImages().size());
     weldChunks(weld);
-    Mesh m = weld.finish();
-    m.materials = input_.materials;
-    m.groups = input_.groups;
-    m.materialLibraries = input_.materialLibraries;
-    return m;
+    return weld.finish(input_);
   }
 
   void streamResult(MeshSink& sink, const ProgressReporter&) const override {

@@ -314,6 +314,13 @@ PatchWelder::PatchWelder(int level, size_t patches, MeshSink* sink) : impl_(std:
 PatchWelder::~PatchWelder() = default;
 void PatchWelder::add(const PatchVertices& patches) { impl_->add(patches); }
 Mesh PatchWelder::finish() { return impl_->finish(); }
+Mesh PatchWelder::finish(const Mesh& input) {
+  Mesh m = impl_->finish();
+  m.materials = input.materials;
+  m.groups = input.groups;
+  m.materialLibraries = input.materialLibraries;
+  return m;
+}
 
 Mesh PatchWelder::tablesOf(const Mesh& input) {
   Mesh m;

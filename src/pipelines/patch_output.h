@@ -88,6 +88,8 @@ class PatchWelder {
   ~PatchWelder();
   void add(const PatchVertices& slice);   // carried fields and parentWeld filled (carryPatchAttributes)
   Mesh finish();
+  // finish() with the tables of `input` (materials, groups, material libraries), as a result carries them.
+  Mesh finish(const Mesh& input);
   // The Mesh of no vertices with the tables of `input` and the flags of a welded result (MeshSink::begin).
   static Mesh tablesOf(const Mesh& input);
 
