@@ -79,6 +79,7 @@
 #define SFFD_ASSUME_LATTICE_IN_STORAGE 8u  // the lattice storage buffers hold it
 #define SFFD_ASSUME_FIT_IN_PARAMS 16u      // DeformParams.inline_lattice holds the fit table
 #define SFFD_ASSUME_FIT_IN_STORAGE 32u     // the lattice frame range holds it
+#define SFFD_ASSUME_ROLLED_LOOPS 64u       // keep the loops bounded by sffdRolled() rolled (prelude.glsl)
 
 // The lattice part of every parameter block.
 SFFD_STRUCT_BEGIN(LatticeParams)

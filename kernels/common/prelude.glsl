@@ -87,11 +87,14 @@ const uint sffdAssumptions = SFFD_ASSUMPTIONS;
 #endif
 bool sffdAssumes(uint bit) { return (sffdAssumptions & bit) != 0u; }
 
-// n, in a form no shader compiler can fold (gl_NumWorkGroups.z is at most 65535, and 1 here): a loop
-// bounded by it is compiled as one copy of its body, not unrolled. llvmpipe and lavapipe generate
-// machine code at a kernel's first dispatch, and unrolled bodies made that take seconds. Not
-// min(n, ...): Mesa 25.0's NIR takes a min's constant as the trip count and unrolls small bodies.
-uint sffdRolled(uint n) { return n + (gl_NumWorkGroups.z >> 16u); }
+// The trip count of a loop over record accesses. Where the host asks for rolled loops
+// (SFFD_ASSUME_ROLLED_LOOPS: llvmpipe and lavapipe of Mesa 23 on, which write a storage access out per
+// lane and component and compile unrolled copies for seconds at a kernel's first dispatch), n in a
+// form no shader compiler can fold (gl_NumWorkGroups.z is at most 65535, and 1 here), so the loop is
+// one copy of its body; not min(n, ...): Mesa 25.0's NIR takes a min's constant as the trip count.
+// Elsewhere n itself: Mesa 22.3 compiles unrolled code quickly and runs every iteration of a rolled
+// loop at a cost, and a GPU driver unrolls what pays.
+uint sffdRolled(uint n) { return sffdAssumes(SFFD_ASSUME_ROLLED_LOOPS) ? n + (gl_NumWorkGroups.z >> 16u) : n; }
 
 #if SFFD_STRICT
 real sdot(real3 a, real3 b) {

@@ -49,6 +49,13 @@ KernelVariant forLattice(KernelVariant v, const gpu::DeformParams& params) {
   return v;
 }
 
+KernelVariant forDevice(KernelVariant v, const DeviceInfo& device) {
+  if (device.name.find("llvmpipe") == std::string::npos) return v;
+  const size_t at = device.driver.find("Mesa ");
+  if (at != std::string::npos && std::atoi(device.driver.c_str() + at + 5) >= 23) v.assumptions |= SFFD_ASSUME_ROLLED_LOOPS;
+  return v;
+}
+
 Error noFloat64Error(const DeviceInfo& info) {
   if (info.api == "gles")
     return Error(ErrorKind::Input, "OpenGL ES has no double precision: use --precision float (or auto) with --backend gles");

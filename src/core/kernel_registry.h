@@ -33,6 +33,9 @@ std::string variantName(KernelVariant v);
 // lattice and the fit table are read from.
 KernelVariant forLattice(KernelVariant v, const gpu::LatticeParams& lattice);
 KernelVariant forLattice(KernelVariant v, const gpu::DeformParams& params);
+// The variant a backend compiles for `device`: with SFFD_ASSUME_ROLLED_LOOPS on llvmpipe and lavapipe of
+// Mesa 23 and later (prelude.glsl sffdRolled; measured on 22.3, which is left without, and 25.0).
+KernelVariant forDevice(KernelVariant v, const DeviceInfo& device);
 
 std::span<const EmbeddedKernel> embeddedKernels();
 // nullptr when no kernel has that name.

@@ -456,6 +456,7 @@ class GlBackend final : public Backend {
   }
 
   const Program& program(const EmbeddedKernel& kernel, KernelVariant variant) {
+    variant = forDevice(variant, info_);
     auto key = std::make_pair(&kernel, variantKey(variant));
     auto it = programs_.find(key);
     if (it != programs_.end()) return it->second;

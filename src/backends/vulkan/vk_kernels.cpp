@@ -52,6 +52,7 @@ void Kernels::destroy() {
 }
 
 VkPipeline Kernels::pipeline(std::string_view kernel, KernelVariant variant) {
+  variant = forDevice(variant, device_.info());
   const int v = variantIndex(variant);
   auto key = std::make_pair(std::string(kernel), variantKey(variant));
   if (auto it = pipelines_.find(key); it != pipelines_.end()) return it->second;
