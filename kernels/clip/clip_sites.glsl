@@ -20,10 +20,14 @@ layout(std430, SFFD_SET binding = SFFD_BINDING_CLIP_WORDS) buffer ClipInWords { 
 #else
 layout(std430, SFFD_SET binding = SFFD_BINDING_CLIP_WORDS) readonly buffer ClipInWords { uint clipInWords[]; };
 #endif
-#define positions(i) clipInReals[i]
-#define normals(i) clipInReals[params.range.z + (i)]
+// Where each input lies in the range (layout.h ClipParams); loadParent reads by these indices.
+#define positionIndex(i) (i)
+#define normalIndex(i) (params.range.z + (i))
+#define pnIndex(i) (params.sections.y + (i))
+#define positions(i) clipInReals[positionIndex(i)]
+#define normals(i) clipInReals[normalIndex(i)]
 #define slotNormals(i) clipInReals[params.sections.x + (i)]
-#define pn(i) clipInReals[params.sections.y + (i)]
+#define pn(i) clipInReals[pnIndex(i)]
 #define clipReals(i) clipInReals[params.sections.z + (i)]
 #define splitTable(i) clipInWords[i]
 #define counts(i) clipInWords[params.words.z + (i)]
@@ -118,12 +122,12 @@ Parent loadParent(uint id) {
   // 0..2 positions, 3..5 normals, 6..21 the PN record (10 control points, 6 normal control points):
   // two iterations of eleven reads.
   real3 q[22];
-  uint base = params.sections.y + SFFD_PN_STRIDE * p.local;
+  uint base = SFFD_PN_STRIDE * p.local;
   for (uint h = 0u; h < sffdRolled(2u); ++h) {
     for (uint j = 0u; j < 11u; ++j) q[j] = q[j + 11u];
     for (uint j = 0u; j < 11u; ++j) {
       uint i = 11u * h + j;
-      uint a = i < 3u ? p.verts[i] : (i < 6u ? params.range.z + p.verts[i - 3u] : base + (i - 6u));
+      uint a = i < 3u ? positionIndex(p.verts[i]) : (i < 6u ? normalIndex(p.verts[i - 3u]) : pnIndex(base + (i - 6u)));
       q[11u + j] = clipInReals[a].xyz;
     }
   }

@@ -69,11 +69,18 @@ void pnQuadraticWeights(RVec3<Real> lam, Real w[6]) {
   w[5] = t * t;
 }
 
+// The cubic Bernstein weights of pnEdgeCurve at t (from A).
+template <class Real>
+void pnEdgeWeights(Real t, Real w[4]) {
+  Real s = Real(1) - t;
+  w[0] = s * s * s, w[1] = Real(3) * s * s * t, w[2] = Real(3) * s * t * t, w[3] = t * t * t;
+}
+
 template <class Real>
 RVec3<Real> pnEdgeCurve(RVec3<Real> A, RVec3<Real> bA, RVec3<Real> bB, RVec3<Real> B, Real t) {
-  Real s = Real(1) - t;
-  Real w0 = s * s * s, w1 = Real(3) * s * s * t, w2 = Real(3) * s * t * t, w3 = t * t * t;
-  return ((A * w0 + bA * w1) + bB * w2) + B * w3;
+  Real w[4];
+  pnEdgeWeights(t, w);
+  return ((A * w[0] + bA * w[1]) + bB * w[2]) + B * w[3];
 }
 
 template <class Real>

@@ -67,7 +67,7 @@ void main() {
     if (welds[b] < welds[a]) { uint x = a; a = b; b = x; }
     en[e] = pnEdgeNormal(V[a], V[b], N[a], N[b]);   // edges (0,1) -> 110, (1,2) -> 011, (2,0) -> 101
   }
-  // The record (SFFD_PN_NORMALS = 10): eight stores in a rolled loop of two.
+  // The record (SFFD_PN_NORMALS = 10, SFFD_PN_STRIDE = 16, asserted in pn_triangles.cpp): eight stores in a rolled loop of two.
   real3 r[16] = real3[16](cp[0], cp[1], cp[2], cp[3], cp[4], cp[5], cp[6], cp[7], cp[8], cp[9], N[0], en[0], en[2], N[1], en[1], N[2]);
   uint base = SFFD_PN_STRIDE * tri;
   for (uint h = 0u; h < sffdRolled(2u); ++h)

@@ -11,6 +11,9 @@
 #include "kernels/common/shader_layout.h"
 #include "core/wall_clock.h"
 
+// pn_triangles.comp stores a record as 16 consecutive values, the normals right after the 10 points.
+static_assert(SFFD_PN_NORMALS == 10 && SFFD_PN_STRIDE == 16, "pn_triangles.comp's record stores follow layout.h");
+
 namespace sffd {
 namespace {
 

@@ -68,10 +68,10 @@ struct SubCorners {
 // few iterations of several accesses each.
 SubCorners smoothSubCorners(uint st) {
   uint rec = SFFD_SUB_STRIDE * st;
-  real3 q[6];   // XPN 0..2, then NLIN 0..2 (layout.h: NLIN = XPN + 6)
+  real3 q[6];   // XPN 0..2, then NLIN 0..2
   for (uint h = 0u; h < sffdRolled(2u); ++h) {
     for (uint j = 0u; j < 3u; ++j) q[j] = q[j + 3u];
-    for (uint j = 0u; j < 3u; ++j) q[3u + j] = subRecords[rec + SFFD_SUB_XPN + 6u * h + j].xyz;
+    for (uint j = 0u; j < 3u; ++j) q[3u + j] = subRecords[rec + SFFD_SUB_XPN + (SFFD_SUB_NLIN - SFFD_SUB_XPN) * h + j].xyz;
   }
   SubCorners C;
   C.x0 = q[0];

@@ -199,9 +199,10 @@ void tessellate(const RVec3<Real> cp[10], const RVec3<Real> ncp[10], int Lv, Rea
         int sa = 2 * a + 1, sb = 2 * b;
         int lo = a, hi = b, steps = stepsFromA, slo = sa, shi = sb;
         if (lexLess(cp[kCornerCp[b]], cp[kCornerCp[a]])) lo = b, hi = a, steps = Lv - stepsFromA, slo = sb, shi = sa;
-        // pnEdgeCurve's weights and sums.
-        const Real u = Real(steps) / Real(Lv), s = Real(1) - u;
-        const Real w0 = s * s * s, w1 = Real(3) * s * s * u, w2 = Real(3) * s * u * u, w3 = u * u * u;
+        // pnEdgeCurve's sums.
+        Real w[4];
+        pnEdgeWeights(Real(steps) / Real(Lv), w);
+        const Real w0 = w[0], w1 = w[1], w2 = w[2], w3 = w[3];
         const int q0 = kCornerCp[lo], q1 = kSlotControlPoint[slo], q2 = kSlotControlPoint[shi], q3 = kCornerCp[hi];
         x = ((P[q0] * V{w0, w0, w0, w0} + P[q1] * V{w1, w1, w1, w1}) + P[q2] * V{w2, w2, w2, w2}) + P[q3] * V{w3, w3, w3, w3};
         n = ((N[q0] * V{w0, w0, w0, w0} + N[q1] * V{w1, w1, w1, w1}) + N[q2] * V{w2, w2, w2, w2}) + N[q3] * V{w3, w3, w3, w3};
