@@ -108,11 +108,8 @@ struct Parent {
   real3 n[6];   // the PN normal control points
 };
 
-// Mesa 25.0 writes each storage read out per lane and component with a branch, so every read written in
-// the kernel (or by an unrolled loop) adds machine code to generate at the first dispatch, and a rolled
-// loop (prelude.glsl sffdRolled) holds one copy. But lavapipe 22.3 pays a few hundred instructions a
-// loop iteration, so the reads go in few iterations of several reads, the values through a shift
-// register (an array indexed by constants only: registers). Same values, same bits.
+// The reads in a loop bounded by sffdRolled (prelude.glsl: why, and why few iterations), the values
+// through a shift register (an array indexed by constants only: registers). Same values, same bits.
 Parent loadParent(uint id) {
   Parent p;
   p.id = id;

@@ -13,11 +13,9 @@ layout(std430, SFFD_SET binding = SFFD_BINDING_MESH_TRIANGLES) readonly buffer T
 layout(std430, SFFD_SET binding = SFFD_BINDING_MESH_SLOT_NORMALS) readonly buffer SlotNormals { real4 slotNormals[]; };
 layout(std430, SFFD_SET binding = SFFD_BINDING_PN_OUT) writeonly buffer PnOut { real4 pn[]; };
 
-// The per-slot work and the stores in rolled loops (prelude.glsl sffdRolled), results through shift
-// registers (arrays indexed by constants only: registers): Mesa 25.0 writes each storage access out
-// per lane and component with a branch, and generating that code for six unrolled slots and sixteen
-// stores took most of this kernel's first dispatch. Few iterations of several accesses each: lavapipe
-// 22.3 pays a few hundred instructions a loop iteration. Same arithmetic, same bits.
+// The per-slot work and the stores in loops bounded by sffdRolled (prelude.glsl; on Mesa 25.0 the six
+// slots and sixteen stores written out took most of this kernel's first dispatch), results through
+// shift registers (arrays indexed by constants only: registers). Same arithmetic, same bits.
 void main() {
   uint t = sffdThreadIndex();
   if (t >= params.range.y) return;

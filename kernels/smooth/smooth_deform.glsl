@@ -61,11 +61,8 @@ real3 nearControlPoint(real3 q0, real3 q1, real3 q2, real3 q3) {
 struct SubCorners {
   real3 x0, x1, x2, n0, n1, n2;
 };
-// Reads in a rolled loop of two (prelude.glsl sffdRolled), the values through a shift register (an
-// array indexed by constants only: registers): Mesa 25.0 writes each storage access out per lane and
-// component with a branch, so each one written in the kernel (or by an unrolled loop) adds machine code
-// to generate at the first dispatch; lavapipe 22.3 pays a few hundred instructions a loop iteration, so
-// few iterations of several accesses each.
+// The reads in a loop of two bounded by sffdRolled (prelude.glsl), the values through a shift register
+// (an array indexed by constants only: registers).
 SubCorners smoothSubCorners(uint st) {
   uint rec = SFFD_SUB_STRIDE * st;
   real3 q[6];   // XPN 0..2, then NLIN 0..2
