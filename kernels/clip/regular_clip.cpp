@@ -85,48 +85,62 @@ std::array<ClipTriangle, 2> bisect(const Mesh& mesh, const ClipTriangle& c, int 
 
 }  // namespace
 
+struct ClipTriangleBuilder::Splits {
+  std::map<std::pair<uint32_t, uint32_t>, SplitPoint> points;   // by the clip edge's weld pair
+};
+
+ClipTriangleBuilder::ClipTriangleBuilder(const Mesh& mesh, double l, int nmax)
+    : mesh_(mesh), l_(l), nmax_(nmax), splits_(std::make_unique<Splits>()) {
+  for (uint32_t w : mesh.weldId) nextWeld_ = std::max(nextWeld_, w + 1);
+}
+ClipTriangleBuilder::~ClipTriangleBuilder() = default;
+
+void ClipTriangleBuilder::add(uint32_t t, std::vector<ClipTriangle>& out) {
+  const Mesh& mesh = mesh_;
+  const int nmax = nmax_;
+  std::vector<ClipTriangle>& work = work_;
+  work.assign(1, parentClipTriangle(mesh, t));
+  bool split = false;
+  for (size_t i = 0; i < work.size();) {
+    ClipTriangle& c = work[i];
+    int worst = -1, worstCount = nmax;
+    double worstLen = 0;
+    for (int e = 0; e < 3; ++e) {
+      int a = e, b = (e + 1) % 3;
+      if (c.weld[b] < c.weld[a]) std::swap(a, b);
+      int n = segmentCount(c.flat[a], c.flat[b], l_);
+      double len = glm::length(c.flat[b] - c.flat[a]);
+      if (n > worstCount || (n == worstCount && n > nmax && len > worstLen)) worst = e, worstCount = n, worstLen = len;
+    }
+    if (worst < 0 || made_ + work.size() > (size_t(1) << 31)) {
+      ++i;
+      continue;
+    }
+    split = true;
+    uint32_t wa = c.weld[worst], wb = c.weld[(worst + 1) % 3];
+    auto key = std::minmax(wa, wb);
+    auto it = splits_->points.find(key);
+    if (it == splits_->points.end()) {
+      // The split point from the edge's lower-weld end: the neighbour finds the same point here.
+      const glm::dvec3& pLo = wa <= wb ? c.flat[worst] : c.flat[(worst + 1) % 3];
+      const glm::dvec3& pHi = wa <= wb ? c.flat[(worst + 1) % 3] : c.flat[worst];
+      it = splits_->points.emplace(key, SplitPoint{nextWeld_++, pLo + (pHi - pLo) * 0.5}).first;
+    }
+    auto kids = bisect(mesh, c, worst, it->second);
+    work[i] = kids[0];
+    work.push_back(kids[1]);
+  }
+  if (split) ++presplitParents_;
+  made_ += work.size();
+  out.insert(out.end(), work.begin(), work.end());
+}
+
 ClipTriangles buildClipTriangles(const Mesh& mesh, double l, int nmax) {
   ClipTriangles out;
-  uint32_t nextWeld = 0;
-  for (uint32_t w : mesh.weldId) nextWeld = std::max(nextWeld, w + 1);
-  std::map<std::pair<uint32_t, uint32_t>, SplitPoint> splits;   // by the clip edge's weld pair
+  ClipTriangleBuilder builder(mesh, l, nmax);
   reserveHuge(out.triangles, mesh.triangles.size());   // at least one a parent: no growth copies below that
-  std::vector<ClipTriangle> work;                       // one parent's, reused
-  for (uint32_t t = 0; t < mesh.triangles.size(); ++t) {
-    work.assign(1, parentClipTriangle(mesh, t));
-    bool split = false;
-    for (size_t i = 0; i < work.size();) {
-      ClipTriangle& c = work[i];
-      int worst = -1, worstCount = nmax;
-      double worstLen = 0;
-      for (int e = 0; e < 3; ++e) {
-        int a = e, b = (e + 1) % 3;
-        if (c.weld[b] < c.weld[a]) std::swap(a, b);
-        int n = segmentCount(c.flat[a], c.flat[b], l);
-        double len = glm::length(c.flat[b] - c.flat[a]);
-        if (n > worstCount || (n == worstCount && n > nmax && len > worstLen)) worst = e, worstCount = n, worstLen = len;
-      }
-      if (worst < 0 || out.triangles.size() + work.size() > (size_t(1) << 31)) {
-        ++i;
-        continue;
-      }
-      split = true;
-      uint32_t wa = c.weld[worst], wb = c.weld[(worst + 1) % 3];
-      auto key = std::minmax(wa, wb);
-      auto it = splits.find(key);
-      if (it == splits.end()) {
-        // The split point from the edge's lower-weld end: the neighbour finds the same point here.
-        const glm::dvec3& pLo = wa <= wb ? c.flat[worst] : c.flat[(worst + 1) % 3];
-        const glm::dvec3& pHi = wa <= wb ? c.flat[(worst + 1) % 3] : c.flat[worst];
-        it = splits.emplace(key, SplitPoint{nextWeld++, pLo + (pHi - pLo) * 0.5}).first;
-      }
-      auto kids = bisect(mesh, c, worst, it->second);
-      work[i] = kids[0];
-      work.push_back(kids[1]);
-    }
-    if (split) ++out.presplitParents;
-    out.triangles.insert(out.triangles.end(), work.begin(), work.end());
-  }
+  for (uint32_t t = 0; t < mesh.triangles.size(); ++t) builder.add(t, out.triangles);
+  out.presplitParents = builder.presplitParents();
   return out;
 }
 

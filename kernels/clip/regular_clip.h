@@ -3,6 +3,7 @@
 // sub-triangles lifted onto the PN surface, crack-free by construction. Also turns knot-box clipping
 // (knot_box_clip.h) into the same sub-triangle records, so both clippings feed one deform stage.
 #pragma once
+#include <memory>
 #include <vector>
 
 #include "core/backend.h"
@@ -34,6 +35,27 @@ struct ClipTriangles {
 
 // Clip triangles for target edge length l: pre-splits where some edge needs more than `nmax` segments.
 ClipTriangles buildClipTriangles(const Mesh& mesh, double l, int nmax);
+
+// The same a parent at a time, parents in increasing order (as buildClipTriangles takes them): the
+// split points of shared edges and the fresh weld ids are kept between calls, so the clip triangles come
+// out as buildClipTriangles makes them, without holding all of them (a one-shot job's chunks).
+class ClipTriangleBuilder {
+ public:
+  ClipTriangleBuilder(const Mesh& mesh, double l, int nmax);   // `mesh` outlives the builder
+  ~ClipTriangleBuilder();
+  void add(uint32_t parent, std::vector<ClipTriangle>& out);   // appends the parent's clip triangles
+  size_t presplitParents() const { return presplitParents_; }
+
+ private:
+  struct Splits;
+  const Mesh& mesh_;
+  double l_;
+  int nmax_;
+  uint32_t nextWeld_ = 0;
+  size_t made_ = 0, presplitParents_ = 0;
+  std::unique_ptr<Splits> splits_;
+  std::vector<ClipTriangle> work_;   // one parent's, reused
+};
 
 struct SubTriangleRecords {
   std::vector<uint32_t> headers;   // 4 per sub-triangle: parent, crease slot bits, 0, 0

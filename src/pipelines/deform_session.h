@@ -34,8 +34,10 @@ struct DeformSessionOptions {
   bool creasesApplied = false;  // the mesh's normals are applyCreaseAngle's already (the Deformer's copy): not again
   size_t maxChunkSubTriangles = 0;   // 0: chunks as large as the device allows (smaller only to test chunking)
   size_t maxChunkParents = 0;        // the same for the pre-compute's chunks of mesh triangles
-  // One deformation (DeformOptions::once): the pre-compute's inputs are freed once it ran (precompute() then
-  // throws); releaseRecords() and releaseOutput() free the rest as the caller reads it.
+  // One deformation (DeformOptions::once). Regular clipping: nothing runs before streamChunks(), which runs
+  // the pre-compute and the deform stage a chunk at a time (streamed()). Knot-box clipping: the pre-compute's
+  // inputs are freed once it ran (precompute() then throws); releaseRecords() and releaseOutput() free the
+  // rest as the caller reads it.
   bool once = false;
 };
 
@@ -52,7 +54,8 @@ struct SessionTimings {
 
 class DeformSession {
  public:
-  // Prepares the mesh (topology, creases from its normals, clip triangles) and runs precompute().
+  // Prepares the mesh (topology, creases from its normals, clip triangles) and runs precompute() (streamed():
+  // neither clip triangles nor the pre-compute; `mesh` must then outlive the session, which reads it later).
   // The lattice fixes the degrees, counts, knots and box that later deform() calls must keep.
   // Throws an input Error for bad options and a device Error when the device refuses the work.
   DeformSession(Backend& backend, const Mesh& mesh, const Lattice& lattice, const DeformSessionOptions& options,
@@ -64,7 +67,8 @@ class DeformSession {
   // Runs the pre-compute stage again (PN triangles and clipping; the records stay on the device).
   const SessionTimings& precompute(const StageProgress& progress = {});
   // Deforms with the lattice's current control points into the chunks' buffers (undefined before the
-  // first call); an input Error if the lattice's structure differs from the session's.
+  // first call); an input Error if the lattice's structure differs from the session's. Streamed: only
+  // takes the lattice, for streamChunks().
   const SessionTimings& deform(const Lattice& lattice, const StageProgress& progress = {});
   const SessionTimings& timings() const { return timings_; }
 
@@ -77,8 +81,19 @@ class DeformSession {
     BufferId output = 0;
     uint64_t patchesOffset = 0;
   };
-  const std::vector<Chunk>& chunks() const { return chunks_; }
-  size_t subTriangles() const { return subCount_; }
+  const std::vector<Chunk>& chunks() const { return chunks_; }   // streamed: none
+  size_t subTriangles() const { return subCount_; }               // streamed: those streamed so far
+
+  // A one-shot job with regular clipping (options().once): the whole mesh is never clipped at once. After
+  // deform(), streamChunks() makes the clip triangles of a few consecutive parents (within 24 MiB of
+  // inputs beyond the vertices, and options().maxChunkParents), uploads them, runs pn_triangles,
+  // clip_count and clip_write, deforms each chunk of their sub-triangles, hands its output (still on the
+  // device) and its pre-images to `read`, and frees it before the next: only one chunk's records and
+  // outputs exist at a time. Chunks come in order, with the same bits as a session that is not once;
+  // their `first` counts from the job's first sub-triangle. Once only (then an input Error).
+  bool streamed() const { return options_.once && !options_.knotBoxClip; }
+  using ChunkReader = std::function<void(const Chunk& chunk, const SubTrianglePreImages& preImages)>;
+  const SessionTimings& streamChunks(const ChunkReader& read, const StageProgress& progress = {});
   size_t precomputeChunks() const;   // the pre-compute's chunks of mesh triangles (options().maxChunkParents)
   int level() const { return options_.level; }
   const DeformSessionOptions& options() const { return options_; }
@@ -103,9 +118,10 @@ class DeformSession {
   std::unique_ptr<Impl> impl_;
   std::vector<Chunk> chunks_;
   size_t subCount_ = 0;
-  bool inputsReleased_ = false, recordsReleased_ = false;
+  bool inputsReleased_ = false, recordsReleased_ = false, deformed_ = false;
   std::optional<SubTrianglePreImages> takenPreImages_;   // once: read by deform() as each chunk's records went
-  void appendPreImages(size_t chunk, SubTrianglePreImages& to);
+  // Appends the pre-images of `count` sub-triangles from their headers and records on the device.
+  void readPreImages(BufferId headers, BufferId records, size_t count, SubTrianglePreImages& to);
   void requireOnce() const;
   SessionTimings timings_;
 };

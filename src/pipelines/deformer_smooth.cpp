@@ -6,6 +6,8 @@
 
 #include <sffd/error.h>
 
+#include "core/huge_pages.h"
+
 #include "kernels/smooth/smooth_deform.h"
 #include "pipelines/deform_session.h"
 #include "pipelines/deformer_internal.h"
@@ -17,7 +19,7 @@ class SmoothRun final : public MethodRun {
  public:
   SmoothRun(Backend& backend, const Mesh& input, const Lattice& lattice, const ResolvedOptions& r, Timings& t,
             const ProgressReporter& progress)
-      : input_(input) {
+      : input_(input), timings_(t) {
     DeformSessionOptions o;
     o.variant = r.variant;
     o.edgeLength = r.edgeLength;
@@ -30,6 +32,8 @@ class SmoothRun final : public MethodRun {
     o.maxChunkSubTriangles = r.maxChunkElements;
     o.once = r.once;
     session_ = std::make_unique<DeformSession>(backend, input, lattice, o, progress);
+    slice_.level = r.tess;
+    slice_.reserve(kWeldSlice);
     t.pnMs = session_->timings().pnMs;
     t.clipMs = session_->timings().clipMs;
   }
@@ -41,13 +45,26 @@ class SmoothRun final : public MethodRun {
   }
 
   // The patch vertices welded in slices as each chunk comes from the device: none of them held whole.
-  Mesh result(const ProgressReporter&) const override {
+  Mesh result(const ProgressReporter& progress) const override {
+    if (session_->streamed()) {
+      PatchWelder weld(session_->level(), 0);
+      streamChunks([&](const DeformSession::Chunk& c, const SubTrianglePreImages& pre) { weldChunk(weld, c, pre, 0); }, progress);
+      return weld.finish(input_);
+    }
     PatchWelder weld(session_->level(), preImages().size());
     weldChunks(weld);
     return weld.finish(input_);
   }
 
-  void streamResult(MeshSink& sink, const ProgressReporter&) const override {
+  void streamResult(MeshSink& sink, const ProgressReporter& progress) const override {
+    if (session_->streamed()) {   // a chunk at a time from the mesh, and the weld keeps only what later chunks reach
+      PatchWelder weld(session_->level(), 0, &sink);
+      weld.forgetPassedLocations(input_);
+      sink.begin(PatchWelder::tablesOf(input_));
+      streamChunks([&](const DeformSession::Chunk& c, const SubTrianglePreImages& pre) { weldChunk(weld, c, pre, 0); }, progress);
+      sink.end();
+      return;
+    }
     PatchWelder weld(session_->level(), preImages().size(), &sink);
     sink.begin(PatchWelder::tablesOf(input_));
     weldChunks(weld);
@@ -64,61 +81,87 @@ class SmoothRun final : public MethodRun {
     return *records_;
   }
 
-  // Each chunk's patch vertices into `weld`, kWeldSlice patches at a time (their carried fields filled).
-  void weldChunks(PatchWelder& weld) const {
-    PatchVertices slice;
-    slice.level = session_->level();
-    slice.reserve(kWeldSlice);
+  // A streamed session's run (DeformSession::streamChunks), its timings the Deformer's.
+  void streamChunks(const DeformSession::ChunkReader& read, const StageProgress& progress) const {
+    const SessionTimings& s = session_->streamChunks(read, progress);
+    timings_.pnMs = s.pnMs;
+    timings_.clipMs = s.clipMs;
+    timings_.deformMs = s.deformMs;
+    timings_.steps = stepsOf(s.dispatches);
+  }
+
+  // Chunk c's patch vertices into `weld`, kWeldSlice patches at a time (their carried fields filled); the
+  // pre-image of c's first sub-triangle is pre's `preFirst`.
+  void weldChunk(PatchWelder& weld, const DeformSession::Chunk& c, const SubTrianglePreImages& pre, size_t preFirst) const {
     auto add = [&](size_t first, size_t count, const auto* tess) {
       const size_t tessReals = 2 * size_t(tessVertexCount(session_->level())) * 4;
       for (size_t s = 0; s < count; s += kWeldSlice) {
-        slice.clear();
-        appendPatchVertices(*records_, first + s, std::min(kWeldSlice, count - s), tess + s * tessReals, slice);
-        carryPatchAttributes(slice, input_);
-        weld.add(slice);
+        slice_.clear();
+        appendPatchVertices(pre, preFirst + first + s, std::min(kWeldSlice, count - s), tess + s * tessReals, slice_);
+        carryPatchAttributes(slice_, input_);
+        weld.add(slice_);
       }
     };
-    session_->options().variant.f64 ? forEachChunk<double>(add) : forEachChunk<float>(add);
+    session_->options().variant.f64 ? forEachBlock(c, downloadD_, add) : forEachBlock(c, downloadF_, add);
+  }
+
+  // Each chunk's patch vertices into `weld` (the session not streamed).
+  void weldChunks(PatchWelder& weld) const {
+    for (size_t ci = 0; ci < session_->chunks().size(); ++ci) {
+      const DeformSession::Chunk& c = session_->chunks()[ci];
+      weldChunk(weld, c, *records_, c.first);
+      if (session_->options().once) session_->releaseOutput(ci);
+    }
   }
 
   std::optional<PatchVertices> patchVertices() const override {
-    preImages();
     PatchVertices p;
     p.level = session_->level();
-    p.reserve(records_->size());
-    auto add = [&](size_t first, size_t count, const auto* tess) {
-      if (first != p.patchCount()) throw std::logic_error("SmoothRun: chunks out of order");
-      appendPatchVertices(*records_, first, count, tess, p);
+    auto append = [&](const DeformSession::Chunk& c, const SubTrianglePreImages& pre, size_t preFirst) {
+      if (c.first != p.patchCount()) throw std::logic_error("SmoothRun: chunks out of order");
+      auto add = [&](size_t first, size_t count, const auto* tess) { appendPatchVertices(pre, preFirst + first, count, tess, p); };
+      session_->options().variant.f64 ? forEachBlock(c, downloadD_, add) : forEachBlock(c, downloadF_, add);
     };
-    session_->options().variant.f64 ? forEachChunk<double>(add) : forEachChunk<float>(add);
+    if (session_->streamed()) {
+      streamChunks([&](const DeformSession::Chunk& c, const SubTrianglePreImages& pre) { append(c, pre, 0); }, {});
+    } else {
+      preImages();
+      p.reserve(records_->size());
+      for (size_t ci = 0; ci < session_->chunks().size(); ++ci) {
+        append(session_->chunks()[ci], *records_, session_->chunks()[ci].first);
+        if (session_->options().once) session_->releaseOutput(ci);
+      }
+    }
     carryAttributes(p, input_);
     return p;
   }
 
-  // Calls add(first, count, tess) for consecutive runs of sub-triangles in order, each chunk's tessellation
-  // read from the device a block of at most kDownloadBytes at a time into one reused buffer (no host copy of
-  // the whole output, nor of a whole chunk, nor of the patches, which the vertices do not need).
+  // A download buffer kept between chunks (not zero-filled: each download overwrites it).
+  template <class Real>
+  struct Download {
+    std::unique_ptr<Real[]> data;
+    size_t size = 0;
+    Real* room(size_t n) {
+      if (n > size) data.reset(new Real[n]), size = n, adviseHugePages(data.get(), n * sizeof(Real));
+      return data.get();
+    }
+  };
+
+  // Calls add(first, count, tess) for consecutive blocks of chunk c's sub-triangles (first counted from
+  // c's), each block's tessellation read from the device into `buffer`, at most kDownloadBytes at a time
+  // (no host copy of the whole output, nor of a whole chunk, nor of the patches, which the vertices do not need).
   template <class Real, class Add>
-  void forEachChunk(const Add& add) const {
+  void forEachBlock(const DeformSession::Chunk& c, Download<Real>& buffer, const Add& add) const {
+    if (!c.count) return;
+    if (!c.output) throw Error(ErrorKind::Input, "the outputs were freed after one deformation (DeformOptions::once)");
     const size_t tessReals = 2 * size_t(tessVertexCount(session_->level())) * 4, patchBytes = tessReals * sizeof(Real);
     const size_t block = std::max<size_t>(1, kDownloadBytes / patchBytes / kWeldSlice) * kWeldSlice;   // whole weld slices
-    size_t most = 0, done = 0;
-    for (const DeformSession::Chunk& c : session_->chunks()) most = std::max(most, std::min(c.count, block));
-    std::unique_ptr<Real[]> tess(new Real[most * tessReals]);   // not zero-filled: each download overwrites it
-    adviseHugePages(tess.get(), most * tessReals * sizeof(Real));
-    for (size_t ci = 0; ci < session_->chunks().size(); ++ci) {
-      const DeformSession::Chunk& c = session_->chunks()[ci];
-      if (!c.count) continue;
-      if (c.first != done) throw std::logic_error("SmoothRun: chunks out of order");
-      for (size_t b = 0; b < c.count; b += block) {
-        const size_t n = std::min(block, c.count - b);
-        session_->backend().download(c.output, b * patchBytes, tess.get(), n * patchBytes);
-        add(c.first + b, n, static_cast<const Real*>(tess.get()));
-      }
-      done += c.count;
-      if (session_->options().once) session_->releaseOutput(ci);
+    Real* tess = buffer.room(std::min(block, c.count) * tessReals);
+    for (size_t b = 0; b < c.count; b += block) {
+      const size_t n = std::min(block, c.count - b);
+      session_->backend().download(c.output, b * patchBytes, tess, n * patchBytes);
+      add(b, n, static_cast<const Real*>(tess));
     }
-    if (done != records_->size()) throw std::logic_error("SmoothRun: chunks do not cover the sub-triangles");
   }
 
   std::vector<double> patchControlPoints() const override { return session_->output().patches; }
@@ -145,7 +188,11 @@ class SmoothRun final : public MethodRun {
   static constexpr size_t kWeldSlice = 64;   // patches a slice: their vertices in double fit the cache
   static constexpr size_t kDownloadBytes = size_t(16) << 20;   // a download's block (rounded to whole slices)
   const Mesh& input_;   // Deformer::Impl::input, which outlives the run
+  Timings& timings_;    // Deformer::Impl::timings: a streamed session's kernels run when its result is taken
   std::unique_ptr<DeformSession> session_;
+  mutable PatchVertices slice_;   // a weld slice, its room kept
+  mutable Download<float> downloadF_;
+  mutable Download<double> downloadD_;
   mutable std::optional<SubTrianglePreImages> records_;
   mutable bool taken_ = false;   // a result was taken (DeformOptions::once allows one)
 };

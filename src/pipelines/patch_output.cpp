@@ -108,6 +108,19 @@ class Key3Map {
     if (same(s->key, kEmpty)) s->key = key, s->value = fresh, ++used_;
     return s->value;
   }
+  // Keeps the keys whose value v has a new value to[v] (kNone: the key goes), in a table sized for them.
+  void remap(const std::vector<uint32_t>& to, uint32_t none) {
+    size_t kept = 0;
+    for (const Slot& s : slots_) kept += !same(s.key, kEmpty) && to[s.value] != none;
+    size_t n = 16;
+    while (n < 4 * kept) n *= 2;
+    std::vector<Slot> old;
+    resizeHuge(old, n);
+    old.swap(slots_);
+    used_ = kept;
+    for (const Slot& s : old)
+      if (!same(s.key, kEmpty) && to[s.value] != none) *find(s.key) = {s.key, to[s.value]};
+  }
 
  private:
   struct Slot {
@@ -148,29 +161,43 @@ class Locations {
   static constexpr uint32_t kNone = ~0u;
 
   // The slot that holds the location of the vertex at pre-image `lam` of a patch of `parent`, whose
-  // corners have weldIds `w` (kNone when it has none yet).
-  uint32_t& of(uint32_t parent, const uint32_t* w, const double* lam) {
+  // corners have weldIds `w` (kNone when it has none yet); with lastUse() given, `until` becomes the last
+  // parent that can reach that location (parents of later patches do not decrease).
+  uint32_t& of(uint32_t parent, const uint32_t* w, const double* lam, uint32_t& until) {
     const int zeros = (lam[0] == 0) + (lam[1] == 0) + (lam[2] == 0);
-    if (zeros == 2) return corner(w[lam[0] != 0 ? 0 : lam[1] != 0 ? 1 : 2]);
+    if (zeros == 2) return corner(w[lam[0] != 0 ? 0 : lam[1] != 0 ? 1 : 2], until);
     if (zeros == 1) {
       const int z = lam[0] == 0 ? 0 : lam[1] == 0 ? 1 : 2, a = (z + 1) % 3, b = (z + 2) % 3;
-      if (w[a] == w[b]) return corner(w[a]);   // an edge of no length: all of it is that corner
+      if (w[a] == w[b]) return corner(w[a], until);   // an edge of no length: all of it is that corner
       const int hi = w[a] < w[b] ? b : a;
+      // Every parent on that edge has both corners.
+      if (!lastUse_.empty()) until = std::min(lastUse_[w[a]], lastUse_[w[b]]);
       // Never all zero: the two weldIds differ.
       return other_.of({uint64_t(std::min(w[a], w[b])) << 32 | std::max(w[a], w[b]), bitsOf(lam[hi]), 0}, kNone);
     }
     // Apart from the edge keys: their last word is 0, the bits of +0, and inside a parent no barycentric
     // is 0 (so neither is this key all zero).
+    until = parent;
     return other_.of({uint64_t(parent), bitsOf(lam[0]), bitsOf(lam[1])}, kNone);
+  }
+  // Per weldId of the input, the last triangle with a corner there.
+  void setLastUse(std::vector<uint32_t> lastUse) { lastUse_ = std::move(lastUse); }
+  // Gives each location v the slot to[v], or forgets it (kNone).
+  void remap(const std::vector<uint32_t>& to) {
+    for (uint32_t& c : corner_)
+      if (c != kNone) c = to[c];
+    other_.remap(to, kNone);
   }
 
  private:
-  uint32_t& corner(uint32_t weldId) {
+  uint32_t& corner(uint32_t weldId, uint32_t& until) {
     if (weldId >= corner_.size()) corner_.resize(size_t(weldId) + 1, kNone);
+    if (!lastUse_.empty()) until = lastUse_[weldId];
     return corner_[weldId];
   }
   std::vector<uint32_t> corner_;
   Key3Map other_;
+  std::vector<uint32_t> lastUse_;
 };
 
 bool onPatchBoundary(int v, int L) {
@@ -184,7 +211,7 @@ struct PatchWelder::Impl {
   size_t patches;   // all that will come: the outputs are reserved for them
   std::vector<uint32_t> local;   // tessTriangles
   std::vector<char> boundary;    // per patch vertex
-  Mesh m;
+  Mesh m;   // per vertex slot its normal and carried values, weldId: its location's slot
   // Per location: its position (from the patch of the lowest parent that reaches it, so that every
   // triangle there uses the same bits where the sides disagree: a fin, a sliver) and first vertex;
   // per vertex: the next vertex of its location (one per distinct normal and carried value).
@@ -198,8 +225,15 @@ struct PatchWelder::Impl {
   bool started = false;
   MeshSink* sink;       // streamed: the pieces go here
   Mesh piece;           // streamed: the vertices and triangles of the last add()
-  size_t emitted = 0;   // streamed: the vertices handed over
+  size_t emitted = 0;   // streamed: the vertex slots handed over
   uint32_t lastParent = 0;
+  // Forgetting (forgetPassedLocations): the slots are compacted, so a slot's location and vertex numbers (the
+  // output's) are kept per slot; until: the last parent that can reach the location.
+  bool forgetting = false;
+  std::vector<uint32_t> locUntil, locId, vertexId;
+  size_t locTotal = 0, vertexTotal = 0;   // made so far: the next location's and vertex's numbers
+  size_t compactAt = kMinCompact;         // locations held when the next add() compacts
+  static constexpr size_t kMinCompact = size_t(1) << 16;
 
   Impl(int level, size_t patches, MeshSink* sink)
       : level(level), patches(patches), local(tessTriangles(level)), where(patches, level), sink(sink) {
@@ -231,6 +265,7 @@ struct PatchWelder::Impl {
       throw std::logic_error("weldPatchVertices: parentWeld not filled (carryAttributes)");
     if (P.level != level) throw std::logic_error("PatchWelder: patches of another level");
     if (!started) reserve(P), started = true;
+    if (forgetting && locs.size() >= compactAt && P.patchCount()) compact(P.parent[0]);
     const int nv = tessVertexCount(level);
     const bool uv = !P.texcoord.empty(), rgba = !P.color.empty();
     auto sameVertex = [&](uint32_t i, size_t g) {
@@ -244,6 +279,8 @@ struct PatchWelder::Impl {
       if (rgba) m.colors.push_back({P.color[4 * g], P.color[4 * g + 1], P.color[4 * g + 2], P.color[4 * g + 3]});
       m.weldId.push_back(loc);
       next.push_back(Locations::kNone);
+      if (forgetting) vertexId.push_back(uint32_t(vertexTotal));
+      ++vertexTotal;
       return i;
     };
     auto positionOf = [&](size_t g) { return glm::dvec3(P.position[3 * g], P.position[3 * g + 1], P.position[3 * g + 2]); };
@@ -254,12 +291,14 @@ struct PatchWelder::Impl {
       lastParent = parent;
       for (int v = 0; v < nv; ++v) {
         const size_t g = p * nv + v;
-        uint32_t fresh = Locations::kNone;
+        uint32_t fresh = Locations::kNone, until = parent;
         // A patch's inner vertices are its own.
-        uint32_t& loc = boundary[v] ? where.of(parent, &P.parentWeld[3 * p], &P.lamParent[3 * g]) : fresh;
+        uint32_t& loc = boundary[v] ? where.of(parent, &P.parentWeld[3 * p], &P.lamParent[3 * g], until) : fresh;
         if (loc == Locations::kNone) {
           loc = uint32_t(locs.size());
           locs.push_back({parent, uint32_t(m.normals.size()), positionOf(g)});
+          if (forgetting) locUntil.push_back(until), locId.push_back(uint32_t(locTotal));
+          ++locTotal;
           map[v] = newVertex(g, loc);
           continue;
         }
@@ -274,6 +313,7 @@ struct PatchWelder::Impl {
         std::array<uint32_t, 3> t{map[local[i]], map[local[i + 1]], map[local[i + 2]]};
         const uint32_t* w = m.weldId.data();
         if (w[t[0]] == w[t[1]] || w[t[1]] == w[t[2]] || w[t[0]] == w[t[2]]) continue;   // a collapsed corner of a degenerate patch
+        if (forgetting) t = {vertexId[t[0]], vertexId[t[1]], vertexId[t[2]]};
         m.triangles.push_back(t);
         if (!P.material.empty()) m.triangleMaterial.push_back(P.material[p]);
         if (!P.group.empty()) m.triangleGroup.push_back(P.group[p]);
@@ -293,26 +333,78 @@ struct PatchWelder::Impl {
     tail(m.texcoords, piece.texcoords);
     tail(m.colors, piece.colors);
     tail(m.weldId, piece.weldId);
+    if (forgetting)
+      for (uint32_t& w : piece.weldId) w = locId[w];
     piece.triangles.swap(m.triangles);
     piece.triangleMaterial.swap(m.triangleMaterial);
     piece.triangleGroup.swap(m.triangleGroup);
     m.triangles.clear(), m.triangleMaterial.clear(), m.triangleGroup.clear();
-    sink->add(piece, emitted);
+    sink->add(piece, vertexTotal - (n - emitted));
     emitted = n;
   }
 
+  // Drops the locations no patch of parent `now` or later can reach, with their vertices (all handed
+  // over: compact() runs between pieces), and renumbers the slots of the rest in order.
+  void compact(uint32_t now) {
+    constexpr uint32_t kNone = Locations::kNone;
+    std::vector<uint32_t> toLoc(locs.size(), kNone), toVertex(m.normals.size(), kNone);
+    size_t kept = 0;
+    for (size_t l = 0; l < locs.size(); ++l)
+      if (locUntil[l] >= now) toLoc[l] = uint32_t(kept), locs[kept] = locs[l], locUntil[kept] = locUntil[l], locId[kept] = locId[l], ++kept;
+    locs.resize(kept), locUntil.resize(kept), locId.resize(kept);
+    const bool uv = !m.texcoords.empty(), rgba = !m.colors.empty();
+    size_t keptV = 0;
+    for (size_t i = 0; i < m.normals.size(); ++i) {
+      if (toLoc[m.weldId[i]] == kNone) continue;
+      toVertex[i] = uint32_t(keptV);
+      m.normals[keptV] = m.normals[i];
+      if (uv) m.texcoords[keptV] = m.texcoords[i];
+      if (rgba) m.colors[keptV] = m.colors[i];
+      m.weldId[keptV] = toLoc[m.weldId[i]];
+      next[keptV] = next[i];
+      vertexId[keptV] = vertexId[i];
+      ++keptV;
+    }
+    for (auto* v : {&m.weldId, &next, &vertexId}) v->resize(keptV);
+    m.normals.resize(keptV);
+    if (uv) m.texcoords.resize(keptV);
+    if (rgba) m.colors.resize(keptV);
+    for (size_t i = 0; i < keptV; ++i)
+      if (next[i] != kNone) next[i] = toVertex[next[i]];
+    for (Location& L : locs) L.first = toVertex[L.first];
+    where.remap(toLoc);
+    emitted = keptV;
+    compactAt = std::max(kMinCompact, 2 * kept);
+  }
+
   Mesh finish() {
+    if (forgetting) throw std::logic_error("PatchWelder: finish() after forgetPassedLocations");
     reserveHuge(m.positions, m.normals.size());
     for (size_t i = 0; i < m.normals.size(); ++i) m.positions.push_back(locs[m.weldId[i]].position);
     locs = {};
     next = {};
     return std::move(m);
   }
+
+  void forgetPassed(const Mesh& input) {
+    if (!sink || started) throw std::logic_error("PatchWelder: forgetPassedLocations needs a sink, before the first add()");
+    std::vector<uint32_t> lastUse;
+    for (uint32_t t = 0; t < input.triangles.size(); ++t)
+      for (uint32_t v : input.triangles[t]) {
+        const uint32_t w = input.weldId[v];
+        if (w >= lastUse.size()) lastUse.resize(size_t(w) + 1, 0);
+        lastUse[w] = t;
+      }
+    where.setLastUse(std::move(lastUse));
+    forgetting = true;
+    patches = 0;   // nothing reserved for all of them: the slots stay few
+  }
 };
 
 PatchWelder::PatchWelder(int level, size_t patches, MeshSink* sink) : impl_(std::make_unique<Impl>(level, patches, sink)) {}
 PatchWelder::~PatchWelder() = default;
 void PatchWelder::add(const PatchVertices& patches) { impl_->add(patches); }
+void PatchWelder::forgetPassedLocations(const Mesh& input) { impl_->forgetPassed(input); }
 Mesh PatchWelder::finish() { return impl_->finish(); }
 Mesh PatchWelder::finish(const Mesh& input) {
   Mesh m = impl_->finish();

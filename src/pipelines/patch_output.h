@@ -87,6 +87,11 @@ class PatchWelder {
   PatchWelder(int level, size_t patches, MeshSink* sink = nullptr);
   ~PatchWelder();
   void add(const PatchVertices& slice);   // carried fields and parentWeld filled (carryPatchAttributes)
+  // Streamed, before the first add(): the slices' parents are triangles of `input` (in non-decreasing
+  // order), so a location no later parent has (a patch's inner point, a parent's inner point once the next
+  // parent comes, an input edge or corner after the last triangle on it) is forgotten with its vertices,
+  // now and then: what the weld holds is the front of the parents still to come, not the output so far.
+  void forgetPassedLocations(const Mesh& input);
   Mesh finish();
   // finish() with the tables of `input` (materials, groups, material libraries), as a result carries them.
   Mesh finish(const Mesh& input);
