@@ -11,6 +11,8 @@
 #include "backends/backend_select.h"
 #include "backends/backend_test_support.h"
 #include "pipelines/deform_session.h"
+#include "pipelines/device_reals.h"
+#include "pipelines/patch_output.h"
 #include <sffd/error.h>
 #include "kernels/clip/knot_box_clip.h"
 #include "model/lattice_pack.h"
@@ -155,6 +157,61 @@ TEST_P(DeformSessionTest, PrecomputeChunksGiveTheSameRecordsAndOutput) {
       EXPECT_EQ(o2.tess, o1.tess);
       EXPECT_EQ(o2.patches, o1.patches);
     }
+  }
+  EXPECT_EQ(vk::validationMessageCount(), 0u);
+}
+
+// A one-shot session (DeformSessionOptions::once, regular clipping) makes its clip triangles and runs
+// every stage a few parents at a time (streamChunks): in many small chunks, with pre-split parents (cube2
+// at l = 0.05), the same pre-images, tessellation and patches as a session that keeps everything.
+TEST_P(DeformSessionTest, StreamedChunksGiveTheSameOutput) {
+  OpenedBackend b = open();
+  for (auto [file, l] : {std::pair{"/cube2.obj", 0.05}, std::pair{"/sphere.obj", 0.3}}) {
+    SCOPED_TRACE(file);
+    const Mesh m = readMesh(std::string(SFFD_TEST_DATA) + file);
+    const Lattice A = latticeFor(m, 5, 0.1);
+    DeformSessionOptions o;
+    o.variant = {true, false};
+    o.edgeLength = l;
+    o.level = 3;
+    DeformSession one(*b.backend, m, A, o);
+    one.deform(A);
+    const SmoothOutput want = one.output();
+    const SubTrianglePreImages wantPre = one.preImages();
+    o.once = true;
+    o.maxChunkParents = 5;
+    o.maxChunkSubTriangles = 50;
+    DeformSession streamed(*b.backend, m, A, o);
+    ASSERT_TRUE(streamed.streamed());
+    EXPECT_TRUE(streamed.chunks().empty());
+    streamed.deform(A);
+    SmoothOutput got;
+    SubTrianglePreImages gotPre;
+    size_t chunks = 0;
+    const size_t tessReals = 2 * size_t(tessVertexCount(o.level)) * 4, patchReals = SFFD_PATCH_STRIDE * 4;
+    streamed.streamChunks([&](const DeformSession::Chunk& c, const SubTrianglePreImages& pre) {
+      EXPECT_EQ(c.first, gotPre.size());
+      ASSERT_EQ(pre.size(), c.count);
+      gotPre.parent.insert(gotPre.parent.end(), pre.parent.begin(), pre.parent.end());
+      gotPre.lam.insert(gotPre.lam.end(), pre.lam.begin(), pre.lam.end());
+      const std::vector<double> tess = downloadReals(*b.backend, c.output, 0, c.count * tessReals, false);
+      const std::vector<double> patches = downloadReals(*b.backend, c.output, c.patchesOffset, c.count * patchReals, false);
+      got.tess.insert(got.tess.end(), tess.begin(), tess.end());
+      got.patches.insert(got.patches.end(), patches.begin(), patches.end());
+      ++chunks;
+    });
+    EXPECT_GT(chunks, 5u);
+    EXPECT_EQ(streamed.subTriangles(), one.subTriangles());
+    EXPECT_EQ(gotPre.parent, wantPre.parent);
+    EXPECT_EQ(gotPre.lam, wantPre.lam);
+    EXPECT_EQ(got.tess, want.tess);
+    EXPECT_EQ(got.patches, want.patches);
+    // Once: what a repeated or kept job reads is gone.
+    EXPECT_THROW(streamed.streamChunks([](const DeformSession::Chunk&, const SubTrianglePreImages&) {}), Error);
+    EXPECT_THROW(streamed.deform(A), Error);
+    EXPECT_THROW(streamed.records(), Error);
+    EXPECT_THROW(streamed.output(), Error);
+    EXPECT_THROW(streamed.precompute(), Error);
   }
   EXPECT_EQ(vk::validationMessageCount(), 0u);
 }

@@ -100,6 +100,7 @@ class AccurateRun final : public MethodRun {
   void streamResult(MeshSink& sink, const ProgressReporter&) const override {
     take();
     PatchWelder weld(job_.level, job_.count(), &sink);
+    weld.forgetPassedLocations(input_);
     sink.begin(PatchWelder::tablesOf(input_));
     weldChunks(weld);
     sink.end();

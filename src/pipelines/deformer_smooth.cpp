@@ -66,6 +66,7 @@ class SmoothRun final : public MethodRun {
       return;
     }
     PatchWelder weld(session_->level(), preImages().size(), &sink);
+    weld.forgetPassedLocations(input_);
     sink.begin(PatchWelder::tablesOf(input_));
     weldChunks(weld);
     sink.end();

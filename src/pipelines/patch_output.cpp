@@ -97,12 +97,13 @@ struct Key3Hash {
 // Locations never makes it. A returned slot stays valid until the next of().
 class Key3Map {
  public:
-  explicit Key3Map(size_t expected) {
-    size_t n = 16;
-    while (n < 2 * expected) n *= 2;
-    resizeHuge(slots_, n);
-  }
+  explicit Key3Map(size_t expected) : expected_(expected) {}
   uint32_t& of(const std::array<uint64_t, 3>& key, uint32_t fresh) {
+    if (slots_.empty()) {   // allocated at the first key (PatchWelder::forgetPassedLocations expects fewer)
+      size_t n = 16;
+      while (n < 2 * expected_) n *= 2;
+      resizeHuge(slots_, n);
+    }
     if (2 * (used_ + 1) > slots_.size()) grow();
     Slot* s = find(key);
     if (same(s->key, kEmpty)) s->key = key, s->value = fresh, ++used_;
@@ -145,7 +146,7 @@ class Key3Map {
     return ((a[0] ^ b[0]) | (a[1] ^ b[1]) | (a[2] ^ b[2])) == 0;
   }
   std::vector<Slot> slots_;
-  size_t used_ = 0;
+  size_t expected_, used_ = 0;
 };
 
 // Where on the input surface a patch-boundary vertex lies, from its pre-image: a corner by the input's
@@ -232,8 +233,7 @@ struct PatchWelder::Impl {
   bool forgetting = false;
   std::vector<uint32_t> locUntil, locId, vertexId;
   size_t locTotal = 0, vertexTotal = 0;   // made so far: the next location's and vertex's numbers
-  size_t compactAt = kMinCompact;         // locations held when the next add() compacts
-  static constexpr size_t kMinCompact = size_t(1) << 16;
+  size_t minCompact = 0, compactAt = 0;   // locations held when the next add() compacts: at least minCompact
 
   Impl(int level, size_t patches, MeshSink* sink)
       : level(level), patches(patches), local(tessTriangles(level)), where(patches, level), sink(sink) {
@@ -374,7 +374,7 @@ struct PatchWelder::Impl {
     for (Location& L : locs) L.first = toVertex[L.first];
     where.remap(toLoc);
     emitted = keptV;
-    compactAt = std::max(kMinCompact, 2 * kept);
+    compactAt = std::max(minCompact, 2 * kept);
   }
 
   Mesh finish() {
@@ -386,7 +386,7 @@ struct PatchWelder::Impl {
     return std::move(m);
   }
 
-  void forgetPassed(const Mesh& input) {
+  void forgetPassed(const Mesh& input, size_t compactFrom) {
     if (!sink || started) throw std::logic_error("PatchWelder: forgetPassedLocations needs a sink, before the first add()");
     std::vector<uint32_t> lastUse;
     for (uint32_t t = 0; t < input.triangles.size(); ++t)
@@ -395,8 +395,10 @@ struct PatchWelder::Impl {
         if (w >= lastUse.size()) lastUse.resize(size_t(w) + 1, 0);
         lastUse[w] = t;
       }
+    where = Locations(0, level);   // no table for every patch's keys: it holds the front's
     where.setLastUse(std::move(lastUse));
     forgetting = true;
+    minCompact = compactAt = compactFrom;
     patches = 0;   // nothing reserved for all of them: the slots stay few
   }
 };
@@ -404,7 +406,8 @@ struct PatchWelder::Impl {
 PatchWelder::PatchWelder(int level, size_t patches, MeshSink* sink) : impl_(std::make_unique<Impl>(level, patches, sink)) {}
 PatchWelder::~PatchWelder() = default;
 void PatchWelder::add(const PatchVertices& patches) { impl_->add(patches); }
-void PatchWelder::forgetPassedLocations(const Mesh& input) { impl_->forgetPassed(input); }
+void PatchWelder::forgetPassedLocations(const Mesh& input, size_t compactAt) { impl_->forgetPassed(input, compactAt); }
+size_t PatchWelder::locationsHeld() const { return impl_->locs.size(); }
 Mesh PatchWelder::finish() { return impl_->finish(); }
 Mesh PatchWelder::finish(const Mesh& input) {
   Mesh m = impl_->finish();

@@ -91,7 +91,9 @@ class PatchWelder {
   // order), so a location no later parent has (a patch's inner point, a parent's inner point once the next
   // parent comes, an input edge or corner after the last triangle on it) is forgotten with its vertices,
   // now and then: what the weld holds is the front of the parents still to come, not the output so far.
-  void forgetPassedLocations(const Mesh& input);
+  // `compactAt`: the locations held before the first compaction (smaller only to test it).
+  void forgetPassedLocations(const Mesh& input, size_t compactAt = size_t(1) << 16);
+  size_t locationsHeld() const;   // those the weld holds now
   Mesh finish();
   // finish() with the tables of `input` (materials, groups, material libraries), as a result carries them.
   Mesh finish(const Mesh& input);

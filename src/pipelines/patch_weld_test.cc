@@ -272,4 +272,49 @@ TEST(PatchWeld, SlicesWeldAsOne) {
   }
 }
 
+// What a streamed weld hands over, appended.
+struct GatheringSink final : MeshSink {
+  Mesh m;
+  void add(const Mesh& piece, size_t firstVertex) override {
+    EXPECT_EQ(firstVertex, m.positions.size());
+    auto append = [](auto& to, const auto& from) { to.insert(to.end(), from.begin(), from.end()); };
+    append(m.positions, piece.positions), append(m.normals, piece.normals), append(m.texcoords, piece.texcoords);
+    append(m.colors, piece.colors), append(m.weldId, piece.weldId), append(m.triangles, piece.triangles);
+    append(m.triangleMaterial, piece.triangleMaterial), append(m.triangleGroup, piece.triangleGroup);
+  }
+};
+
+// A streamed weld that forgets the locations no later parent reaches (compacting as soon as it may here)
+// hands over the mesh of one that keeps them all, holding far fewer.
+TEST(PatchWeld, ForgettingPassedLocationsStreamsTheSameMesh) {
+  const Mesh sphere = readMesh(std::string(SFFD_TEST_DATA) + "/sphere.obj");
+  for (Method method : {Method::Smooth, Method::Accurate}) {
+    SCOPED_TRACE(method == Method::Smooth ? "smooth" : "accurate");
+    Lattice lattice = fitLattice(sphere, {5, 5, 5}, {2, 2, 2});
+    applyLatticePreset(lattice, "twist", 0.3);
+    DeviceRequest request;
+    request.name = "cpu";
+    Device d = Device::open(request);
+    DeformOptions o;
+    o.method = method;
+    o.tess = 3;
+    Deformer deformer(d, sphere, lattice, o);
+    deformer.deform(lattice);
+    const PatchVertices P = *deformer.internal().run->patchVertices();
+    const Mesh whole = weldPatchVertices(P);
+    GatheringSink sink;
+    sink.m.normalsFromFile = sink.m.weldIdIsLocation = true;
+    PatchWelder weld(P.level, P.patchCount(), &sink);
+    weld.forgetPassedLocations(deformer.internal().input, 1);
+    size_t mostHeld = 0;
+    for (size_t first = 0; first < P.patchCount(); first += 7) {
+      weld.add(sliceOf(P, first, std::min(P.patchCount(), first + 7)));
+      mostHeld = std::max(mostHeld, weld.locationsHeld());
+    }
+    expectSameMesh(sink.m, whole);
+    EXPECT_LT(mostHeld, whole.positions.size() / 2);
+    EXPECT_THROW(weld.finish(), std::logic_error);
+  }
+}
+
 }  // namespace
