@@ -78,13 +78,14 @@ DeformRun runMethod(const ParsedArgs& args, Job& job, Device& device, Method met
   };
   DeformRun run{name, method == Method::Accurate ? "knot-box" : args.get("--clip", "regular"), line, make(), {}};
   run.prepareMs = lap();
+  if (sinkFor) job.mesh = Mesh();   // the Deformer has its copy: not two at the streamed result's peak
   run.deformer.deform(job.lattice);
   run.deformMs = lap();
   if (sinkFor) run.deformer.streamResult(sinkFor(run.deformer));
   else run.mesh = run.deformer.result();
   run.resultMs = lap();
   line->clear();
-  if (method == Method::Smooth) job.mesh = run.deformer.internal().input;
+  if (method == Method::Smooth || sinkFor) job.mesh = run.deformer.internal().input;
   return run;
 }
 

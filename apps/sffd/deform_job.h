@@ -42,7 +42,7 @@ struct DeformRun {
 // depend on it); empty: the result is kept in DeformRun::mesh.
 using SinkFor = std::function<MeshSink&(const Deformer&)>;
 // With `sinkFor`, the result is streamed instead of kept (DeformRun::mesh stays empty), and the Deformer is
-// made for one deformation (DeformOptions::once).
+// made for one deformation (DeformOptions::once); job.mesh is emptied while it runs (then the Deformer's).
 DeformRun runMethod(const ParsedArgs& args, Job& job, Device& device, Method method, const SinkFor& sinkFor = {});
 // Round-trip digits of the results when written as text: 9 for float, 17 for double, or for float
 // results computed around a local origin away from 0 (their float bits are relative to it,

@@ -60,9 +60,12 @@ struct DeformOptions {
   size_t maxChunkElements = 0;   // 0: chunks as large as the device allows (smaller only to test chunking)
   ProgressCallback progress;     // called during long work; may be empty
   // A one-shot job, deformed and its result taken once (as `sffd deform` does): what only a repeated call
-  // needs is freed as soon as it is used (smooth: the pre-compute's inputs once it ran, the sub-triangle
-  // records as each chunk is deformed; smooth and accurate: each chunk's output once read), so a large job's
-  // peak memory is lower. A second deform(), or a second result() or streamResult(), throws an input Error.
+  // needs is never kept, so a large job's peak memory is lower. Smooth with regular clipping: deform() only
+  // takes the lattice, and result() or streamResult() runs the pre-compute and the deform stage a few
+  // parents at a time, each chunk's records and output freed once welded (timings() and subTriangles() are
+  // then the run's; deviceOutput() is empty, patchControlPoints() throws). Knot-box clipping: the pre-compute's
+  // inputs go once it ran, the records as each chunk is deformed. Smooth and accurate: each chunk's output
+  // goes once read. A second deform(), or a second result() or streamResult(), throws an input Error.
   bool once = false;
 };
 

@@ -226,22 +226,36 @@ void ClipRanges::name(gpu::ClipParams& p) const {
 }
 
 template <class Real>
+void writeClipVertexSection(const PreparedMesh& mesh, Real* out) {
+  // positions, then normals (meshVertexRange's order), converted as they are copied: no wider copy.
+  std::copy(mesh.positions.begin(), mesh.positions.end(), out);
+  std::copy(mesh.normals.begin(), mesh.normals.end(), out + mesh.positions.size());
+}
+
+template <class Real>
+void writeClipParentSections(const ClipRanges& r, const PreparedMesh& mesh, const std::vector<double>* pnRecords,
+                             const PackedClip& clip, Real* out) {
+  auto at = [&](uint64_t element) { return out + 4 * (element - r.slotNormals); };
+  mesh.slotNormals(r.firstParent, r.parents, at(r.slotNormals));
+  if (pnRecords) std::copy_n(pnRecords->begin() + 4 * SFFD_PN_STRIDE * r.firstParent, 4 * SFFD_PN_STRIDE * r.parents, at(r.pn));
+  std::copy(clip.reals.begin(), clip.reals.end(), at(r.clipReals));
+}
+
+template <class Real>
 std::vector<Real> clipRealRange(const ClipRanges& r, const PreparedMesh& mesh, const std::vector<double>* pnRecords,
                                 const PackedClip& clip) {
   std::vector<Real> v;
   resizeHuge(v, 4 * r.realElements, Real(0));
-  const std::vector<double> verts = meshVertexRange(mesh);
-  std::copy(verts.begin(), verts.end(), v.begin());
-  auto part = [&](const std::vector<double>& from, uint64_t stride, uint64_t at) {
-    std::copy_n(from.begin() + 4 * stride * r.firstParent, 4 * stride * r.parents, v.begin() + 4 * at);
-  };
-  mesh.slotNormals(r.firstParent, r.parents, v.data() + 4 * r.slotNormals);
-  if (pnRecords) part(*pnRecords, SFFD_PN_STRIDE, r.pn);
-  std::copy(clip.reals.begin(), clip.reals.end(), v.begin() + 4 * r.clipReals);
+  writeClipVertexSection(mesh, v.data());
+  writeClipParentSections(r, mesh, pnRecords, clip, v.data() + 4 * r.slotNormals);
   return v;
 }
 template std::vector<float> clipRealRange<float>(const ClipRanges&, const PreparedMesh&, const std::vector<double>*, const PackedClip&);
 template std::vector<double> clipRealRange<double>(const ClipRanges&, const PreparedMesh&, const std::vector<double>*, const PackedClip&);
+template void writeClipVertexSection<float>(const PreparedMesh&, float*);
+template void writeClipVertexSection<double>(const PreparedMesh&, double*);
+template void writeClipParentSections<float>(const ClipRanges&, const PreparedMesh&, const std::vector<double>*, const PackedClip&, float*);
+template void writeClipParentSections<double>(const ClipRanges&, const PreparedMesh&, const std::vector<double>*, const PackedClip&, double*);
 
 std::vector<uint32_t> clipWordRange(const ClipRanges& r, const PreparedMesh& mesh, const PackedClip& clip) {
   std::vector<uint32_t> w;

@@ -110,6 +110,15 @@ ClipRanges clipRanges(uint64_t vertices, uint64_t firstParent, uint64_t parents,
 template <class Real>
 std::vector<Real> clipRealRange(const ClipRanges& r, const PreparedMesh& mesh, const std::vector<double>* pnRecords,
                                   const PackedClip& clip);
+// Its two parts, which every chunk of a mesh shares and which are the chunk's own: the vertices' section
+// (elements [0, 2 * vertices); the rest of [0, r.slotNormals) is padding), and from element r.slotNormals
+// on the parents' and clip triangles' sections, written at `out` (room for 4 * (r.realElements -
+// r.slotNormals) reals, zero-filled).
+template <class Real>
+void writeClipVertexSection(const PreparedMesh& mesh, Real* out);
+template <class Real>
+void writeClipParentSections(const ClipRanges& r, const PreparedMesh& mesh, const std::vector<double>* pnRecords,
+                             const PackedClip& clip, Real* out);
 std::vector<uint32_t> clipWordRange(const ClipRanges& r, const PreparedMesh& mesh, const PackedClip& clip);
 
 struct CpuKernelArgs;

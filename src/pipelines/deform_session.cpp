@@ -83,6 +83,30 @@ struct DeformSession::Impl {
     c.words = uploadVector(b, clipWordRange(r, mesh, pc));
     return c;
   }
+  // The same for a streamed chunk: the vertices' section, which every chunk repeats, is built once
+  // (vertexSection, with its padding) and each chunk's own sections apart, so no chunk's whole range is
+  // built on the host.
+  std::vector<unsigned char> vertexSection;
+  void makeVertexSection(const ClipRanges& r) {
+    vertexSection.assign(r.byteOf(r.slotNormals), 0);
+    if (realSize == 8) writeClipVertexSection(mesh, reinterpret_cast<double*>(vertexSection.data()));
+    else writeClipVertexSection(mesh, reinterpret_cast<float*>(vertexSection.data()));
+  }
+  PreChunkInputs uploadStreamedInputs(Backend& b, const ClipRanges& r, const PackedClip& pc) {
+    PreChunkInputs c{r};
+    c.reals = make(b, r.byteOf(r.realElements));
+    b.upload(c.reals, 0, vertexSection.data(), vertexSection.size());
+    auto upload = [&](auto zero) {
+      using Real = decltype(zero);
+      std::vector<Real> own;
+      resizeHuge(own, 4 * (r.realElements - r.slotNormals), zero);
+      writeClipParentSections(r, mesh, nullptr, pc, own.data());
+      b.upload(c.reals, r.byteOf(r.slotNormals), own.data(), own.size() * sizeof(Real));
+    };
+    realSize == 8 ? upload(0.0) : upload(0.0f);
+    c.words = uploadVector(b, clipWordRange(r, mesh, pc));
+    return c;
+  }
 };
 
 namespace {
@@ -127,7 +151,7 @@ std::vector<ClipRanges> preChunks(const PreparedMesh& mesh, const ClipTriangles&
 
 // The most bytes of reals a streamed chunk (DeformSession::streamChunks) takes beyond the vertices, which
 // every chunk repeats: its inputs, records and outputs are all there is of the job's at a time.
-constexpr uint64_t kStreamedChunkBytes = uint64_t(24) << 20;
+constexpr uint64_t kStreamedChunkBytes = uint64_t(16) << 20;
 
 // What one sub-triangle takes on the device: its record, its tessellation and its output range (the
 // patches, the tessellation and, split, the samples).
@@ -285,6 +309,8 @@ void DeformSession::prepare(const Mesh& input, const Lattice& lattice, const Sta
     if (&mesh == &withCreases) I.creased = std::move(withCreases);
     I.clipSource = &mesh == &input ? &input : &I.creased;
     I.clipBuilder = std::make_unique<ClipTriangleBuilder>(*I.clipSource, options.edgeLength, splitPatternTable().nmax());
+    // The chunks read the slot normals' part of the topology (PreparedMesh::slotNormals), not the adjacency.
+    I.mesh.topology.neighbour = {}, I.mesh.topology.neighbourEdge = {};
     return;
   }
   if (options.knotBoxClip) I.knotBoxSubs = clipAgainstKnotBoxes(mesh, lattice);
@@ -510,6 +536,8 @@ const SessionTimings& DeformSession::streamChunks(const ChunkReader& read, const
   std::vector<ChunkPlan> plan;
   uint64_t p = 0, firstClip = 0;
   subCount_ = 0;
+  I.makeVertexSection(clipRanges(nv, 0, 0, 0, 0, I.realSize));
+  I.mesh.positions = {};   // in the vertex section now; the slot normals read the normals
   while (p < nt) {
     // The chunk's parents: as many as keep its inputs within one binding and kStreamedChunkBytes.
     const uint64_t p0 = p;
@@ -524,7 +552,7 @@ const SessionTimings& DeformSession::streamChunks(const ChunkReader& read, const
       nextMade = false;
     }
     if (!r.parents) throw tooLargeForOneBinding(nv, p0, I.realSize, lim.maxStorageBufferRange);
-    const PreChunkInputs in = I.uploadInputs(B, r, packClip(clips));
+    const PreChunkInputs in = I.uploadStreamedInputs(B, r, packClip(clips));
     K.pn(in);
     counts.assign(r.clips, 0);
     K.clipCount(in, counts.data());
@@ -557,6 +585,7 @@ const SessionTimings& DeformSession::streamChunks(const ChunkReader& read, const
     I.drop(B, reals), I.drop(B, words);
     if (progress) progress("deform", double(p) / double(nt + 1));
   }
+  I.vertexSection = {};
   B.finish();
   timings_.dispatches = B.takeTimings();
   sumStages(timings_);

@@ -85,8 +85,8 @@ class DeformSession {
   size_t subTriangles() const { return subCount_; }               // streamed: those streamed so far
 
   // A one-shot job with regular clipping (options().once): the whole mesh is never clipped at once. After
-  // deform(), streamChunks() makes the clip triangles of a few consecutive parents (within 24 MiB of
-  // inputs beyond the vertices, and options().maxChunkParents), uploads them, runs pn_triangles,
+  // deform(), streamChunks() makes the clip triangles of a few consecutive parents (their inputs beyond the
+  // vertices within deform_session.cpp's kStreamedChunkBytes, and options().maxChunkParents), uploads them, runs pn_triangles,
   // clip_count and clip_write, deforms each chunk of their sub-triangles, hands its output (still on the
   // device) and its pre-images to `read`, and frees it before the next: only one chunk's records and
   // outputs exist at a time. Chunks come in order, with the same bits as a session that is not once;

@@ -187,7 +187,7 @@ class SmoothRun final : public MethodRun {
 
  private:
   static constexpr size_t kWeldSlice = 64;   // patches a slice: their vertices in double fit the cache
-  static constexpr size_t kDownloadBytes = size_t(16) << 20;   // a download's block (rounded to whole slices)
+  static constexpr size_t kDownloadBytes = size_t(4) << 20;   // a download's block (rounded to whole slices)
   const Mesh& input_;   // Deformer::Impl::input, which outlives the run
   Timings& timings_;    // Deformer::Impl::timings: a streamed session's kernels run when its result is taken
   std::unique_ptr<DeformSession> session_;
