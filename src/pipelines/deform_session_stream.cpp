@@ -1,0 +1,102 @@
+// DeformSession::streamChunks: a one-shot session (DeformSessionOptions::once, regular clipping) runs from
+// the mesh a few parents at a time, each chunk's inputs, records and outputs made, used and freed before
+// the next, so that only one chunk's exist at a time (docs/PERFORMANCE.md "Scaling").
+#include <chrono>
+
+#include "core/huge_pages.h"
+#include "core/wall_clock.h"
+#include "pipelines/deform_session_internal.h"
+
+namespace sffd {
+namespace {
+
+// The most bytes of reals a streamed chunk (DeformSession::streamChunks) takes beyond the vertices, which
+// every chunk repeats: its inputs, records and outputs are all there is of the job's at a time.
+constexpr uint64_t kStreamedChunkBytes = uint64_t(16) << 20;
+
+}  // namespace
+
+const SessionTimings& DeformSession::streamChunks(const ChunkReader& read, const StageProgress& progress) {
+  if (!streamed()) throw std::logic_error("DeformSession: streamChunks without options().once (regular clipping)");
+  if (recordsReleased_) throw Error(ErrorKind::Input, "the one-shot session's chunks were already streamed (DeformOptions::once)");
+  if (!deformed_) throw Error(ErrorKind::Input, "DeformSession: streamChunks before deform()");
+  recordsReleased_ = true;   // once, also when `read` throws half way
+  Impl& I = *impl_;
+  Backend& B = backend_;
+  const SessionKernels K{B, options_};
+  const DeviceLimits& lim = B.info().limits;
+  auto t0 = std::chrono::steady_clock::now();
+  timings_ = {};
+  const uint64_t nv = I.mesh.positions.size() / 4, nt = I.triangles;
+  const SubBytes bytes = subBytesOf(options_, I.realSize, I.fit.points);
+  const uint64_t maxSubsOfBinding = maxChunkSubs(lim, bytes, options_.maxChunkSubTriangles);
+  auto fits = [&](const ClipRanges& r) {
+    return r.byteOf(r.realElements) <= lim.maxStorageBufferRange && r.words * 4 <= lim.maxStorageBufferRange;
+  };
+  ClipTriangles clips;               // the chunk's
+  std::vector<ClipTriangle> next;    // parent p's, made but not yet in a chunk
+  bool nextMade = false;
+  std::vector<uint32_t> counts, chunkOffsets;
+  std::vector<uint64_t> offsets;
+  std::vector<ChunkPlan> plan;
+  uint64_t p = 0, firstClip = 0;
+  subCount_ = 0;
+  I.makeVertexSection(clipRanges(nv, 0, 0, 0, 0, I.realSize));
+  I.mesh.positions = {};   // in the vertex section now; the slot normals read the normals
+  while (p < nt) {
+    // The chunk's parents: as many as keep its inputs within one binding and kStreamedChunkBytes.
+    const uint64_t p0 = p;
+    clips.triangles.clear();
+    ClipRanges r = clipRanges(nv, p0, 0, firstClip, 0, I.realSize);
+    for (; p < nt && (!options_.maxChunkParents || p - p0 < options_.maxChunkParents); ++p) {
+      if (!nextMade) next.clear(), I.clipBuilder->add(uint32_t(p), next), nextMade = true;
+      const ClipRanges grown = clipRanges(nv, p0, p + 1 - p0, firstClip, clips.triangles.size() + next.size(), I.realSize);
+      if (!fits(grown) || (r.parents && grown.byteOf(grown.realElements - grown.slotNormals) > kStreamedChunkBytes)) break;
+      r = grown;
+      clips.triangles.insert(clips.triangles.end(), next.begin(), next.end());
+      nextMade = false;
+    }
+    if (!r.parents) throw tooLargeForOneBinding(nv, p0, I.realSize, lim.maxStorageBufferRange);
+    const PreChunkInputs in = I.uploadStreamedInputs(B, r, packClip(clips));
+    K.pn(in);
+    counts.assign(r.clips, 0);
+    K.clipCount(in, counts.data());
+    offsets.assign(r.clips + 1, 0);
+    uint64_t maxSubs = maxSubsOfBinding;
+    for (size_t i = 0; i < r.clips; ++i) offsets[i + 1] = offsets[i] + counts[i], maxSubs = std::max<uint64_t>(maxSubs, counts[i]);
+    plan.clear();
+    planChunks(plan, offsets, 0, r.clips, maxSubs, 0);
+    // Each chunk of sub-triangles clipped, deformed, read and freed before the next is made.
+    for (const ChunkPlan& pl : plan) {
+      Chunk c;
+      c.first = subCount_ + pl.first;
+      c.count = pl.count;
+      c.output = I.make(B, pl.count * bytes.out);
+      c.patchesOffset = pl.count * bytes.tess;
+      BufferId headers = I.make(B, pl.count * 16), records = I.make(B, pl.count * bytes.record);
+      chunkOffsets.resize(pl.clipCount);
+      for (size_t i = 0; i < pl.clipCount; ++i) chunkOffsets[i] = uint32_t(offsets[pl.firstClip + i] - offsets[pl.firstClip]);
+      K.clipWrite(in, pl.firstClip, pl.clipCount, chunkOffsets.data(), headers, records);
+      K.deform(I.deformParams, c.count, I.fit.points, {I.coeffs, I.frame, records, c.output});
+      SubTrianglePreImages pre;
+      readPreImages(headers, records, c.count, pre);
+      I.drop(B, headers), I.drop(B, records);
+      read(c, pre);
+      I.drop(B, c.output);
+    }
+    subCount_ += offsets.back();
+    firstClip += r.clips;
+    BufferId reals = in.reals, words = in.words;
+    I.drop(B, reals), I.drop(B, words);
+    if (progress) progress("deform", double(p) / double(nt + 1));
+  }
+  I.vertexSection = {};
+  B.finish();
+  timings_.dispatches = B.takeTimings();
+  sumStages(timings_);
+  timings_.wallMs = msSince(t0);
+  if (!B.info().limits.timestamps) timings_.deformMs = timings_.wallMs;
+  return timings_;
+}
+
+}  // namespace sffd
