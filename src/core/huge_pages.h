@@ -29,6 +29,12 @@ void resizeHuge(std::vector<T>& v, size_t count, const T& value = T()) {
   v.resize(count, value);
 }
 
+// Frees a vector's storage (`v = {}` does not: it assigns an empty initializer list, keeping the capacity).
+template <class T>
+void freeStorage(std::vector<T>& v) {
+  std::vector<T>().swap(v);
+}
+
 // The GLIBC_TUNABLES value under which glibc's malloc (2.35 on) asks for huge pages itself, for every
 // large allocation of the process, the driver's included: `current` with glibc.malloc.hugetlb=1 added.
 // None where it would change nothing: the kernel's THP mode (the bracketed word of

@@ -105,7 +105,7 @@ void DeformSession::prepare(const Mesh& input, const Lattice& lattice, const Sta
     I.clipSource = &mesh == &input ? &input : &I.creased;
     I.clipBuilder = std::make_unique<ClipTriangleBuilder>(*I.clipSource, options.edgeLength, splitPatternTable().nmax());
     // The chunks read the slot normals' part of the topology (PreparedMesh::slotNormals), not the adjacency.
-    I.mesh.topology.neighbour = {}, I.mesh.topology.neighbourEdge = {};
+    freeStorage(I.mesh.topology.neighbour), freeStorage(I.mesh.topology.neighbourEdge);
     return;
   }
   if (options.knotBoxClip) I.knotBoxSubs = clipAgainstKnotBoxes(mesh, lattice);

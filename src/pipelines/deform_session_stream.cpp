@@ -42,7 +42,7 @@ const SessionTimings& DeformSession::streamChunks(const ChunkReader& read, const
   uint64_t p = 0, firstClip = 0;
   subCount_ = 0;
   I.makeVertexSection(clipRanges(nv, 0, 0, 0, 0, I.realSize));
-  I.mesh.positions = {};   // in the vertex section now; the slot normals read the normals
+  freeStorage(I.mesh.positions);   // in the vertex section now; the slot normals read the normals
   while (p < nt) {
     // The chunk's parents: as many as keep its inputs within one binding and kStreamedChunkBytes.
     const uint64_t p0 = p;
@@ -90,7 +90,7 @@ const SessionTimings& DeformSession::streamChunks(const ChunkReader& read, const
     I.drop(B, reals), I.drop(B, words);
     if (progress) progress("deform", double(p) / double(nt + 1));
   }
-  I.vertexSection = {};
+  freeStorage(I.vertexSection);
   B.finish();
   timings_.dispatches = B.takeTimings();
   sumStages(timings_);

@@ -381,8 +381,8 @@ struct PatchWelder::Impl {
     if (forgetting) throw std::logic_error("PatchWelder: finish() after forgetPassedLocations");
     reserveHuge(m.positions, m.normals.size());
     for (size_t i = 0; i < m.normals.size(); ++i) m.positions.push_back(locs[m.weldId[i]].position);
-    locs = {};
-    next = {};
+    freeStorage(locs);
+    freeStorage(next);
     return std::move(m);
   }
 
