@@ -62,15 +62,16 @@ VkPipeline Kernels::pipeline(std::string_view kernel, KernelVariant variant) {
   if (variant.f64 && !device_.info().limits.float64)
     throw deviceError("The Vulkan device " + device_.info().name +
                       " has no 64-bit floating point in shaders (shaderFloat64); double precision needs another device.");
-  if (!k->spirv[v] || k->spirvWords[v] == 0)
+  const std::span<const uint32_t> spirv = spirvFor(*k, variant);
+  if (spirv.empty())
     throw Error(ErrorKind::Internal, "kernel '" + std::string(kernel) + "' has no SPIR-V for variant " + std::to_string(v));
 
   const Api& api = device_.api();
   VkDevice dev = device_.handle();
   CompileTrace trace("vulkan", kernel, variant);
   auto mi = vkStruct<VkShaderModuleCreateInfo>(VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO);
-  mi.codeSize = k->spirvWords[v] * sizeof(uint32_t);
-  mi.pCode = k->spirv[v];
+  mi.codeSize = spirv.size_bytes();
+  mi.pCode = spirv.data();
   VkShaderModule module = VK_NULL_HANDLE;
   check(api.vkCreateShaderModule(dev, &mi, nullptr, &module), "vkCreateShaderModule");
 
@@ -79,7 +80,7 @@ VkPipeline Kernels::pipeline(std::string_view kernel, KernelVariant variant) {
   ci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
   ci.stage.module = module;
   ci.stage.pName = "main";
-  // The assumptions as a specialization constant (ignored by kernels that do not declare it).
+  // The assumptions as a specialization constant (ignored by modules that do not declare it).
   const uint32_t assumptions = variant.assumptions;
   VkSpecializationMapEntry entry{SFFD_SPEC_ASSUMPTIONS, 0, sizeof(assumptions)};
   VkSpecializationInfo spec{1, &entry, sizeof(assumptions), &assumptions};
