@@ -1,6 +1,6 @@
 # Compiles every kernel in kernels/<stage>/ to SPIR-V in four variants (strict x f64) with
-# glslangValidator, tracked by depfiles, and optimizes it with spirv-opt (below); compiles the
-# SFFD_SPECIALIZED_<stem> forms the same way; writes its OpenGL ES form ("#version 310 es", f32 only) and
+# glslangValidator, tracked by depfiles, optimizing those of SFFD_SPIRV_OPTIMIZED with spirv-opt, and
+# the SFFD_SPECIALIZED_<stem> forms the same way; writes its OpenGL ES form ("#version 310 es", f32 only) and
 # checks it with glslang against the ES 3.1 rules in both float variants; and embeds them with the
 # include-inlined GLSL into one generated C++ file (src/core/kernel_registry.h). Add a kernel by adding
 # STAGE/STEM to SFFD_KERNELS; it is registered under its stem.
@@ -12,12 +12,16 @@ set(SFFD_KERNELS
     smooth/deform_step_sample smooth/deform_step_fit smooth/deform_step_adjust smooth/deform_step_tessellate
     accurate/accurate_patches)
 
-# spirv-opt's performance passes (`-O`) without its arithmetic simplification: lavapipe translates
-# and optimizes each kernel's SPIR-V in every process (its disk cache keeps only machine code), and
-# inlined, SSA-form SPIR-V is faster to translate (docs/PERFORMANCE.md, "SPIR-V optimized at build
-# time"). `--simplify-instructions` is left out because it reassociates float constants where no
-# NoContraction forbids it: the fast kernels would no longer give the CPU twin's bits on lavapipe.
-# The rest changes no arithmetic (constant folding is IEEE; strict kernels are bit-identical).
+# spirv-opt's performance passes (`-O`) without its arithmetic simplification, for the kernels of
+# SFFD_SPIRV_OPTIMIZED: lavapipe translates and optimizes each pipeline's SPIR-V in every process (its
+# disk cache keeps only machine code), and deform_smooth's inlined SSA form with its assumptions folded
+# is translated in 30-50 ms, not 100-260 (docs/PERFORMANCE.md, "SPIR-V made for the usual dispatch").
+# The other kernels gain nothing there, and clip_write's code on lavapipe 22.3 runs 5 % more
+# instructions optimized, so they stay as glslang writes them. `--simplify-instructions` is left out
+# because it reassociates float constants where no NoContraction forbids it: the fast kernels would no
+# longer give the CPU twin's bits on lavapipe. The rest changes no arithmetic (constant folding is IEEE;
+# strict kernels stay bit-identical).
+set(SFFD_SPIRV_OPTIMIZED deform_smooth)
 find_program(SFFD_SPIRV_OPT spirv-opt REQUIRED)
 set(SFFD_SPIRV_OPT_PASSES
     --wrap-opkill --eliminate-dead-branches --merge-return --inline-entry-points-exhaustive
@@ -45,7 +49,7 @@ target_compile_options(embed_kernels PRIVATE ${SFFD_WARNINGS})
 # Kernels also compiled for their most common dispatches, the assumptions (layout.h SFFD_ASSUME_*, named
 # without the prefix) a constant as on GL rather than the specialization constant: lavapipe translates a
 # pipeline's SPIR-V in every process, and deform_smooth's general form, every lattice case in it, takes
-# 75-110 ms there, the degree-2 one 30 (docs/PERFORMANCE.md, "SPIR-V made for the usual dispatch").
+# 75-110 ms there, the degree-2 one 30-50 (docs/PERFORMANCE.md, "SPIR-V made for the usual dispatch").
 set(SFFD_SPECIALIZED_deform_smooth
     DEGREE2|LATTICE_IN_PARAMS|FIT_IN_PARAMS                 # degree 2, lattice and fit table in the parameter block
     DEGREE2|LATTICE_IN_PARAMS|FIT_IN_PARAMS|ROLLED_LOOPS)   # the same on llvmpipe of Mesa 23 on (forDevice)
@@ -77,12 +81,16 @@ foreach(kernel IN LISTS SFFD_KERNELS)
         set(out ${SFFD_SPV_DIR}/${stem}.v${v}.${form}.spv)
         set(define ${define_${form}})
       endif()
+      set(optimize)
+      if(stem IN_LIST SFFD_SPIRV_OPTIMIZED)
+        set(optimize COMMAND ${SFFD_SPIRV_OPT} ${SFFD_SPIRV_OPT_PASSES} --target-env=vulkan1.1 ${out} -o ${out})
+      endif()
       add_custom_command(
         OUTPUT ${out}
         COMMAND Vulkan::glslangValidator -V --target-env vulkan1.1 --quiet
                 -DSFFD_STRICT=${strict} -DSFFD_F64=${f64} ${define}
                 --depfile ${out}.d -o ${out} ${SFFD_KERNEL_DIR}/${kernel}.comp
-        COMMAND ${SFFD_SPIRV_OPT} ${SFFD_SPIRV_OPT_PASSES} --target-env=vulkan1.1 ${out} -o ${out}
+        ${optimize}
         DEPENDS ${SFFD_KERNEL_DIR}/${kernel}.comp
         DEPFILE ${out}.d
         COMMENT "glslang: ${stem} variant ${v} ${form}"
