@@ -73,7 +73,7 @@ int run(const ParsedArgs& args) {
   }
   Device device = openDeviceFromArgs(args);
   DeformRun run = runDeformJob(args, job, device);   // the pre-compute, and frame 0 (the first key)
-  const MeshWriteOptions write{.significantDigits = outputDigits(run.deformer), .binary = args.has("--binary")};
+  const MeshWriteOptions write{.significantDigits = run.deformer.resultDigits(), .binary = args.has("--binary")};
   std::vector<Mesh> meshes;
   for (int f = 0; f < frames; ++f) {
     if (f > 0) {

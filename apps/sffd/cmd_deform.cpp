@@ -22,7 +22,7 @@ namespace {
 void writePatchFile(const std::string& path, DeformRun& run, const std::vector<double>& controlPoints) {
   const PatchVertices patches = *run.patches();
   const size_t n = patches.patchCount();
-  const int digits = outputDigits(run.deformer);
+  const int digits = run.deformer.resultDigits();
   writeFileAtomically(path, [&](std::ostream& o) {
     char line[128];
     o << "sffd-patches 1 " << n << " 3\n";
@@ -62,7 +62,7 @@ int run(const ParsedArgs& args) {
                         MeshFileWriter::streams(out, {.binary = args.has("--binary")}, !job.mesh.colors.empty());
   std::unique_ptr<MeshFileWriter> writer;
   auto writerFor = [&](const Deformer& d) -> MeshSink& {
-    writer = std::make_unique<MeshFileWriter>(out, MeshWriteOptions{.significantDigits = outputDigits(d), .binary = args.has("--binary")});
+    writer = std::make_unique<MeshFileWriter>(out, MeshWriteOptions{.significantDigits = d.resultDigits(), .binary = args.has("--binary")});
     return *writer;
   };
   DeformRun run = runDeformJob(args, job, device, streamed ? SinkFor(writerFor) : SinkFor());
@@ -70,7 +70,7 @@ int run(const ParsedArgs& args) {
   const Timings& t = run.deformer.timings();
   const Mesh& deformed = run.mesh;
   if (!streamed)
-    writeMesh(out, deformed, MeshWriteOptions{.significantDigits = outputDigits(run.deformer), .binary = args.has("--binary")});
+    writeMesh(out, deformed, MeshWriteOptions{.significantDigits = run.deformer.resultDigits(), .binary = args.has("--binary")});
   const double writeMs = lap();
   const size_t outVertices = streamed ? writer->vertexCount() : deformed.positions.size();
   const size_t outTriangles = streamed ? writer->triangleCount() : deformed.triangles.size();

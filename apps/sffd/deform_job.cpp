@@ -99,8 +99,4 @@ DeformRun runDeformJob(const ParsedArgs& args, Job& job, Device& device, const S
   return run;
 }
 
-int outputDigits(const Deformer& deformer) {
-  return deformer.doublePrecision() || deformer.localOrigin() != glm::dvec3(0.0) ? 17 : 9;
-}
-
 }  // namespace sffd::cli

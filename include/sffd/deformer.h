@@ -134,6 +134,10 @@ class Deformer {
   // result but deviceOutput() is moved back, so float precision does not depend on where a model sits.
   glm::dvec3 localOrigin() const;
   bool doublePrecision() const;   // whether the reals above are doubles
+  // Significant digits that keep every value of result() in a text file (MeshWriteOptions, as `sffd
+  // deform` writes): 17 for double results, or float ones computed around a localOrigin() away from 0
+  // (their float bits are relative to it, docs/ROBUSTNESS.md); else 9.
+  int resultDigits() const;
   const DeformOptions& options() const;
   Device& device() const;
 

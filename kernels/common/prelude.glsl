@@ -76,8 +76,9 @@ uint sffdThreadIndex() {
   return gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * (gl_NumWorkGroups.x * uint(SFFD_LOCAL_SIZE));
 }
 
-// The host's assumptions for this dispatch (layout.h SFFD_ASSUME_*).
-#ifdef VULKAN
+// The host's assumptions for this dispatch (layout.h SFFD_ASSUME_*): defined by GL's source and by the
+// SPIR-V compiled for one dispatch (cmake/Kernels.cmake), else a specialization constant.
+#if defined(VULKAN) && !defined(SFFD_ASSUMPTIONS)
 layout(constant_id = SFFD_SPEC_ASSUMPTIONS) const uint sffdAssumptions = 0u;
 #else
 #ifndef SFFD_ASSUMPTIONS

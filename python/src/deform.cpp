@@ -77,8 +77,9 @@ double creaseAngleOf(py::handle a) {
 
 PyDeformer makeDeformer(py::handle vertices, py::handle triangles, const Lattice& lattice, const std::string& method,
                         py::handle backend, py::object edgeLength, int tess, py::handle normals, bool strict,
-                        const std::string& precision, py::handle creaseAngle) {
+                        const std::string& precision, py::handle creaseAngle, bool once = false) {
   DeformOptions o;
+  o.once = once;
   o.creaseAngleDeg = creaseAngleOf(creaseAngle);
   o.method = methodOf(method);
   o.edgeLength = edgeLength.is_none() ? 0.0 : edgeLength.cast<double>();
@@ -100,7 +101,19 @@ void bindDeform(py::module_& m, DeviceFor deviceFor) {
                          "A mesh prepared once on a device for lattices of one structure; deform(lattice) as often as asked.")
       .def(py::init(&makeDeformer), "vertices"_a, "triangles"_a, "lattice"_a, py::kw_only(), "method"_a = "smooth",
            "backend"_a = "auto", "edge_length"_a = py::none(), "tess"_a = 10, "normals"_a = py::none(), "strict"_a = false,
-           "precision"_a = "auto", "crease_angle"_a = py::none())
+           "precision"_a = "auto", "crease_angle"_a = py::none(), "once"_a = false)
+      .def(
+          "write",
+          [](PyDeformer& d, const std::string& path, py::object lattice, bool binary) {
+            if (!lattice.is_none()) d.deformer->deform(lattice.cast<const Lattice&>());
+            // The result streamed into the file as it is downloaded and welded: never held whole.
+            MeshFileWriter out(path, {.significantDigits = d.deformer->resultDigits(), .binary = binary});
+            d.deformer->streamResult(out);
+            return py::make_tuple(out.vertexCount(), out.triangleCount());
+          },
+          "path"_a, "lattice"_a = py::none(), py::kw_only(), "binary"_a = false,
+          "Deforms with `lattice` if one is given, then writes the result to `path` as write_mesh would, "
+          "streamed: (vertex count, triangle count).")
       .def(
           "deform",
           [](PyDeformer& d, const Lattice& lattice) {
@@ -134,11 +147,12 @@ void bindDeform(py::module_& m, DeviceFor deviceFor) {
       "Reads .obj .off .ply .stl .om (.bpt): (vertices, triangles, normals); normals computed where the file has none.");
   m.def(
       "write_mesh",
-      [](const std::string& path, py::handle vertices, py::handle triangles, py::handle normals) {
+      [](const std::string& path, py::handle vertices, py::handle triangles, py::handle normals, bool binary) {
         Inputs in = inputsOf(vertices, triangles, normals);
-        writeMesh(path, meshFromView(in.view()));
+        writeMesh(path, meshFromView(in.view()), {.binary = binary});
       },
-      "path"_a, "vertices"_a, "triangles"_a, "normals"_a = py::none(), "Writes by extension (.obj .ply .off .stl).");
+      "path"_a, "vertices"_a, "triangles"_a, "normals"_a = py::none(), py::kw_only(), "binary"_a = false,
+      "Writes by extension (.obj .ply .off .stl .gltf .glb); binary: binary .ply and .stl.");
 
   // Classic FFD of bare points (sffd.FFD.__call__). A Mesh needs a triangle: one degenerate triangle
   // over point 0 is handed over, and fixed normals, so that none is computed; the kernel moves each

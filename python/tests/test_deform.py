@@ -208,3 +208,33 @@ def test_crease_angle_for_meshes_without_normals():
     for bad in (-1, 181, "sharp", float("nan")):
         with pytest.raises(sffd.InputError, match="crease_angle"):
             run(crease_angle=bad)
+
+
+def test_deformer_write_streams_the_clis_file(sphere, tmp_path):
+    if not CLI.exists():
+        pytest.skip(f"no command-line tool at {CLI}")
+    # The input as the CLI reads it (sphere.obj's texture coordinates would go into the CLI's file).
+    sffd.write_mesh(str(tmp_path / "in.ply"), *sphere, binary=True)
+    v, t, n = sffd.read_mesh(str(tmp_path / "in.ply"))
+    lat = sffd.Lattice.fitted(v).preset("twist", 0.5)
+    lat.save(str(tmp_path / "twist.json"))
+    for ext, binary in ((".ply", True), (".ply", False), (".stl", True), (".obj", False)):
+        cli = tmp_path / (("cli_b" if binary else "cli_t") + ext)
+        subprocess.run([str(CLI), "deform", str(tmp_path / "in.ply"), "-l", str(tmp_path / "twist.json"), "--backend", "cpu",
+                        "--tess", "3", "-o", str(cli), "--quiet"] + (["--binary"] if binary else []), check=True)
+        d = sffd.Deformer(v, t, lat, backend="cpu", normals=n, tess=3, once=True)
+        out = tmp_path / ("py" + ext)
+        nv, nt = d.write(str(out), lat, binary=binary)
+        assert out.read_bytes() == cli.read_bytes(), ext
+        cv, ct, _ = sffd.read_mesh(str(out))
+        assert nt == len(ct) and nt > 720 * 9 and (nv == len(cv) or ext == ".stl")
+        with pytest.raises(sffd.InputError):   # once: the result was taken
+            d.write(str(tmp_path / "again.ply"))
+    # A Deformer made for many lattices writes as often as asked.
+    d = sffd.Deformer(v, t, lat, backend="cpu", normals=n, tess=3)
+    d.deform(lat)
+    d.write(str(tmp_path / "again.ply"), binary=True)
+    assert d.write(str(tmp_path / "again.ply"), lat, binary=True) == (nv, nt)
+    assert (tmp_path / "again.ply").read_bytes() == (tmp_path / "cli_b.ply").read_bytes()
+    with pytest.raises(sffd.InputError, match="binary"):
+        sffd.write_mesh(str(tmp_path / "x.obj"), v, t, binary=True)

@@ -16,6 +16,14 @@ const EmbeddedKernel* findKernel(std::string_view name) {
   return nullptr;
 }
 
+std::span<const uint32_t> spirvFor(const EmbeddedKernel& kernel, KernelVariant variant) {
+  const int v = variantIndex(variant);
+  for (const SpecializedSpirv& s : kernel.specialized)
+    if (s.assumptions == variant.assumptions) return {s.spirv[v], s.spirvWords[v]};
+  if (!kernel.spirv[v]) return {};
+  return {kernel.spirv[v], kernel.spirvWords[v]};
+}
+
 std::string glslForVariant(const EmbeddedKernel& kernel, KernelVariant variant, bool es) {
   std::string src = es ? kernel.gles : kernel.glsl;
   size_t eol = src.find('\n');

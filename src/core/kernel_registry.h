@@ -14,16 +14,28 @@
 
 namespace sffd {
 
+// SPIR-V compiled for one set of assumptions (cmake/Kernels.cmake SFFD_SPECIALIZED_<kernel>).
+struct SpecializedSpirv {
+  uint32_t assumptions;
+  const uint32_t* spirv[4];         // index variantIndex()
+  size_t spirvWords[4];
+};
+
 struct EmbeddedKernel {
   const char* name;
   const char* glsl;                 // inlined source without variant defines
   const char* gles;                 // the same as OpenGL ES 3.1 ("#version 310 es"; f32 variants only)
-  const uint32_t* spirv[4];         // index variantIndex(): strict + 2 * f64
+  const uint32_t* spirv[4];         // index variantIndex(): strict + 2 * f64; assumptions a specialization constant
   size_t spirvWords[4];
+  std::span<const SpecializedSpirv> specialized;
 };
 
-// The SPIR-V of a variant (the assumptions are a specialization constant of it).
+// The SPIR-V of a variant.
 inline int variantIndex(KernelVariant v) { return (v.strict ? 1 : 0) + (v.f64 ? 2 : 0); }
+// The SPIR-V a Vulkan pipeline of `variant` is made from: the module compiled for exactly its assumptions
+// where the build made one (faster for lavapipe to translate), else the general one, whose specialization
+// constant SFFD_SPEC_ASSUMPTIONS takes them. Empty if the kernel has no SPIR-V for the variant.
+std::span<const uint32_t> spirvFor(const EmbeddedKernel& kernel, KernelVariant variant);
 // One compiled pipeline or program per key.
 inline uint64_t variantKey(KernelVariant v) { return uint64_t(variantIndex(v)) + 4 * uint64_t(v.assumptions); }
 // "strict f32", "fast f64 assuming 0x5", ...: for messages and traces.

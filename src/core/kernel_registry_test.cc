@@ -27,3 +27,40 @@ TEST(KernelRegistry, RolledLoopsOnlyForMesaFrom23OnTheCpu) {
   EXPECT_EQ(forDevice(v, device("NVIDIA H100", "550.54.15")).assumptions, SFFD_ASSUME_DEGREE2);
   EXPECT_EQ(forDevice(v, device(llvmpipe, "")).assumptions, SFFD_ASSUME_DEGREE2);
 }
+
+// deform_smooth is embedded compiled for its usual dispatch (a degree-2 lattice and its fit table in the
+// parameter block; cmake/Kernels.cmake SFFD_SPECIALIZED_deform_smooth), with and without rolled loops, in
+// every variant: a Vulkan pipeline of it is made from that module, which has no specialization constant
+// left; any other dispatch gets the general module. The bits are those of layout.h, so a renumbering
+// there cannot leave the build's forms unused.
+TEST(KernelRegistry, DeformSmoothCompiledForItsUsualDispatch) {
+  const EmbeddedKernel* k = findKernel("deform_smooth");
+  ASSERT_NE(k, nullptr);
+  // SPIR-V: OpDecorate (opcode 71, 3 words + literals) %id SpecId (decoration 1).
+  auto hasSpecConstant = [](std::span<const uint32_t> spirv) {
+    for (size_t i = 5; i < spirv.size();) {
+      const uint32_t words = spirv[i] >> 16, opcode = spirv[i] & 0xffffu;
+      if (opcode == 71 && words >= 4 && spirv[i + 2] == 1) return true;
+      i += words ? words : 1;
+    }
+    return false;
+  };
+  const uint32_t usual = SFFD_ASSUME_DEGREE2 | SFFD_ASSUME_LATTICE_IN_PARAMS | SFFD_ASSUME_FIT_IN_PARAMS;
+  for (int v = 0; v < 4; ++v) {
+    KernelVariant variant;
+    variant.strict = v % 2, variant.f64 = v / 2;
+    EXPECT_TRUE(hasSpecConstant(spirvFor(*k, variant)));
+    for (uint32_t a : {usual, usual | SFFD_ASSUME_ROLLED_LOOPS}) {
+      variant.assumptions = a;
+      const std::span<const uint32_t> s = spirvFor(*k, variant);
+      ASSERT_FALSE(s.empty());
+      EXPECT_NE(s.data(), k->spirv[v]) << variantName(variant);
+      EXPECT_FALSE(hasSpecConstant(s)) << variantName(variant);
+    }
+    for (uint32_t a : {(usual & ~SFFD_ASSUME_DEGREE2) | SFFD_ASSUME_GENERAL_DEGREE,
+                       (usual & ~SFFD_ASSUME_FIT_IN_PARAMS) | SFFD_ASSUME_FIT_IN_STORAGE}) {
+      variant.assumptions = a;
+      EXPECT_EQ(spirvFor(*k, variant).data(), k->spirv[v]) << variantName(variant);
+    }
+  }
+}

@@ -112,6 +112,7 @@ class DeformSession {
 
  private:
   void prepare(const Mesh& mesh, const Lattice& lattice, const StageProgress& progress);
+  void compileAhead(const PackedLattice& lattice);
   struct Impl;
   Backend& backend_;
   DeformSessionOptions options_;

@@ -189,6 +189,7 @@ size_t Deformer::subTriangles() const { return impl_->run->subTriangles(); }
 std::vector<OutputChunk> Deformer::deviceOutput() const { return impl_->run->deviceOutput(); }
 glm::dvec3 Deformer::localOrigin() const { return impl_->origin; }
 bool Deformer::doublePrecision() const { return impl_->resolved.variant.f64; }
+int Deformer::resultDigits() const { return doublePrecision() || localOrigin() != glm::dvec3(0.0) ? 17 : 9; }
 const DeformOptions& Deformer::options() const { return impl_->options; }
 Device& Deformer::device() const { return *impl_->device; }
 Deformer::Impl& Deformer::internal() { return *impl_; }

@@ -41,7 +41,14 @@ Kernels::~Kernels() { destroy(); }
 void Kernels::destroy() {
   const Api& api = device_.api();
   VkDevice dev = device_.handle();
-  for (auto& [key, pipeline] : pipelines_) api.vkDestroyPipeline(dev, pipeline, nullptr);
+  for (std::future<void>& w : workers_) w.wait();
+  workers_.clear();
+  for (auto& [key, pipeline] : pipelines_) {
+    try {
+      api.vkDestroyPipeline(dev, pipeline.get(), nullptr);
+    } catch (...) {   // one that failed to compile: nothing to destroy
+    }
+  }
   pipelines_.clear();
   if (cache_) api.vkDestroyPipelineCache(dev, cache_, nullptr);
   if (pipelineLayout_) api.vkDestroyPipelineLayout(dev, pipelineLayout_, nullptr);
@@ -53,24 +60,66 @@ void Kernels::destroy() {
 
 VkPipeline Kernels::pipeline(std::string_view kernel, KernelVariant variant) {
   variant = forDevice(variant, device_.info());
-  const int v = variantIndex(variant);
-  auto key = std::make_pair(std::string(kernel), variantKey(variant));
-  if (auto it = pipelines_.find(key); it != pipelines_.end()) return it->second;
+  Key key(std::string(kernel), variantKey(variant));
+  std::shared_future<VkPipeline> made;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (auto it = pipelines_.find(key); it != pipelines_.end()) made = it->second;
+  }
+  if (made.valid()) return made.get();   // rethrows the worker's error
+  VkPipeline p = create(kernel, variant);   // not cached on failure: the error repeats on the next try
+  std::promise<VkPipeline> ready;
+  ready.set_value(p);
+  std::lock_guard<std::mutex> lock(mutex_);
+  pipelines_.emplace(std::move(key), ready.get_future().share());
+  return p;
+}
 
+void Kernels::compileAhead(const std::vector<Backend::KernelUse>& kernels) {
+  std::vector<std::pair<std::promise<VkPipeline>, Backend::KernelUse>> jobs;
+  std::vector<std::string> names;   // the jobs' kernel names outlive the caller's views
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const Backend::KernelUse& use : kernels) {
+      const KernelVariant variant = forDevice(use.variant, device_.info());
+      Key key(std::string(use.kernel), variantKey(variant));
+      if (pipelines_.count(key)) continue;
+      jobs.emplace_back(std::promise<VkPipeline>(), Backend::KernelUse{{}, variant});
+      pipelines_.emplace(key, jobs.back().first.get_future().share());
+      names.push_back(key.first);
+    }
+  }
+  if (jobs.empty()) return;
+  workers_.push_back(std::async(std::launch::async, [this, jobs = std::move(jobs), names = std::move(names)]() mutable {
+    for (size_t i = 0; i < jobs.size(); ++i) {
+      try {
+        jobs[i].first.set_value(create(names[i], jobs[i].second.variant));
+      } catch (...) {
+        jobs[i].first.set_exception(std::current_exception());
+      }
+    }
+  }));
+}
+
+// Makes one pipeline; `variant` is forDevice()'s already. Thread-safe: Vulkan allows concurrent
+// pipeline creation, and the pipeline cache synchronizes itself.
+VkPipeline Kernels::create(std::string_view kernel, KernelVariant variant) {
+  const int v = variantIndex(variant);
   const EmbeddedKernel* k = findKernel(kernel);
   if (!k) throw Error(ErrorKind::Internal, "unknown kernel '" + std::string(kernel) + "'");
   if (variant.f64 && !device_.info().limits.float64)
     throw deviceError("The Vulkan device " + device_.info().name +
                       " has no 64-bit floating point in shaders (shaderFloat64); double precision needs another device.");
-  if (!k->spirv[v] || k->spirvWords[v] == 0)
+  const std::span<const uint32_t> spirv = spirvFor(*k, variant);
+  if (spirv.empty())
     throw Error(ErrorKind::Internal, "kernel '" + std::string(kernel) + "' has no SPIR-V for variant " + std::to_string(v));
 
   const Api& api = device_.api();
   VkDevice dev = device_.handle();
   CompileTrace trace("vulkan", kernel, variant);
   auto mi = vkStruct<VkShaderModuleCreateInfo>(VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO);
-  mi.codeSize = k->spirvWords[v] * sizeof(uint32_t);
-  mi.pCode = k->spirv[v];
+  mi.codeSize = spirv.size_bytes();
+  mi.pCode = spirv.data();
   VkShaderModule module = VK_NULL_HANDLE;
   check(api.vkCreateShaderModule(dev, &mi, nullptr, &module), "vkCreateShaderModule");
 
@@ -79,7 +128,7 @@ VkPipeline Kernels::pipeline(std::string_view kernel, KernelVariant variant) {
   ci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
   ci.stage.module = module;
   ci.stage.pName = "main";
-  // The assumptions as a specialization constant (ignored by kernels that do not declare it).
+  // The assumptions as a specialization constant (ignored by modules that do not declare it).
   const uint32_t assumptions = variant.assumptions;
   VkSpecializationMapEntry entry{SFFD_SPEC_ASSUMPTIONS, 0, sizeof(assumptions)};
   VkSpecializationInfo spec{1, &entry, sizeof(assumptions), &assumptions};
@@ -89,7 +138,6 @@ VkPipeline Kernels::pipeline(std::string_view kernel, KernelVariant variant) {
   VkResult r = api.vkCreateComputePipelines(dev, cache_, 1, &ci, nullptr, &pipeline);
   api.vkDestroyShaderModule(dev, module, nullptr);   // the pipeline keeps what it needs
   check(r, "vkCreateComputePipelines");
-  pipelines_.emplace(std::move(key), pipeline);
   return pipeline;
 }
 
