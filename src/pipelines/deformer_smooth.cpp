@@ -1,5 +1,6 @@
 // Deformer, Method::Smooth: DeformSession (deform_session.h) keeps the sub-triangle records and the
-// tessellation on the device; the results are downloaded when asked for.
+// tessellation on the device; the results are downloaded when asked for. A one-shot Deformer's session
+// (DeformSession::streamed) runs only when its result is taken, a chunk at a time, each welded as it comes.
 #include <algorithm>
 #include <memory>
 #include <stdexcept>
@@ -7,7 +8,6 @@
 #include <sffd/error.h>
 
 #include "core/huge_pages.h"
-
 #include "kernels/smooth/smooth_deform.h"
 #include "pipelines/deform_session.h"
 #include "pipelines/deformer_internal.h"
