@@ -12,7 +12,7 @@ namespace {
 
 // The most bytes of reals a streamed chunk (DeformSession::streamChunks) takes beyond the vertices, which
 // every chunk repeats: its inputs, records and outputs are all there is of the job's at a time.
-constexpr uint64_t kStreamedChunkBytes = uint64_t(16) << 20;
+constexpr uint64_t kStreamedChunkBytes = uint64_t(8) << 20;
 
 }  // namespace
 
