@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <set>
 #include <sstream>
 
@@ -243,32 +244,50 @@ PatchVertices sliceOf(const PatchVertices& P, size_t first, size_t last) {
   return s;
 }
 
-// The results weld the downloaded patches in slices (PatchWelder): the same mesh as all of them welded
-// at once, whatever the slices (the sphere carries texture coordinates).
-TEST(PatchWeld, SlicesWeldAsOne) {
+// The sphere (it carries texture coordinates) twisted by `method` at level 3 on the CPU device: the
+// Deformer, its patches' vertices and those welded at once.
+struct TwistedSphere {
+  std::unique_ptr<Device> device;   // outlives the Deformer
+  std::unique_ptr<Deformer> deformer;
+  PatchVertices P;
+  Mesh whole;
+};
+
+TwistedSphere twistedSphere(Method method) {
   const Mesh sphere = readMesh(std::string(SFFD_TEST_DATA) + "/sphere.obj");
-  ASSERT_FALSE(sphere.texcoords.empty());
-  for (Method method : {Method::Smooth, Method::Accurate}) {
-    SCOPED_TRACE(method == Method::Smooth ? "smooth" : "accurate");
-    Lattice lattice = fitLattice(sphere, {5, 5, 5}, {2, 2, 2});
-    applyLatticePreset(lattice, "twist", 0.3);
-    DeviceRequest request;
-    request.name = "cpu";
-    Device d = Device::open(request);
-    DeformOptions o;
-    o.method = method;
-    o.tess = 3;
-    Deformer deformer(d, sphere, lattice, o);
-    deformer.deform(lattice);
-    const PatchVertices P = *deformer.internal().run->patchVertices();
-    const Mesh whole = weldPatchVertices(P);
-    ASSERT_GT(whole.triangles.size(), 0u);
-    expectSameMesh(deformer.result(), whole);
-    for (size_t step : {size_t(1), size_t(7)}) {
-      PatchWelder weld(P.level, P.patchCount());
-      for (size_t first = 0; first < P.patchCount(); first += step) weld.add(sliceOf(P, first, std::min(P.patchCount(), first + step)));
-      expectSameMesh(weld.finish(), whole);
-    }
+  EXPECT_FALSE(sphere.texcoords.empty());
+  Lattice lattice = fitLattice(sphere, {5, 5, 5}, {2, 2, 2});
+  applyLatticePreset(lattice, "twist", 0.3);
+  TwistedSphere t;
+  DeviceRequest request;
+  request.name = "cpu";
+  t.device = std::make_unique<Device>(Device::open(request));
+  DeformOptions o;
+  o.method = method;
+  o.tess = 3;
+  t.deformer = std::make_unique<Deformer>(*t.device, sphere, lattice, o);
+  t.deformer->deform(lattice);
+  t.P = *t.deformer->internal().run->patchVertices();
+  t.whole = weldPatchVertices(t.P);
+  EXPECT_GT(t.whole.triangles.size(), 0u);
+  return t;
+}
+
+// The welds of the smooth and the accurate method's patches.
+class PatchWeldOf : public ::testing::TestWithParam<Method> {};
+INSTANTIATE_TEST_SUITE_P(Methods, PatchWeldOf, ::testing::Values(Method::Smooth, Method::Accurate),
+                         [](const ::testing::TestParamInfo<Method>& m) { return m.param == Method::Smooth ? "smooth" : "accurate"; });
+
+// The results weld the downloaded patches in slices (PatchWelder): the same mesh as all of them welded
+// at once, whatever the slices.
+TEST_P(PatchWeldOf, SlicesWeldAsOne) {
+  const TwistedSphere t = twistedSphere(GetParam());
+  const PatchVertices& P = t.P;
+  expectSameMesh(t.deformer->result(), t.whole);
+  for (size_t step : {size_t(1), size_t(7)}) {
+    PatchWelder weld(P.level, P.patchCount());
+    for (size_t first = 0; first < P.patchCount(); first += step) weld.add(sliceOf(P, first, std::min(P.patchCount(), first + step)));
+    expectSameMesh(weld.finish(), t.whole);
   }
 }
 
@@ -286,35 +305,21 @@ struct GatheringSink final : MeshSink {
 
 // A streamed weld that forgets the locations no later parent reaches (compacting as soon as it may here)
 // hands over the mesh of one that keeps them all, holding far fewer.
-TEST(PatchWeld, ForgettingPassedLocationsStreamsTheSameMesh) {
-  const Mesh sphere = readMesh(std::string(SFFD_TEST_DATA) + "/sphere.obj");
-  for (Method method : {Method::Smooth, Method::Accurate}) {
-    SCOPED_TRACE(method == Method::Smooth ? "smooth" : "accurate");
-    Lattice lattice = fitLattice(sphere, {5, 5, 5}, {2, 2, 2});
-    applyLatticePreset(lattice, "twist", 0.3);
-    DeviceRequest request;
-    request.name = "cpu";
-    Device d = Device::open(request);
-    DeformOptions o;
-    o.method = method;
-    o.tess = 3;
-    Deformer deformer(d, sphere, lattice, o);
-    deformer.deform(lattice);
-    const PatchVertices P = *deformer.internal().run->patchVertices();
-    const Mesh whole = weldPatchVertices(P);
-    GatheringSink sink;
-    sink.m.normalsFromFile = sink.m.weldIdIsLocation = true;
-    PatchWelder weld(P.level, P.patchCount(), &sink);
-    weld.forgetPassedLocations(deformer.internal().input, 1);
-    size_t mostHeld = 0;
-    for (size_t first = 0; first < P.patchCount(); first += 7) {
-      weld.add(sliceOf(P, first, std::min(P.patchCount(), first + 7)));
-      mostHeld = std::max(mostHeld, weld.locationsHeld());
-    }
-    expectSameMesh(sink.m, whole);
-    EXPECT_LT(mostHeld, whole.positions.size() / 2);
-    EXPECT_THROW(weld.finish(), std::logic_error);
+TEST_P(PatchWeldOf, ForgettingPassedLocationsStreamsTheSameMesh) {
+  const TwistedSphere t = twistedSphere(GetParam());
+  const PatchVertices& P = t.P;
+  GatheringSink sink;
+  sink.m.normalsFromFile = sink.m.weldIdIsLocation = true;
+  PatchWelder weld(P.level, P.patchCount(), &sink);
+  weld.forgetPassedLocations(t.deformer->internal().input, 1);
+  size_t mostHeld = 0;
+  for (size_t first = 0; first < P.patchCount(); first += 7) {
+    weld.add(sliceOf(P, first, std::min(P.patchCount(), first + 7)));
+    mostHeld = std::max(mostHeld, weld.locationsHeld());
   }
+  expectSameMesh(sink.m, t.whole);
+  EXPECT_LT(mostHeld, t.whole.positions.size() / 2);
+  EXPECT_THROW(weld.finish(), std::logic_error);
 }
 
 }  // namespace
