@@ -259,36 +259,6 @@ TEST_P(BackendContract, ClassicIdentityInEveryVariant) {
   EXPECT_TRUE(b.takeTimings().empty());
 }
 
-// Kernels named to compileAhead() run as if they were not (the Vulkan backend makes them on a worker
-// thread); what cannot be made fails at its dispatch, with the error it would have given there; a
-// backend destroyed with work ahead still in flight waits for it.
-TEST_P(BackendContract, KernelsCompiledAheadRunAsDispatched) {
-  Backend& b = backend();
-  const KernelVariant fast{false, false}, strict{true, false}, f64{false, true};
-  b.compileAhead({{"no_such_kernel", fast}, {"classic_ffd", strict}, {"classic_ffd", f64}, {"classic_ffd", fast}});
-  b.compileAhead({{"classic_ffd", fast}});   // already asked for: nothing more
-  for (KernelVariant v : {fast, strict}) {
-    ClassicJob<float> job(b, 1000, 900);
-    job.dispatch(v, 0, 1000, job.vertIn, job.vertOut);
-    job.expectIdentity(0, 1000, 900, 1e-6);
-  }
-  ClassicJob<double> job64(b, 100, 100);
-  if (b.info().limits.float64) {
-    job64.dispatch(f64, 0, 100, job64.vertIn, job64.vertOut);
-    job64.expectIdentity(0, 100, 100, 1e-14);
-  } else {
-    EXPECT_EQ(errorKindOf([&] { job64.dispatch(f64, 0, 100, job64.vertIn, job64.vertOut); }), ErrorKind::Device);
-  }
-  Dispatch bad;
-  bad.kernel = "no_such_kernel";
-  EXPECT_EQ(errorKindOf([&] { b.dispatch(bad); }), ErrorKind::Internal);
-  EXPECT_EQ(errorKindOf([&] { b.dispatch(bad); }), ErrorKind::Internal);   // and again
-  b.finish();
-  // Work ahead left running when the backend goes: a second backend, destroyed at once.
-  OpenedBackend other = sffd::testing::openForTest(GetParam() == "vulkan-staging" ? "vulkan" : GetParam());
-  other.backend->compileAhead({{"classic_ffd", strict}, {"clip_write", fast}, {"deform_smooth", fast}});
-}
-
 // Ranges in the middle of one larger buffer, at aligned offsets; bad dispatches are internal errors.
 TEST_P(BackendContract, BindsRangesAtAlignedOffsetsAndRefusesBadDispatches) {
   Backend& b = backend();

@@ -64,14 +64,6 @@ class Backend {
 
   // Records (or issues) one dispatch; compiles the kernel variant on first use.
   virtual void dispatch(const Dispatch& d) = 0;
-  // A hint that these kernel variants will be dispatched, in this order: a backend may compile them
-  // ahead, beside the caller's own work (Vulkan: on a thread of its own), and dispatch() waits for the
-  // one it needs. Compile errors surface from dispatch(). The others ignore it.
-  struct KernelUse {
-    std::string_view kernel;
-    KernelVariant variant;
-  };
-  virtual void compileAhead(const std::vector<KernelUse>& kernels) { (void)kernels; }
   // Makes the writes of earlier dispatches visible to later dispatches and transfers.
   virtual void barrier() = 0;
   // Submits everything recorded and waits for it.

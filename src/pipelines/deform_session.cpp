@@ -85,7 +85,6 @@ void DeformSession::prepare(const Mesh& input, const Lattice& lattice, const Sta
   int s = options.samples > 0 ? options.samples : lattice.degree[0] + lattice.degree[1] + lattice.degree[2];
   I.fit = makeFitTable(std::max(3, s));
   PackedLattice packed = packLattice(lattice);
-  compileAhead(packed);
   // A copy only where the creases are still to be applied.
   Mesh withCreases;
   if (!input.normalsFromFile && !options.creasesApplied) {
@@ -127,21 +126,6 @@ void DeformSession::prepare(const Mesh& input, const Lattice& lattice, const Sta
     for (PreChunkInputs& c : I.pre) I.drop(backend, c.reals), I.drop(backend, c.words);
     inputsReleased_ = true;
   }
-}
-
-// The session's kernels, in the order it runs them, with the variants it will dispatch: compiled by
-// the backend beside the preparation of the mesh where it can (Backend::compileAhead).
-void DeformSession::compileAhead(const PackedLattice& lattice) {
-  const KernelVariant v = options_.variant;
-  std::vector<Backend::KernelUse> kernels = {{"pn_triangles", v}};
-  if (!options_.knotBoxClip) kernels.insert(kernels.end(), {{"clip_count", v}, {"clip_write", v}});
-  const KernelVariant deform = forLattice(v, deformParamsFor(lattice, v.f64, &impl_->fit.data));
-  if (options_.split)
-    for (const char* k : {"deform_step_sample", "deform_step_fit", "deform_step_adjust", "deform_step_tessellate"})
-      kernels.push_back({k, deform});
-  else
-    kernels.push_back({"deform_smooth", deform});
-  backend_.compileAhead(kernels);
 }
 
 void DeformSession::requireOnce() const {

@@ -112,7 +112,6 @@ class DeformSession {
 
  private:
   void prepare(const Mesh& mesh, const Lattice& lattice, const StageProgress& progress);
-  void compileAhead(const PackedLattice& lattice);
   struct Impl;
   Backend& backend_;
   DeformSessionOptions options_;

@@ -181,8 +181,6 @@ class VulkanBackend final : public Backend {
     device_.release(staging);
   }
 
-  void compileAhead(const std::vector<KernelUse>& kernels) override { kernels_.compileAhead(kernels); }
-
   void dispatch(const Dispatch& d) override {
     VkPipeline pipeline = kernels_.pipeline(d.kernel, d.variant);   // throws before anything is recorded
     const DeviceLimits& limits = device_.info().limits;

@@ -41,14 +41,7 @@ Kernels::~Kernels() { destroy(); }
 void Kernels::destroy() {
   const Api& api = device_.api();
   VkDevice dev = device_.handle();
-  for (std::future<void>& w : workers_) w.wait();
-  workers_.clear();
-  for (auto& [key, pipeline] : pipelines_) {
-    try {
-      api.vkDestroyPipeline(dev, pipeline.get(), nullptr);
-    } catch (...) {   // one that failed to compile: nothing to destroy
-    }
-  }
+  for (auto& [key, pipeline] : pipelines_) api.vkDestroyPipeline(dev, pipeline, nullptr);
   pipelines_.clear();
   if (cache_) api.vkDestroyPipelineCache(dev, cache_, nullptr);
   if (pipelineLayout_) api.vkDestroyPipelineLayout(dev, pipelineLayout_, nullptr);
@@ -60,51 +53,10 @@ void Kernels::destroy() {
 
 VkPipeline Kernels::pipeline(std::string_view kernel, KernelVariant variant) {
   variant = forDevice(variant, device_.info());
-  Key key(std::string(kernel), variantKey(variant));
-  std::shared_future<VkPipeline> made;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (auto it = pipelines_.find(key); it != pipelines_.end()) made = it->second;
-  }
-  if (made.valid()) return made.get();   // rethrows the worker's error
-  VkPipeline p = create(kernel, variant);   // not cached on failure: the error repeats on the next try
-  std::promise<VkPipeline> ready;
-  ready.set_value(p);
-  std::lock_guard<std::mutex> lock(mutex_);
-  pipelines_.emplace(std::move(key), ready.get_future().share());
-  return p;
-}
-
-void Kernels::compileAhead(const std::vector<Backend::KernelUse>& kernels) {
-  std::vector<std::pair<std::promise<VkPipeline>, Backend::KernelUse>> jobs;
-  std::vector<std::string> names;   // the jobs' kernel names outlive the caller's views
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    for (const Backend::KernelUse& use : kernels) {
-      const KernelVariant variant = forDevice(use.variant, device_.info());
-      Key key(std::string(use.kernel), variantKey(variant));
-      if (pipelines_.count(key)) continue;
-      jobs.emplace_back(std::promise<VkPipeline>(), Backend::KernelUse{{}, variant});
-      pipelines_.emplace(key, jobs.back().first.get_future().share());
-      names.push_back(key.first);
-    }
-  }
-  if (jobs.empty()) return;
-  workers_.push_back(std::async(std::launch::async, [this, jobs = std::move(jobs), names = std::move(names)]() mutable {
-    for (size_t i = 0; i < jobs.size(); ++i) {
-      try {
-        jobs[i].first.set_value(create(names[i], jobs[i].second.variant));
-      } catch (...) {
-        jobs[i].first.set_exception(std::current_exception());
-      }
-    }
-  }));
-}
-
-// Makes one pipeline; `variant` is forDevice()'s already. Thread-safe: Vulkan allows concurrent
-// pipeline creation, and the pipeline cache synchronizes itself.
-VkPipeline Kernels::create(std::string_view kernel, KernelVariant variant) {
   const int v = variantIndex(variant);
+  auto key = std::make_pair(std::string(kernel), variantKey(variant));
+  if (auto it = pipelines_.find(key); it != pipelines_.end()) return it->second;
+
   const EmbeddedKernel* k = findKernel(kernel);
   if (!k) throw Error(ErrorKind::Internal, "unknown kernel '" + std::string(kernel) + "'");
   if (variant.f64 && !device_.info().limits.float64)
@@ -138,6 +90,7 @@ VkPipeline Kernels::create(std::string_view kernel, KernelVariant variant) {
   VkResult r = api.vkCreateComputePipelines(dev, cache_, 1, &ci, nullptr, &pipeline);
   api.vkDestroyShaderModule(dev, module, nullptr);   // the pipeline keeps what it needs
   check(r, "vkCreateComputePipelines");
+  pipelines_.emplace(std::move(key), pipeline);
   return pipeline;
 }
 

@@ -1,16 +1,12 @@
 // Compute pipelines of the embedded kernels. Every kernel shares one descriptor set layout
 // (binding 0: the parameter block as a uniform buffer; 1..SFFD_MAX_STORAGE_BINDINGS: storage
 // buffers, see kernels/common/layout.h), so one pipeline layout serves all of them. A pipeline is
-// built on first use of a (kernel, variant) pair from the SPIR-V embedded at build time, or ahead on a
-// worker thread when asked (compileAhead).
+// built on first use of a (kernel, variant) pair from the SPIR-V embedded at build time.
 #pragma once
-#include <future>
 #include <map>
-#include <mutex>
 #include <string>
 #include <string_view>
 #include <utility>
-#include <vector>
 
 #include "core/backend.h"
 #include "backends/vulkan/vk_device.h"
@@ -28,25 +24,16 @@ class Kernels {
   VkPipelineLayout pipelineLayout() const { return pipelineLayout_; }
   // Throws an internal Error for an unknown kernel, a device Error for an f64 variant on a device
   // without shaderFloat64.
-  // Waits for it if compileAhead() is making it.
   VkPipeline pipeline(std::string_view kernel, KernelVariant variant);
-  // Starts making these pipelines, in order, on one worker thread (Backend::compileAhead): a driver's
-  // compiler then runs beside the host's work (lavapipe translates each pipeline's SPIR-V in every
-  // process). Pipelines already made or asked for are skipped; errors surface from pipeline().
-  void compileAhead(const std::vector<Backend::KernelUse>& kernels);
 
  private:
-  using Key = std::pair<std::string, uint64_t>;
-  VkPipeline create(std::string_view kernel, KernelVariant variant);
   void destroy();
 
   Device& device_;
   VkDescriptorSetLayout setLayout_ = VK_NULL_HANDLE;
   VkPipelineLayout pipelineLayout_ = VK_NULL_HANDLE;
   VkPipelineCache cache_ = VK_NULL_HANDLE;   // in memory only: Mesa and vendor drivers keep their own disk caches
-  std::mutex mutex_;                                       // guards pipelines_
-  std::map<Key, std::shared_future<VkPipeline>> pipelines_;   // made, or being made by the worker
-  std::vector<std::future<void>> workers_;                  // compileAhead() calls, joined by destroy()
+  std::map<std::pair<std::string, uint64_t>, VkPipeline> pipelines_;
 };
 
 }  // namespace sffd::vk
