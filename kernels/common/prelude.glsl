@@ -97,6 +97,7 @@ bool sffdAssumes(uint bit) { return (sffdAssumptions & bit) != 0u; }
 // loop at a cost, and a GPU driver unrolls what pays. A rolled iteration costs llvmpipe a few hundred
 // instructions per 8 lanes on either Mesa, so these loops have few iterations of several accesses each.
 uint sffdRolled(uint n) { return sffdAssumes(SFFD_ASSUME_ROLLED_LOOPS) ? n + (gl_NumWorkGroups.z >> 16u) : n; }
+bool sffdRollsLoops() { return sffdAssumes(SFFD_ASSUME_ROLLED_LOOPS); }
 
 #if SFFD_STRICT
 real sdot(real3 a, real3 b) {

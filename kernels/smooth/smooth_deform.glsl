@@ -61,14 +61,22 @@ real3 nearControlPoint(real3 q0, real3 q1, real3 q2, real3 q3) {
 struct SubCorners {
   real3 x0, x1, x2, n0, n1, n2;
 };
-// The reads in a loop of two bounded by sffdRolled (prelude.glsl), the values through a shift register
-// (an array indexed by constants only: registers).
+// The reads in two forms, as clip_sites.glsl's loadParent: two iterations of three, or where the host
+// asks for rolled loops (prelude.glsl sffdRollsLoops) one an iteration; the values through a shift
+// register (an array indexed by constants only: registers).
 SubCorners smoothSubCorners(uint st) {
   uint rec = SFFD_SUB_STRIDE * st;
   real3 q[6];   // XPN 0..2, then NLIN 0..2
-  for (uint h = 0u; h < sffdRolled(2u); ++h) {
-    for (uint j = 0u; j < 3u; ++j) q[j] = q[j + 3u];
-    for (uint j = 0u; j < 3u; ++j) q[3u + j] = subRecords[rec + SFFD_SUB_XPN + (SFFD_SUB_NLIN - SFFD_SUB_XPN) * h + j].xyz;
+  if (!sffdRollsLoops()) {
+    for (uint h = 0u; h < 2u; ++h) {
+      for (uint j = 0u; j < 3u; ++j) q[j] = q[j + 3u];
+      for (uint j = 0u; j < 3u; ++j) q[3u + j] = subRecords[rec + SFFD_SUB_XPN + (SFFD_SUB_NLIN - SFFD_SUB_XPN) * h + j].xyz;
+    }
+  } else {
+    for (uint i = 0u; i < sffdRolled(6u); ++i) {
+      for (uint j = 0u; j < 5u; ++j) q[j] = q[j + 1u];
+      q[5] = subRecords[rec + (i < 3u ? SFFD_SUB_XPN : SFFD_SUB_NLIN) + i % 3u].xyz;
+    }
   }
   SubCorners C;
   C.x0 = q[0];
@@ -80,14 +88,10 @@ SubCorners smoothSubCorners(uint st) {
   return C;
 }
 
-// Steps 1 and 2 at corner c (and step 4, which needs the same Jacobian): the deformed corner, its
-// deformed normal, and the adjusting normals of the corner and of its two slots (crease slots only).
-void smoothCornerSample(uint st, uint c, uint creaseBits, real3 x, real3 nlin, out real3 Q, out real3 QN, out real3 adj,
-                        out real3 adjA, out real3 adjB) {
+// Step 4 at corner c, from the corner's lattice sample: the adjusting normals of the corner and of its
+// two slots (crease slots only).
+void smoothCornerAdjust(LatticeSample S, uint st, uint c, uint creaseBits, out real3 adj, out real3 adjA, out real3 adjB) {
   uint rec = SFFD_SUB_STRIDE * st;
-  LatticeSample S = latticeEvaluate(params.lattice, x);
-  Q = S.value;
-  QN = snormalize(latticeCofactorNormal(S, nlin));
   adj = snormalize(latticeCofactorNormal(S, subRecords[rec + SFFD_SUB_NPN + c].xyz));
   adjA = adj;
   adjB = adj;
@@ -99,42 +103,68 @@ void smoothCornerSample(uint st, uint c, uint creaseBits, real3 x, real3 nlin, o
 real3 subCornerX(SubCorners C, uint c) { return c == 0u ? C.x0 : (c == 1u ? C.x1 : C.x2); }
 real3 subCornerN(SubCorners C, uint c) { return c == 0u ? C.n0 : (c == 1u ? C.n1 : C.n2); }
 
-// Loops rather than calls written out: every call inlines a whole lattice evaluation, and the
-// kernels' compile time grows with their number.
-void smoothCornerSamples(uint st, SubCorners C, out real3 Q[3], out real3 QN[3], out real3 adj[3], out real3 adjNbr[6]) {
+// Edge sample k (E[2e] a third from corner e, E[2e+1] a third from e+1): its point and its normal
+// before the deformation.
+void smoothEdgePoint(SubCorners C, uint k, out real3 x, out real3 n) {
+  P real third = real(1) / real(3);
+  P real twoThirds = real(2) / real(3);
+  uint e = k / 2u, b = e == 2u ? 0u : e + 1u;
+  P real wa = k % 2u == 0u ? twoThirds : third;
+  P real wb = k % 2u == 0u ? third : twoThirds;
+  P real3 xk = subCornerX(C, e) * wa + subCornerX(C, b) * wb;
+  P real3 nk = subCornerN(C, e) * wa + subCornerN(C, b) * wb;
+  x = xk;
+  n = snormalize(nk);
+}
+
+// Steps 1 and 2 on the boundary and step 4: at corner c the deformed corner Q[c], its deformed normal
+// QN[c] and the adjusting normals (smoothCornerAdjust); at edge sample k the deformed point E[k] and
+// normal EN[k]. Loops rather than calls written out: every call inlines a whole lattice evaluation,
+// and the kernels' compile time grows with their number. Where the host asks for rolled loops, the
+// corners and the edge samples share one loop bounded by sffdRolled (prelude.glsl): one lattice
+// evaluation in the code instead of two. Elsewhere a loop each: lavapipe 22.3 would run both kinds'
+// code at every sample under lane masks. The same operations on each sample either way.
+void smoothBoundarySamples(uint st, SubCorners C, out real3 Q[3], out real3 QN[3], out real3 adj[3], out real3 adjNbr[6],
+                           out real3 E[6], out real3 EN[6]) {
   uint creaseBits = smoothCreaseBits(st);
+  if (sffdRollsLoops()) {
+    for (uint j = 0u; j < sffdRolled(9u); ++j) {   // corners 0..2, then edge samples 0..5
+      bool corner = j < 3u;
+      real3 x = subCornerX(C, j), n = subCornerN(C, j);
+      if (!corner) smoothEdgePoint(C, j - 3u, x, n);
+      LatticeSample S = latticeEvaluate(params.lattice, x);
+      real3 normal = snormalize(latticeCofactorNormal(S, n));
+      if (corner) {
+        real3 ad, a0, a1;
+        smoothCornerAdjust(S, st, j, creaseBits, ad, a0, a1);
+        Q[j] = S.value;
+        QN[j] = normal;
+        adj[j] = ad;
+        adjNbr[2u * j] = a0;
+        adjNbr[2u * j + 1u] = a1;
+      } else {
+        E[j - 3u] = S.value;
+        EN[j - 3u] = normal;
+      }
+    }
+    return;
+  }
   for (uint c = 0u; c < 3u; ++c) {
-    real3 q, qn, ad, a0, a1;
-    smoothCornerSample(st, c, creaseBits, subCornerX(C, c), subCornerN(C, c), q, qn, ad, a0, a1);
-    Q[c] = q;
-    QN[c] = qn;
+    LatticeSample S = latticeEvaluate(params.lattice, subCornerX(C, c));
+    real3 ad, a0, a1;
+    smoothCornerAdjust(S, st, c, creaseBits, ad, a0, a1);
+    Q[c] = S.value;
+    QN[c] = snormalize(latticeCofactorNormal(S, subCornerN(C, c)));
     adj[c] = ad;
     adjNbr[2u * c] = a0;
     adjNbr[2u * c + 1u] = a1;
   }
-}
-
-// Step 2 on an edge: the sample at wa * a + wb * b.
-void smoothEdgeSample(real3 xa, real3 xb, real3 na, real3 nb, real wa, real wb, out real3 E, out real3 EN) {
-  P real3 x = xa * wa + xb * wb;
-  P real3 n = na * wa + nb * wb;
-  LatticeSample S = latticeEvaluate(params.lattice, x);
-  E = S.value;
-  EN = snormalize(latticeCofactorNormal(S, snormalize(n)));
-}
-
-// Step 2 on the edges: samples at one third from each end, E[2e] near corner e, E[2e+1] near e+1.
-void smoothEdgeSamples(SubCorners C, out real3 E[6], out real3 EN[6]) {
-  P real third = real(1) / real(3);
-  P real twoThirds = real(2) / real(3);
   for (uint k = 0u; k < 6u; ++k) {
-    uint e = k / 2u, b = e == 2u ? 0u : e + 1u;
-    P real wa = k % 2u == 0u ? twoThirds : third;
-    P real wb = k % 2u == 0u ? third : twoThirds;
     real3 x, n;
-    smoothEdgeSample(subCornerX(C, e), subCornerX(C, b), subCornerN(C, e), subCornerN(C, b), wa, wb, x, n);
-    E[k] = x;
-    EN[k] = n;
+    smoothEdgePoint(C, k, x, n);
+    LatticeSample S = latticeEvaluate(params.lattice, x);
+    E[k] = S.value;
+    EN[k] = snormalize(latticeCofactorNormal(S, n));
   }
 }
 
