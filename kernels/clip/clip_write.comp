@@ -12,8 +12,10 @@ void main() {
   uint t = sffdThreadIndex();
   if (t >= params.range.y) return;
   uint ct = params.range.x + t;
-  ClipSetup S = clipSetup(ct);
   ClipTriangle T = loadClipTriangle(ct);
+  ClipSetup S;
+  if (sffdRollsLoops()) S = clipSetupOf(T.welds, T.flatCorner);   // its records read once (loadClipTriangle)
+  else S = clipSetup(ct);
   Parent par = loadParent(T.parent);
   // Per local clip edge: the parent edge it lies on and the neighbour's normal there (crease edges).
   // A rolled loop (one copy of the reads, see loadParent), the results through a shift register.

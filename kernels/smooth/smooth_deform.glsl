@@ -89,14 +89,31 @@ SubCorners smoothSubCorners(uint st) {
 }
 
 // Step 4 at corner c, from the corner's lattice sample: the adjusting normals of the corner and of its
-// two slots (crease slots only).
+// two slots (crease slots only). Where the host asks for rolled loops (prelude.glsl sffdRollsLoops), the
+// three in a loop: one copy of the read and of the cofactor normal.
 void smoothCornerAdjust(LatticeSample S, uint st, uint c, uint creaseBits, out real3 adj, out real3 adjA, out real3 adjB) {
   uint rec = SFFD_SUB_STRIDE * st;
-  adj = snormalize(latticeCofactorNormal(S, subRecords[rec + SFFD_SUB_NPN + c].xyz));
-  adjA = adj;
-  adjB = adj;
-  if (((creaseBits >> (2u * c)) & 1u) != 0u) adjA = snormalize(latticeCofactorNormal(S, subRecords[rec + SFFD_SUB_NNBR + 2u * c].xyz));
-  if (((creaseBits >> (2u * c + 1u)) & 1u) != 0u) adjB = snormalize(latticeCofactorNormal(S, subRecords[rec + SFFD_SUB_NNBR + 2u * c + 1u].xyz));
+  if (!sffdRollsLoops()) {
+    adj = snormalize(latticeCofactorNormal(S, subRecords[rec + SFFD_SUB_NPN + c].xyz));
+    adjA = adj;
+    adjB = adj;
+    if (((creaseBits >> (2u * c)) & 1u) != 0u) adjA = snormalize(latticeCofactorNormal(S, subRecords[rec + SFFD_SUB_NNBR + 2u * c].xyz));
+    if (((creaseBits >> (2u * c + 1u)) & 1u) != 0u) adjB = snormalize(latticeCofactorNormal(S, subRecords[rec + SFFD_SUB_NNBR + 2u * c + 1u].xyz));
+    return;
+  }
+  real3 a = real3(0), r[2];   // the corner's, then a shift register of the slots'
+  for (uint m = 0u; m < sffdRolled(3u); ++m) {
+    uint s = 2u * c + m - 1u;   // the slot, m > 0
+    real3 v = a;
+    if (m == 0u || ((creaseBits >> s) & 1u) != 0u)
+      v = snormalize(latticeCofactorNormal(S, subRecords[rec + (m == 0u ? SFFD_SUB_NPN + c : SFFD_SUB_NNBR + s)].xyz));
+    if (m == 0u) a = v;
+    r[0] = r[1];
+    r[1] = v;
+  }
+  adj = a;
+  adjA = r[0];
+  adjB = r[1];
 }
 
 // Corner c's lifted point and linear normal (selects, not an indexed array).
