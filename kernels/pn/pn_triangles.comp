@@ -20,8 +20,16 @@ void main() {
   uint t = sffdThreadIndex();
   if (t >= params.range.y) return;
   uint tri = params.range.x + t;
-  uvec4 ids = triangles[SFFD_MESH_TRIANGLE_STRIDE * tri];
-  uvec4 welds = triangles[SFFD_MESH_TRIANGLE_STRIDE * tri + 1u];
+  uvec4 ids, welds;
+  if (!sffdRollsLoops()) {
+    ids = triangles[SFFD_MESH_TRIANGLE_STRIDE * tri];
+    welds = triangles[SFFD_MESH_TRIANGLE_STRIDE * tri + 1u];
+  } else {
+    for (uint i = 0u; i < sffdRolled(2u); ++i) {
+      ids = welds;
+      welds = triangles[SFFD_MESH_TRIANGLE_STRIDE * tri + i];
+    }
+  }
   real3 q[6];   // positions(ids[0..2]), then normals(ids[0..2])
   for (uint i = 0u; i < sffdRolled(6u); ++i) {
     for (uint j = 0u; j < 5u; ++j) q[j] = q[j + 1u];

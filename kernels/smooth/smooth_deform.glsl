@@ -264,12 +264,21 @@ void smoothAdjust(uint creaseBits, real3 adj[3], real3 adjNbr[6], inout real3 cp
 void smoothTessellate(real3 cp[10], real3 ncp[10], uint L, uint tbase) {
   uint nv = (L + 1u) * (L + 2u) / 2u;
   uint lastRow = L * (L + 1u) / 2u;
-  for (uint c = 0u; c < sffdRolled(3u); ++c) {   // rolled: one copy of the stores (smoothSubCorners)
+  // The corners; where the host asks for rolled loops (prelude.glsl sffdRollsLoops), one store an
+  // iteration: position, then normal.
+  bool oneStore = sffdRollsLoops();
+  for (uint i = 0u; i < (oneStore ? sffdRolled(6u) : 3u); ++i) {
+    uint c = oneStore ? i / 2u : i;
     uint v = c == 0u ? 0u : (c == 1u ? lastRow : lastRow + L);
     real3 xc = c == 0u ? cp[0] : (c == 1u ? cp[6] : cp[9]);
     real3 nc = c == 0u ? ncp[0] : (c == 1u ? ncp[6] : ncp[9]);
-    tess(tbase + v) = real4(xc, 0);
-    tess(tbase + nv + v) = real4(snormalize(nc), 0);
+    if (!oneStore) {
+      tess(tbase + v) = real4(xc, 0);
+      tess(tbase + nv + v) = real4(snormalize(nc), 0);
+    } else {
+      bool normal = i % 2u == 1u;
+      tess(tbase + (normal ? nv : 0u) + v) = real4(normal ? snormalize(nc) : xc, 0);
+    }
   }
   // Edge a runs from corner a to a + 1: vertices (s, 0), (L, s), (L - s, L - s) for a = 0, 1, 2, s steps
   // from corner a; its cubic runs through corner a, the control points of slots 2a+1 and 2a+2 and corner
