@@ -262,7 +262,8 @@ struct EdgeNeighbour {
   real3 nLo, nMid, nHi;   // the neighbour's quadratic normal curve, from the edge's lower-weld end
 };
 
-EdgeNeighbour edgeNeighbour(Parent p, real pe) {
+// rolled: the reads in a loop (see loadParent); a constant at each call, see clip_write.
+EdgeNeighbour edgeNeighbour(Parent p, real pe, bool rolled) {
   EdgeNeighbour r;
   r.crease = false;
   r.e = 0u;
@@ -272,8 +273,8 @@ EdgeNeighbour edgeNeighbour(Parent p, real pe) {
   edgeEnds(p, e, lo, hi);
   uint sLo = SFFD_SLOT_NORMAL_STRIDE * p.local + 2u * slotOf(lo, e);
   uint sHi = SFFD_SLOT_NORMAL_STRIDE * p.local + 2u * slotOf(hi, e);
-  real4 fLo, gLo, fHi, gHi;   // rolled where the host asks for it (see loadParent)
-  if (!sffdRollsLoops()) {
+  real4 fLo, gLo, fHi, gHi;
+  if (!rolled) {
     fLo = slotNormals(sLo), gLo = slotNormals(sLo + 1u);
     fHi = slotNormals(sHi), gHi = slotNormals(sHi + 1u);
   } else {
@@ -312,14 +313,20 @@ struct ClipTriangle {
   real3 flatCorner[3];
 };
 
-ClipTriangle loadClipTriangle(uint ct) {
+// rolled: as edgeNeighbour's.
+ClipTriangle loadClipTriangle(uint ct, bool rolled) {
   ClipTriangle T;
   uvec4 h;
-  clipHeaderRecords(ct, h, T.welds);
+  if (!rolled) {
+    h = clipHeaders(SFFD_CLIP_HEADER_STRIDE * ct);
+    T.welds = clipHeaders(SFFD_CLIP_HEADER_STRIDE * ct + 1u);
+  } else {
+    clipHeaderRecords(ct, h, T.welds);
+  }
   T.parent = h.x;
   T.kinds = h.y;
   uint base = SFFD_CLIP_REAL_STRIDE * ct;
-  if (!sffdRollsLoops()) {
+  if (!rolled) {
     real4 q[6];   // corners 0..2, then edge params 6..8: two iterations of three reads
     for (uint h = 0u; h < 2u; ++h) {
       for (uint j = 0u; j < 3u; ++j) q[j] = q[j + 3u];

@@ -94,9 +94,14 @@ bool sffdAssumes(uint bit) { return (sffdAssumptions & bit) != 0u; }
 // form no shader compiler can fold (gl_NumWorkGroups.z is at most 65535, and 1 here), so the loop is
 // one copy of its body; not min(n, ...): Mesa 25.0's NIR takes a min's constant as the trip count.
 // Elsewhere n itself: Mesa 22.3 compiles unrolled code quickly and runs every iteration of a rolled
-// loop at a cost, and a GPU driver unrolls what pays. A rolled iteration costs llvmpipe a few hundred
-// instructions per 8 lanes on either Mesa, so these loops have few iterations of several accesses each.
+// loop at a cost (a few hundred instructions per 8 lanes), and a GPU driver unrolls what pays.
 uint sffdRolled(uint n) { return sffdAssumes(SFFD_ASSUME_ROLLED_LOOPS) ? n + (gl_NumWorkGroups.z >> 16u) : n; }
+// Whether the host asks for rolled loops. Where a kernel has two forms of the same operations, the
+// rolled one has one record access (and one copy of the work on it) an iteration, each kept once in
+// the code: that is what Mesa 25.0 compiles fastest. The other is the straight code Mesa 22.3 runs
+// fastest: reads written out or in a few constant iterations of several, which it unrolls and keeps
+// together (its counts of executed instructions stay those of the straight code; a loop of one read
+// an iteration with a constant bound did not, in clip_write).
 bool sffdRollsLoops() { return sffdAssumes(SFFD_ASSUME_ROLLED_LOOPS); }
 
 #if SFFD_STRICT
