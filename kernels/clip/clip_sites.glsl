@@ -262,8 +262,7 @@ struct EdgeNeighbour {
   real3 nLo, nMid, nHi;   // the neighbour's quadratic normal curve, from the edge's lower-weld end
 };
 
-// rolled: the reads in a loop (see loadParent); a constant at each call, see clip_write.
-EdgeNeighbour edgeNeighbour(Parent p, real pe, bool rolled) {
+EdgeNeighbour edgeNeighbour(Parent p, real pe) {
   EdgeNeighbour r;
   r.crease = false;
   r.e = 0u;
@@ -273,8 +272,8 @@ EdgeNeighbour edgeNeighbour(Parent p, real pe, bool rolled) {
   edgeEnds(p, e, lo, hi);
   uint sLo = SFFD_SLOT_NORMAL_STRIDE * p.local + 2u * slotOf(lo, e);
   uint sHi = SFFD_SLOT_NORMAL_STRIDE * p.local + 2u * slotOf(hi, e);
-  real4 fLo, gLo, fHi, gHi;
-  if (!rolled) {
+  real4 fLo, gLo, fHi, gHi;   // rolled where the host asks for it (see loadParent)
+  if (!sffdRollsLoops()) {
     fLo = slotNormals(sLo), gLo = slotNormals(sLo + 1u);
     fHi = slotNormals(sHi), gHi = slotNormals(sHi + 1u);
   } else {
@@ -313,20 +312,14 @@ struct ClipTriangle {
   real3 flatCorner[3];
 };
 
-// rolled: as edgeNeighbour's.
-ClipTriangle loadClipTriangle(uint ct, bool rolled) {
+ClipTriangle loadClipTriangle(uint ct) {
   ClipTriangle T;
   uvec4 h;
-  if (!rolled) {
-    h = clipHeaders(SFFD_CLIP_HEADER_STRIDE * ct);
-    T.welds = clipHeaders(SFFD_CLIP_HEADER_STRIDE * ct + 1u);
-  } else {
-    clipHeaderRecords(ct, h, T.welds);
-  }
+  clipHeaderRecords(ct, h, T.welds);
   T.parent = h.x;
   T.kinds = h.y;
   uint base = SFFD_CLIP_REAL_STRIDE * ct;
-  if (!rolled) {
+  if (!sffdRollsLoops()) {
     real4 q[6];   // corners 0..2, then edge params 6..8: two iterations of three reads
     for (uint h = 0u; h < 2u; ++h) {
       for (uint j = 0u; j < 3u; ++j) q[j] = q[j + 3u];

@@ -12,33 +12,18 @@ void main() {
   uint t = sffdThreadIndex();
   if (t >= params.range.y) return;
   uint ct = params.range.x + t;
-  // The rolled form (prelude.glsl sffdRollsLoops) and the straight one apart, not chosen inside the
-  // functions: lavapipe 22.3 ran more instructions when a loop of its straight code held the rolled
-  // form's loop in a branch it drops.
+  ClipTriangle T = loadClipTriangle(ct);
   ClipSetup S;
-  ClipTriangle T;
-  // Per local clip edge: the parent edge it lies on and the neighbour's normal there (crease edges),
-  // in a loop (one copy of the reads), the results through a shift register.
+  if (sffdRollsLoops()) S = clipSetupOf(T.welds, T.flatCorner);   // its records read once (loadClipTriangle)
+  else S = clipSetup(ct);
+  Parent par = loadParent(T.parent);
+  // Per local clip edge: the parent edge it lies on and the neighbour's normal there (crease edges).
+  // A rolled loop (one copy of the reads, see loadParent), the results through a shift register.
   EdgeNeighbour nbr0, nbr1, nbr2;
-  Parent par;
-  if (!sffdRollsLoops()) {
-    S = clipSetup(ct);
-    T = loadClipTriangle(ct, false);
-    par = loadParent(T.parent);
-    for (uint le = 0u; le < 3u; ++le) {
-      nbr0 = nbr1;
-      nbr1 = nbr2;
-      nbr2 = edgeNeighbour(par, clipEdgeParams(T, le).x, false);
-    }
-  } else {
-    T = loadClipTriangle(ct, true);
-    S = clipSetupOf(T.welds, T.flatCorner);   // the clip triangle's records read once
-    par = loadParent(T.parent);
-    for (uint le = 0u; le < sffdRolled(3u); ++le) {
-      nbr0 = nbr1;
-      nbr1 = nbr2;
-      nbr2 = edgeNeighbour(par, clipEdgeParams(T, le).x, true);
-    }
+  for (uint le = 0u; le < sffdRolled(3u); ++le) {
+    nbr0 = nbr1;
+    nbr1 = nbr2;
+    nbr2 = edgeNeighbour(par, clipEdgeParams(T, le).x);
   }
   uint out0 = counts(ct);
   for (uint k = 0u; k < S.entry.w; ++k) {
