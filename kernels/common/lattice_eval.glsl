@@ -104,42 +104,15 @@ void latticeRow2(uint c, real3 bw, real3 dbw, out real3 q, out real3 qw) {
   qw = rw;
 }
 
-// Where the host asks for rolled loops (prelude.glsl sffdRollsLoops), the rows of a slab and the slabs
-// of a volume are summed in loops: one copy of a row's three coefficient reads instead of 27. The sums
-// keep their order, ((z + x0 b.x) + x1 b.y) + x2 b.z, from this z: +0 in the strict variant, as the
-// written-out sums; -0 in the fast one, where the compilers drop their "0 +" (-0 + x is x).
-real3 latticeSumStart() {
-#if SFFD_STRICT
-  return real3(0);
-#else
-  return real3(-0.0);
-#endif
-}
-
 // One slab of nine coefficients (fixed u index): sums over v and w.
 void latticeSlab2(uint c, real3 bv, real3 dbv, real3 bw, real3 dbw, out real3 sp, out real3 spv, out real3 spw) {
-  if (!sffdRollsLoops()) {
-    real3 q0, q0w, q1, q1w, q2, q2w;
-    latticeRow2(c, bw, dbw, q0, q0w);
-    latticeRow2(c + 3u, bw, dbw, q1, q1w);
-    latticeRow2(c + 6u, bw, dbw, q2, q2w);
-    P real3 a = ((real3(0) + q0 * bv.x) + q1 * bv.y) + q2 * bv.z;
-    P real3 av = ((real3(0) + q0 * dbv.x) + q1 * dbv.y) + q2 * dbv.z;
-    P real3 aw = ((real3(0) + q0w * bv.x) + q1w * bv.y) + q2w * bv.z;
-    sp = a;
-    spv = av;
-    spw = aw;
-    return;
-  }
-  P real3 a = latticeSumStart(), av = a, aw = a;
-  for (uint j = 0u; j < sffdRolled(3u); ++j) {
-    real3 q, qw;
-    latticeRow2(c + 3u * j, bw, dbw, q, qw);
-    real b = j == 0u ? bv.x : (j == 1u ? bv.y : bv.z), db = j == 0u ? dbv.x : (j == 1u ? dbv.y : dbv.z);
-    a = a + q * b;
-    av = av + q * db;
-    aw = aw + qw * b;
-  }
+  real3 q0, q0w, q1, q1w, q2, q2w;
+  latticeRow2(c, bw, dbw, q0, q0w);
+  latticeRow2(c + 3u, bw, dbw, q1, q1w);
+  latticeRow2(c + 6u, bw, dbw, q2, q2w);
+  P real3 a = ((real3(0) + q0 * bv.x) + q1 * bv.y) + q2 * bv.z;
+  P real3 av = ((real3(0) + q0 * dbv.x) + q1 * dbv.y) + q2 * dbv.z;
+  P real3 aw = ((real3(0) + q0w * bv.x) + q1w * bv.y) + q2w * bv.z;
   sp = a;
   spv = av;
   spw = aw;
@@ -151,31 +124,14 @@ void latticeVolume2(uint base, real su, real sv, real sw, out real3 R, out real3
   latticeBernstein2(su, bu, dbu);
   latticeBernstein2(sv, bv, dbv);
   latticeBernstein2(sw, bw, dbw);
-  if (!sffdRollsLoops()) {
-    real3 s0, s0v, s0w, s1, s1v, s1w, s2, s2v, s2w;
-    latticeSlab2(base, bv, dbv, bw, dbw, s0, s0v, s0w);
-    latticeSlab2(base + 9u, bv, dbv, bw, dbw, s1, s1v, s1w);
-    latticeSlab2(base + 18u, bv, dbv, bw, dbw, s2, s2v, s2w);
-    P real3 r = ((real3(0) + s0 * bu.x) + s1 * bu.y) + s2 * bu.z;
-    P real3 ru = ((real3(0) + s0 * dbu.x) + s1 * dbu.y) + s2 * dbu.z;
-    P real3 rv = ((real3(0) + s0v * bu.x) + s1v * bu.y) + s2v * bu.z;
-    P real3 rw = ((real3(0) + s0w * bu.x) + s1w * bu.y) + s2w * bu.z;
-    R = r;
-    Ru = ru;
-    Rv = rv;
-    Rw = rw;
-    return;
-  }
-  P real3 r = latticeSumStart(), ru = r, rv = r, rw = r;   // the slabs in a loop, as the rows in latticeSlab2
-  for (uint i = 0u; i < sffdRolled(3u); ++i) {
-    real3 sp, spv, spw;
-    latticeSlab2(base + 9u * i, bv, dbv, bw, dbw, sp, spv, spw);
-    real b = i == 0u ? bu.x : (i == 1u ? bu.y : bu.z), db = i == 0u ? dbu.x : (i == 1u ? dbu.y : dbu.z);
-    r = r + sp * b;
-    ru = ru + sp * db;
-    rv = rv + spv * b;
-    rw = rw + spw * b;
-  }
+  real3 s0, s0v, s0w, s1, s1v, s1w, s2, s2v, s2w;
+  latticeSlab2(base, bv, dbv, bw, dbw, s0, s0v, s0w);
+  latticeSlab2(base + 9u, bv, dbv, bw, dbw, s1, s1v, s1w);
+  latticeSlab2(base + 18u, bv, dbv, bw, dbw, s2, s2v, s2w);
+  P real3 r = ((real3(0) + s0 * bu.x) + s1 * bu.y) + s2 * bu.z;
+  P real3 ru = ((real3(0) + s0 * dbu.x) + s1 * dbu.y) + s2 * dbu.z;
+  P real3 rv = ((real3(0) + s0v * bu.x) + s1v * bu.y) + s2v * bu.z;
+  P real3 rw = ((real3(0) + s0w * bu.x) + s1w * bu.y) + s2w * bu.z;
   R = r;
   Ru = ru;
   Rv = rv;
