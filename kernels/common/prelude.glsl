@@ -96,15 +96,12 @@ bool sffdAssumes(uint bit) { return (sffdAssumptions & bit) != 0u; }
 // Elsewhere n itself: Mesa 22.3 compiles unrolled code quickly and runs every iteration of a rolled
 // loop at a cost (a few hundred instructions per 8 lanes), and a GPU driver unrolls what pays.
 uint sffdRolled(uint n) { return sffdAssumes(SFFD_ASSUME_ROLLED_LOOPS) ? n + (gl_NumWorkGroups.z >> 16u) : n; }
-// Whether the host asks for rolled loops. Where a kernel has two forms of the same operations, the
-// rolled one has one record access (and one copy of the work on it) an iteration, each kept once in
-// the code: that is what Mesa 25.0 compiles fastest. The other is the straight code Mesa 22.3 runs
-// fastest: reads written out or in a few constant iterations of several, which it unrolls and keeps
-// together (its counts of executed instructions stay those of the straight code; a loop of one read
-// an iteration with a constant bound did not, in clip_write).
-// A constant expression rather than a call: where the assumptions are constant (GL, the SPIR-V compiled
-// ahead) the compiler drops the other form before the driver sees it (a form chosen after inlining cost
-// lavapipe 22.3 5 to 25 % more clip_write instructions).
+// Whether the host asks for rolled loops. A kernel with two forms of the same operations has for these
+// drivers one record access an iteration, each access and the work on it once in the code (what Mesa
+// 25.0 compiles fastest, at some warm cost), elsewhere the straight code Mesa 22.3 runs fastest. A
+// constant expression rather than a call: where the assumptions are constant (GL, the SPIR-V compiled
+// ahead) the compiler drops the other form before the driver sees it (chosen after inlining, the
+// forms cost lavapipe 22.3 5 to 25 % more clip_write instructions).
 const bool sffdRollsLoopsHere = (sffdAssumptions & SFFD_ASSUME_ROLLED_LOOPS) != 0u;
 #define sffdRollsLoops() sffdRollsLoopsHere
 
