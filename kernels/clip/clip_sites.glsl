@@ -31,9 +31,30 @@ layout(std430, SFFD_SET binding = SFFD_BINDING_CLIP_WORDS) readonly buffer ClipI
 #define clipReals(i) clipInReals[params.sections.z + (i)]
 #define splitTable(i) clipInWords[i]
 #define counts(i) clipInWords[params.words.z + (i)]
-uvec4 clipWords4(uint w) { return uvec4(clipInWords[w], clipInWords[w + 1u], clipInWords[w + 2u], clipInWords[w + 3u]); }
+// Four words (rolled where the host asks for it, see loadParent).
+uvec4 clipWords4(uint w) {
+  uvec4 r;
+  if (!sffdRollsLoops()) r = uvec4(clipInWords[w], clipInWords[w + 1u], clipInWords[w + 2u], clipInWords[w + 3u]);
+  else
+    for (uint i = 0u; i < sffdRolled(4u); ++i) r = uvec4(r.yzw, clipInWords[w + i]);
+  return r;
+}
+// Eight words: two records of four, in one loop where the host asks for rolled loops.
+void clipWords8(uint w, out uvec4 a, out uvec4 b) {
+  if (!sffdRollsLoops()) {
+    a = clipWords4(w);
+    b = clipWords4(w + 4u);
+  } else {
+    for (uint i = 0u; i < sffdRolled(8u); ++i) {
+      a = uvec4(a.yzw, b.x);
+      b = uvec4(b.yzw, clipInWords[w + i]);
+    }
+  }
+}
 #define triangles(i) clipWords4(params.words.x + 4u * (i))
 #define clipHeaders(i) clipWords4(params.words.y + 4u * (i))
+#define triangleRecords(i, verts, welds) clipWords8(params.words.x + 4u * SFFD_MESH_TRIANGLE_STRIDE * (i), verts, welds)
+#define clipHeaderRecords(i, h, welds) clipWords8(params.words.y + 4u * SFFD_CLIP_HEADER_STRIDE * (i), h, welds)
 
 // The split of one clip triangle: counts, the canonical-to-local corner map and the pattern entry.
 struct ClipSetup {
@@ -45,10 +66,8 @@ struct ClipSetup {
   uvec4 entry;       // firstVertex, vertexCount, firstTriangle, triangleCount
 };
 
-ClipSetup clipSetup(uint ct) {
-  uvec4 welds = clipHeaders(SFFD_CLIP_HEADER_STRIDE * ct + 1u);
-  real3 corner[3];
-  for (uint c = 0u; c < 3u; ++c) corner[c] = clipReals(SFFD_CLIP_REAL_STRIDE * ct + 3u + c).xyz;
+// From the clip triangle's corner welds and flat corners.
+ClipSetup clipSetupOf(uvec4 welds, real3 corner[3]) {
   uint n[3];
   uint nmax = params.table.x;
   for (uint e = 0u; e < 3u; ++e) {
@@ -80,8 +99,23 @@ ClipSetup clipSetup(uint ct) {
   // Float lengths of a flat triangle may break a + b >= c by one segment: fall back to c = a + b.
   uint cc = min(S.count[2], S.count[0] + S.count[1]);
   uint key = ((S.count[0] - 1u) * nmax + (S.count[1] - 1u)) * nmax + (cc - 1u);
-  S.entry = uvec4(splitTable(4u * key), splitTable(4u * key + 1u), splitTable(4u * key + 2u), splitTable(4u * key + 3u));
+  S.entry = clipWords4(4u * key);   // splitTable(4 key ..)
   return S;
+}
+
+ClipSetup clipSetup(uint ct) {
+  uvec4 welds = clipHeaders(SFFD_CLIP_HEADER_STRIDE * ct + 1u);
+  real3 corner[3];   // rolled where the host asks for it (see loadParent)
+  if (!sffdRollsLoops()) {
+    for (uint c = 0u; c < 3u; ++c) corner[c] = clipReals(SFFD_CLIP_REAL_STRIDE * ct + 3u + c).xyz;
+  } else {
+    for (uint c = 0u; c < sffdRolled(3u); ++c) {
+      corner[0] = corner[1];
+      corner[1] = corner[2];
+      corner[2] = clipReals(SFFD_CLIP_REAL_STRIDE * ct + 3u + c).xyz;
+    }
+  }
+  return clipSetupOf(welds, corner);
 }
 
 // Where a point lies on the parent: kind 0..2 parent corner, 3..5 on parent edge kind-3 at t (from the
@@ -108,24 +142,32 @@ struct Parent {
   real3 n[6];   // the PN normal control points
 };
 
-// The reads in a loop bounded by sffdRolled (prelude.glsl: why, and why few iterations), the values
-// through a shift register (an array indexed by constants only: registers). Same values, same bits.
+// The reads in two forms (prelude.glsl sffdRollsLoops): for Mesa 22.3 and GPUs, few iterations of
+// several reads; where the host asks for rolled loops, one read an iteration. The values go through a
+// shift register (an array indexed by constants only: registers). Same values, same bits.
 Parent loadParent(uint id) {
   Parent p;
   p.id = id;
   p.local = id - params.range.w;
-  p.verts = triangles(SFFD_MESH_TRIANGLE_STRIDE * p.local);
-  p.welds = triangles(SFFD_MESH_TRIANGLE_STRIDE * p.local + 1u);
+  triangleRecords(p.local, p.verts, p.welds);
   // 0..2 positions, 3..5 normals, 6..21 the PN record (10 control points, 6 normal control points):
   // two iterations of eleven reads.
   real3 q[22];
   uint base = SFFD_PN_STRIDE * p.local;
-  for (uint h = 0u; h < sffdRolled(2u); ++h) {
-    for (uint j = 0u; j < 11u; ++j) q[j] = q[j + 11u];
-    for (uint j = 0u; j < 11u; ++j) {
-      uint i = 11u * h + j;
-      uint a = i < 3u ? positionIndex(p.verts[i]) : (i < 6u ? normalIndex(p.verts[i - 3u]) : pnIndex(base + (i - 6u)));
-      q[11u + j] = clipInReals[a].xyz;
+  if (!sffdRollsLoops()) {
+    for (uint h = 0u; h < 2u; ++h) {   // two iterations of eleven reads
+      for (uint j = 0u; j < 11u; ++j) q[j] = q[j + 11u];
+      for (uint j = 0u; j < 11u; ++j) {
+        uint i = 11u * h + j;
+        uint a = i < 3u ? positionIndex(p.verts[i]) : (i < 6u ? normalIndex(p.verts[i - 3u]) : pnIndex(base + (i - 6u)));
+        q[11u + j] = clipInReals[a].xyz;
+      }
+    }
+  } else {
+    for (uint i = 0u; i < sffdRolled(22u); ++i) {
+      uint a = i < 3u ? positionIndex(p.verts[i % 3u]) : (i < 6u ? normalIndex(p.verts[i % 3u]) : pnIndex(base + (i - 6u)));
+      for (uint j = 0u; j < 21u; ++j) q[j] = q[j + 1u];
+      q[21] = clipInReals[a].xyz;
     }
   }
   p.V[0] = q[0]; p.V[1] = q[1]; p.V[2] = q[2];
@@ -230,8 +272,18 @@ EdgeNeighbour edgeNeighbour(Parent p, real pe) {
   edgeEnds(p, e, lo, hi);
   uint sLo = SFFD_SLOT_NORMAL_STRIDE * p.local + 2u * slotOf(lo, e);
   uint sHi = SFFD_SLOT_NORMAL_STRIDE * p.local + 2u * slotOf(hi, e);
-  real4 fLo = slotNormals(sLo), gLo = slotNormals(sLo + 1u);
-  real4 fHi = slotNormals(sHi), gHi = slotNormals(sHi + 1u);
+  real4 fLo, gLo, fHi, gHi;   // rolled where the host asks for it (see loadParent)
+  if (!sffdRollsLoops()) {
+    fLo = slotNormals(sLo), gLo = slotNormals(sLo + 1u);
+    fHi = slotNormals(sHi), gHi = slotNormals(sHi + 1u);
+  } else {
+    real4 q[4];
+    for (uint i = 0u; i < sffdRolled(4u); ++i) {
+      for (uint j = 0u; j < 3u; ++j) q[j] = q[j + 1u];
+      q[3] = slotNormals((i < 2u ? sLo : sHi) + i % 2u);
+    }
+    fLo = q[0], gLo = q[1], fHi = q[2], gHi = q[3];
+  }
   r.e = e;
   r.crease = !(fLo.w < real(0.5) && fHi.w < real(0.5));
   r.nLo = gLo.w > real(0.5) ? gLo.xyz : fLo.xyz;   // the one that is not this triangle's own
@@ -251,27 +303,40 @@ real3 neighbourNormalAt(EdgeNeighbour n, real t) {
 // A clip triangle's corners and edges, read once (as Parent): per corner its barycentrics in the
 // parent (w: the parameter t on a parent edge) and site kind, per clip edge the parent edge it lies on
 // (x, -1 if none) and the parameters of its ends there (y, z).
+// Where the host asks for rolled loops, also its flat corners, for clipSetupOf: every record of the
+// clip triangle read once, one an iteration (see loadParent).
 struct ClipTriangle {
   uint parent, kinds;
   uvec4 welds;
   real4 lam[3], edgeParams[3];
+  real3 flatCorner[3];
 };
 
 ClipTriangle loadClipTriangle(uint ct) {
   ClipTriangle T;
-  uvec4 h = clipHeaders(SFFD_CLIP_HEADER_STRIDE * ct);
+  uvec4 h;
+  clipHeaderRecords(ct, h, T.welds);
   T.parent = h.x;
   T.kinds = h.y;
-  T.welds = clipHeaders(SFFD_CLIP_HEADER_STRIDE * ct + 1u);
-  // Corners 0..2, then edge params 6..8: two iterations of three reads (see loadParent).
-  real4 q[6];
   uint base = SFFD_CLIP_REAL_STRIDE * ct;
-  for (uint h = 0u; h < sffdRolled(2u); ++h) {
-    for (uint j = 0u; j < 3u; ++j) q[j] = q[j + 3u];
-    for (uint j = 0u; j < 3u; ++j) q[3u + j] = clipReals(base + 6u * h + j);
+  if (!sffdRollsLoops()) {
+    real4 q[6];   // corners 0..2, then edge params 6..8: two iterations of three reads
+    for (uint h = 0u; h < 2u; ++h) {
+      for (uint j = 0u; j < 3u; ++j) q[j] = q[j + 3u];
+      for (uint j = 0u; j < 3u; ++j) q[3u + j] = clipReals(base + 6u * h + j);
+    }
+    T.lam[0] = q[0]; T.lam[1] = q[1]; T.lam[2] = q[2];
+    T.edgeParams[0] = q[3]; T.edgeParams[1] = q[4]; T.edgeParams[2] = q[5];
+  } else {
+    real4 q[9];   // corners 0..2, flat corners 3..5, edge params 6..8
+    for (uint i = 0u; i < sffdRolled(9u); ++i) {
+      for (uint j = 0u; j < 8u; ++j) q[j] = q[j + 1u];
+      q[8] = clipReals(base + i);
+    }
+    T.lam[0] = q[0]; T.lam[1] = q[1]; T.lam[2] = q[2];
+    T.flatCorner[0] = q[3].xyz; T.flatCorner[1] = q[4].xyz; T.flatCorner[2] = q[5].xyz;
+    T.edgeParams[0] = q[6]; T.edgeParams[1] = q[7]; T.edgeParams[2] = q[8];
   }
-  T.lam[0] = q[0]; T.lam[1] = q[1]; T.lam[2] = q[2];
-  T.edgeParams[0] = q[3]; T.edgeParams[1] = q[4]; T.edgeParams[2] = q[5];
   return T;
 }
 

@@ -12,8 +12,10 @@ void main() {
   uint t = sffdThreadIndex();
   if (t >= params.range.y) return;
   uint ct = params.range.x + t;
-  ClipSetup S = clipSetup(ct);
   ClipTriangle T = loadClipTriangle(ct);
+  ClipSetup S;
+  if (sffdRollsLoops()) S = clipSetupOf(T.welds, T.flatCorner);   // its records read once (loadClipTriangle)
+  else S = clipSetup(ct);
   Parent par = loadParent(T.parent);
   // Per local clip edge: the parent edge it lies on and the neighbour's normal there (crease edges).
   // A rolled loop (one copy of the reads, see loadParent), the results through a shift register.
@@ -38,19 +40,28 @@ void main() {
       uint word = splitTable(params.table.z + i / 2u);
       uint idx = (i % 2u == 0u) ? (word & 65535u) : (word >> 16u);
       uint v = params.table.y + 4u * (S.entry.x + idx);
-      real3 lamCanon = real3(uintBitsToFloat(splitTable(v)), uintBitsToFloat(splitTable(v + 1u)), uintBitsToFloat(splitTable(v + 2u)));
-      uint w = splitTable(v + 3u);
+      uvec4 vw = clipWords4(v);   // splitTable(v ..)
+      real3 lamCanon = real3(uintBitsToFloat(vw.x), uintBitsToFloat(vw.y), uintBitsToFloat(vw.z));
+      uint w = vw.w;
       edge[c] = w & 255u;
       step[c] = w >> 16u;
       Site site = patternSite(T, S, edge[c], step[c], lamCanon);
       kind[c] = site.kind;
       siteT[c] = site.t;
       SiteValue val = evaluateSite(par, site);
-      subRecords[rec + SFFD_SUB_LAM + c] = real4(val.lam, 0);
-      subRecords[rec + SFFD_SUB_XPN + c] = real4(val.xpn, 0);
-      subRecords[rec + SFFD_SUB_XFLAT + c] = real4(val.xflat, 0);
-      subRecords[rec + SFFD_SUB_NLIN + c] = real4(val.nlin, 0);
-      subRecords[rec + SFFD_SUB_NPN + c] = real4(val.npn, 0);
+      if (!sffdRollsLoops()) {
+        subRecords[rec + SFFD_SUB_LAM + c] = real4(val.lam, 0);
+        subRecords[rec + SFFD_SUB_XPN + c] = real4(val.xpn, 0);
+        subRecords[rec + SFFD_SUB_XFLAT + c] = real4(val.xflat, 0);
+        subRecords[rec + SFFD_SUB_NLIN + c] = real4(val.nlin, 0);
+        subRecords[rec + SFFD_SUB_NPN + c] = real4(val.npn, 0);
+      } else {   // LAM, XPN, XFLAT, NLIN, NPN (layout.h: evenly apart), one store an iteration (see loadParent)
+        real3 f[5] = real3[5](val.lam, val.xpn, val.xflat, val.nlin, val.npn);
+        for (uint j = 0u; j < sffdRolled(5u); ++j) {
+          subRecords[rec + SFFD_SUB_LAM + (SFFD_SUB_XPN - SFFD_SUB_LAM) * j + c] = real4(f[0], 0);
+          for (uint m = 0u; m < 4u; ++m) f[m] = f[m + 1u];
+        }
+      }
       if (c == 0u) lam0 = val.lam, npn0 = val.npn;
       if (c == 1u) npn1 = val.npn;
       if (c == 2u) npn2 = val.npn;

@@ -94,9 +94,16 @@ bool sffdAssumes(uint bit) { return (sffdAssumptions & bit) != 0u; }
 // form no shader compiler can fold (gl_NumWorkGroups.z is at most 65535, and 1 here), so the loop is
 // one copy of its body; not min(n, ...): Mesa 25.0's NIR takes a min's constant as the trip count.
 // Elsewhere n itself: Mesa 22.3 compiles unrolled code quickly and runs every iteration of a rolled
-// loop at a cost, and a GPU driver unrolls what pays. A rolled iteration costs llvmpipe a few hundred
-// instructions per 8 lanes on either Mesa, so these loops have few iterations of several accesses each.
+// loop at a cost (a few hundred instructions per 8 lanes), and a GPU driver unrolls what pays.
 uint sffdRolled(uint n) { return sffdAssumes(SFFD_ASSUME_ROLLED_LOOPS) ? n + (gl_NumWorkGroups.z >> 16u) : n; }
+// Whether the host asks for rolled loops. A kernel with two forms of the same operations has for these
+// drivers one record access an iteration, each access and the work on it once in the code (what Mesa
+// 25.0 compiles fastest, at some warm cost), elsewhere the straight code Mesa 22.3 runs fastest. A
+// constant expression rather than a call: where the assumptions are constant (GL, the SPIR-V compiled
+// ahead) the compiler drops the other form before the driver sees it (chosen after inlining, the
+// forms cost lavapipe 22.3 5 to 25 % more clip_write instructions).
+const bool sffdRollsLoopsHere = (sffdAssumptions & SFFD_ASSUME_ROLLED_LOOPS) != 0u;
+#define sffdRollsLoops() sffdRollsLoopsHere
 
 #if SFFD_STRICT
 real sdot(real3 a, real3 b) {

@@ -12,8 +12,7 @@ void main() {
   uint st = params.range.x + tid;
   real3 Q[3], QN[3], adj[3], adjNbr[6], E[6], EN[6];
   SubCorners corners = smoothSubCorners(st);
-  smoothCornerSamples(st, corners, Q, QN, adj, adjNbr);
-  smoothEdgeSamples(corners, E, EN);
+  smoothBoundarySamples(st, corners, Q, QN, adj, adjNbr, E, EN);
   uint b = (SFFD_SAMPLE_FIXED + params.range.z) * st;
   for (uint c = 0u; c < 3u; ++c) {
     samples(b + c) = real4(Q[c], 0);

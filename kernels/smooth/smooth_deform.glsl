@@ -61,14 +61,22 @@ real3 nearControlPoint(real3 q0, real3 q1, real3 q2, real3 q3) {
 struct SubCorners {
   real3 x0, x1, x2, n0, n1, n2;
 };
-// The reads in a loop of two bounded by sffdRolled (prelude.glsl), the values through a shift register
-// (an array indexed by constants only: registers).
+// The reads in two forms, as clip_sites.glsl's loadParent: two iterations of three, or where the host
+// asks for rolled loops (prelude.glsl sffdRollsLoops) one an iteration; the values through a shift
+// register (an array indexed by constants only: registers).
 SubCorners smoothSubCorners(uint st) {
   uint rec = SFFD_SUB_STRIDE * st;
   real3 q[6];   // XPN 0..2, then NLIN 0..2
-  for (uint h = 0u; h < sffdRolled(2u); ++h) {
-    for (uint j = 0u; j < 3u; ++j) q[j] = q[j + 3u];
-    for (uint j = 0u; j < 3u; ++j) q[3u + j] = subRecords[rec + SFFD_SUB_XPN + (SFFD_SUB_NLIN - SFFD_SUB_XPN) * h + j].xyz;
+  if (!sffdRollsLoops()) {
+    for (uint h = 0u; h < 2u; ++h) {
+      for (uint j = 0u; j < 3u; ++j) q[j] = q[j + 3u];
+      for (uint j = 0u; j < 3u; ++j) q[3u + j] = subRecords[rec + SFFD_SUB_XPN + (SFFD_SUB_NLIN - SFFD_SUB_XPN) * h + j].xyz;
+    }
+  } else {
+    for (uint i = 0u; i < sffdRolled(6u); ++i) {
+      for (uint j = 0u; j < 5u; ++j) q[j] = q[j + 1u];
+      q[5] = subRecords[rec + (i < 3u ? SFFD_SUB_XPN : SFFD_SUB_NLIN) + i % 3u].xyz;
+    }
   }
   SubCorners C;
   C.x0 = q[0];
@@ -80,61 +88,77 @@ SubCorners smoothSubCorners(uint st) {
   return C;
 }
 
-// Steps 1 and 2 at corner c (and step 4, which needs the same Jacobian): the deformed corner, its
-// deformed normal, and the adjusting normals of the corner and of its two slots (crease slots only).
-void smoothCornerSample(uint st, uint c, uint creaseBits, real3 x, real3 nlin, out real3 Q, out real3 QN, out real3 adj,
-                        out real3 adjA, out real3 adjB) {
+// Step 4 at corner c, from the corner's lattice sample: the adjusting normals of the corner and of its
+// two slots (crease slots only). Where the host asks for rolled loops (prelude.glsl sffdRollsLoops), the
+// three in a loop: one copy of the read and of the cofactor normal.
+void smoothCornerAdjust(LatticeSample S, uint st, uint c, uint creaseBits, out real3 adj, out real3 adjA, out real3 adjB) {
   uint rec = SFFD_SUB_STRIDE * st;
-  LatticeSample S = latticeEvaluate(params.lattice, x);
-  Q = S.value;
-  QN = snormalize(latticeCofactorNormal(S, nlin));
-  adj = snormalize(latticeCofactorNormal(S, subRecords[rec + SFFD_SUB_NPN + c].xyz));
-  adjA = adj;
-  adjB = adj;
-  if (((creaseBits >> (2u * c)) & 1u) != 0u) adjA = snormalize(latticeCofactorNormal(S, subRecords[rec + SFFD_SUB_NNBR + 2u * c].xyz));
-  if (((creaseBits >> (2u * c + 1u)) & 1u) != 0u) adjB = snormalize(latticeCofactorNormal(S, subRecords[rec + SFFD_SUB_NNBR + 2u * c + 1u].xyz));
+  if (!sffdRollsLoops()) {
+    adj = snormalize(latticeCofactorNormal(S, subRecords[rec + SFFD_SUB_NPN + c].xyz));
+    adjA = adj;
+    adjB = adj;
+    if (((creaseBits >> (2u * c)) & 1u) != 0u) adjA = snormalize(latticeCofactorNormal(S, subRecords[rec + SFFD_SUB_NNBR + 2u * c].xyz));
+    if (((creaseBits >> (2u * c + 1u)) & 1u) != 0u) adjB = snormalize(latticeCofactorNormal(S, subRecords[rec + SFFD_SUB_NNBR + 2u * c + 1u].xyz));
+    return;
+  }
+  real3 a = real3(0), r[2];   // the corner's, then a shift register of the slots'
+  for (uint m = 0u; m < sffdRolled(3u); ++m) {
+    uint s = 2u * c + m - 1u;   // the slot, m > 0
+    real3 v = a;
+    if (m == 0u || ((creaseBits >> s) & 1u) != 0u)
+      v = snormalize(latticeCofactorNormal(S, subRecords[rec + (m == 0u ? SFFD_SUB_NPN + c : SFFD_SUB_NNBR + s)].xyz));
+    if (m == 0u) a = v;
+    r[0] = r[1];
+    r[1] = v;
+  }
+  adj = a;
+  adjA = r[0];
+  adjB = r[1];
 }
 
 // Corner c's lifted point and linear normal (selects, not an indexed array).
 real3 subCornerX(SubCorners C, uint c) { return c == 0u ? C.x0 : (c == 1u ? C.x1 : C.x2); }
 real3 subCornerN(SubCorners C, uint c) { return c == 0u ? C.n0 : (c == 1u ? C.n1 : C.n2); }
 
-// Loops rather than calls written out: every call inlines a whole lattice evaluation, and the
-// kernels' compile time grows with their number.
-void smoothCornerSamples(uint st, SubCorners C, out real3 Q[3], out real3 QN[3], out real3 adj[3], out real3 adjNbr[6]) {
+// Edge sample k (E[2e] a third from corner e, E[2e+1] a third from e+1): its point and its normal
+// before the deformation.
+void smoothEdgePoint(SubCorners C, uint k, out real3 x, out real3 n) {
+  P real third = real(1) / real(3);
+  P real twoThirds = real(2) / real(3);
+  uint e = k / 2u, b = e == 2u ? 0u : e + 1u;
+  P real wa = k % 2u == 0u ? twoThirds : third;
+  P real wb = k % 2u == 0u ? third : twoThirds;
+  P real3 xk = subCornerX(C, e) * wa + subCornerX(C, b) * wb;
+  P real3 nk = subCornerN(C, e) * wa + subCornerN(C, b) * wb;
+  x = xk;
+  n = snormalize(nk);
+}
+
+// Steps 1 and 2 on the boundary and step 4: at corner c the deformed corner Q[c], its deformed normal
+// QN[c] and the adjusting normals (smoothCornerAdjust); at edge sample k the deformed point E[k] and
+// normal EN[k]. Loops rather than calls written out: every call inlines a whole lattice evaluation,
+// and the kernels' compile time grows with their number. (One loop for both kinds, where the host asks
+// for rolled loops, saved Mesa 25.0 about 45 ms of deform_smooth's first dispatch but cost it 11 %
+// more deform instructions warm.)
+void smoothBoundarySamples(uint st, SubCorners C, out real3 Q[3], out real3 QN[3], out real3 adj[3], out real3 adjNbr[6],
+                           out real3 E[6], out real3 EN[6]) {
   uint creaseBits = smoothCreaseBits(st);
   for (uint c = 0u; c < 3u; ++c) {
-    real3 q, qn, ad, a0, a1;
-    smoothCornerSample(st, c, creaseBits, subCornerX(C, c), subCornerN(C, c), q, qn, ad, a0, a1);
-    Q[c] = q;
-    QN[c] = qn;
+    LatticeSample S = latticeEvaluate(params.lattice, subCornerX(C, c));
+    real3 ad, a0, a1;
+    smoothCornerAdjust(S, st, c, creaseBits, ad, a0, a1);
+    Q[c] = S.value;
+    QN[c] = snormalize(latticeCofactorNormal(S, subCornerN(C, c)));
     adj[c] = ad;
     adjNbr[2u * c] = a0;
     adjNbr[2u * c + 1u] = a1;
   }
-}
-
-// Step 2 on an edge: the sample at wa * a + wb * b.
-void smoothEdgeSample(real3 xa, real3 xb, real3 na, real3 nb, real wa, real wb, out real3 E, out real3 EN) {
-  P real3 x = xa * wa + xb * wb;
-  P real3 n = na * wa + nb * wb;
-  LatticeSample S = latticeEvaluate(params.lattice, x);
-  E = S.value;
-  EN = snormalize(latticeCofactorNormal(S, snormalize(n)));
-}
-
-// Step 2 on the edges: samples at one third from each end, E[2e] near corner e, E[2e+1] near e+1.
-void smoothEdgeSamples(SubCorners C, out real3 E[6], out real3 EN[6]) {
-  P real third = real(1) / real(3);
-  P real twoThirds = real(2) / real(3);
   for (uint k = 0u; k < 6u; ++k) {
-    uint e = k / 2u, b = e == 2u ? 0u : e + 1u;
-    P real wa = k % 2u == 0u ? twoThirds : third;
-    P real wb = k % 2u == 0u ? third : twoThirds;
     real3 x, n;
-    smoothEdgeSample(subCornerX(C, e), subCornerX(C, b), subCornerN(C, e), subCornerN(C, b), wa, wb, x, n);
-    E[k] = x;
-    EN[k] = n;
+    smoothEdgePoint(C, k, x, n);
+    LatticeSample S = latticeEvaluate(params.lattice, x);
+    E[k] = S.value;
+    EN[k] = snormalize(latticeCofactorNormal(S, n));
   }
 }
 
@@ -217,12 +241,21 @@ void smoothAdjust(uint creaseBits, real3 adj[3], real3 adjNbr[6], inout real3 cp
 void smoothTessellate(real3 cp[10], real3 ncp[10], uint L, uint tbase) {
   uint nv = (L + 1u) * (L + 2u) / 2u;
   uint lastRow = L * (L + 1u) / 2u;
-  for (uint c = 0u; c < sffdRolled(3u); ++c) {   // rolled: one copy of the stores (smoothSubCorners)
+  // The corners; where the host asks for rolled loops (prelude.glsl sffdRollsLoops), one store an
+  // iteration: position, then normal.
+  bool oneStore = sffdRollsLoops();
+  for (uint i = 0u; i < (oneStore ? sffdRolled(6u) : 3u); ++i) {
+    uint c = oneStore ? i / 2u : i;
     uint v = c == 0u ? 0u : (c == 1u ? lastRow : lastRow + L);
     real3 xc = c == 0u ? cp[0] : (c == 1u ? cp[6] : cp[9]);
     real3 nc = c == 0u ? ncp[0] : (c == 1u ? ncp[6] : ncp[9]);
-    tess(tbase + v) = real4(xc, 0);
-    tess(tbase + nv + v) = real4(snormalize(nc), 0);
+    if (!oneStore) {
+      tess(tbase + v) = real4(xc, 0);
+      tess(tbase + nv + v) = real4(snormalize(nc), 0);
+    } else {
+      bool normal = i % 2u == 1u;
+      tess(tbase + (normal ? nv : 0u) + v) = real4(normal ? snormalize(nc) : xc, 0);
+    }
   }
   // Edge a runs from corner a to a + 1: vertices (s, 0), (L, s), (L - s, L - s) for a = 0, 1, 2, s steps
   // from corner a; its cubic runs through corner a, the control points of slots 2a+1 and 2a+2 and corner

@@ -72,7 +72,7 @@ struct DeformTwin {
   }
   RVec3<Real> cofN(const LatticeSampleT<Real>& S, RVec3<Real> n) const { return snormalize(L.cofactorNormal(S, n)); }
 
-  // Steps 1, 2 and 4 at the corners (smoothCornerSamples).
+  // Steps 1, 2 and 4 at the corners (smoothBoundarySamples).
   void cornerSamples(size_t st, const Corners& C, RVec3<Real> Q[3], RVec3<Real> QN[3], RVec3<Real> adj[3],
                      RVec3<Real> adjNbr[6]) const {
     const uint32_t creaseBits = creaseBitsOf(st);
@@ -88,7 +88,7 @@ struct DeformTwin {
     }
   }
 
-  // Step 2 on the edges (smoothEdgeSamples): E[2e] a third from corner e, E[2e+1] a third from e+1.
+  // Step 2 on the edges (smoothBoundarySamples, smoothEdgePoint): E[2e] a third from corner e, E[2e+1] a third from e+1.
   void edgeSamples(const Corners& C, RVec3<Real> E[6], RVec3<Real> EN[6]) const {
     const Real third = Real(1) / Real(3), twoThirds = Real(2) / Real(3);
     for (int e = 0; e < 3; ++e) {

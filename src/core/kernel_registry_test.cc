@@ -64,3 +64,26 @@ TEST(KernelRegistry, DeformSmoothCompiledForItsUsualDispatch) {
     }
   }
 }
+
+// The kernels with two loop forms and no other assumption (cmake/Kernels.cmake): both forms compiled
+// ahead, neither with the specialization constant; other assumptions fall back to the general module.
+TEST(KernelRegistry, LoopFormsCompiledAhead) {
+  for (const char* name : {"pn_triangles", "clip_count", "clip_write"}) {
+    const EmbeddedKernel* k = findKernel(name);
+    ASSERT_NE(k, nullptr) << name;
+    for (int v = 0; v < 4; ++v) {
+      KernelVariant variant;
+      variant.strict = v % 2, variant.f64 = v / 2;
+      const std::span<const uint32_t> straight = spirvFor(*k, variant);
+      variant.assumptions = SFFD_ASSUME_ROLLED_LOOPS;
+      const std::span<const uint32_t> rolled = spirvFor(*k, variant);
+      ASSERT_FALSE(straight.empty()) << name;
+      ASSERT_FALSE(rolled.empty()) << name;
+      EXPECT_NE(straight.data(), k->spirv[v]) << name;
+      EXPECT_NE(rolled.data(), k->spirv[v]) << name;
+      EXPECT_NE(straight.data(), rolled.data()) << name;
+      variant.assumptions = SFFD_ASSUME_DEGREE2;
+      EXPECT_EQ(spirvFor(*k, variant).data(), k->spirv[v]) << name;
+    }
+  }
+}
