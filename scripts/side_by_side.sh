@@ -21,10 +21,10 @@ MESA25=("$PWD/scripts/mesa.sh" run --)
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 load() { echo "== load $(cut -d' ' -f1-3 /proc/loadavg)"; }
-run() {  # BUILD [PREFIX...] -- ARGS...: the build's sffd, its library first
+run() {  # BUILD [PREFIX...] :: ARGS...: the build's sffd (its library first) run by PREFIX
   local b=$1; shift
   local prefix=()
-  while [ "$1" != -- ]; do prefix+=("$1"); shift; done
+  while [ "$1" != :: ]; do prefix+=("$1"); shift; done
   shift
   LD_LIBRARY_PATH=$b "${prefix[@]}" "$b/sffd" "$@"
 }
@@ -34,14 +34,14 @@ for r in d["runs"]: print(sys.argv[1], r["backend"], " ".join("%s=%.2f" % (k, v[
 
 load
 for _ in 1 2; do for b in "$BASE" "$HEAD"; do
-  run "$b" -- bench "$T" -l "$L" "${A[@]}" --backends vulkan,gl,cpu --repeat 20 --json --quiet | python3 -c "$medians" "mesa-system $(basename "$b")"
+  run "$b" :: bench "$T" -l "$L" "${A[@]}" --backends vulkan,gl,cpu --repeat 20 --json --quiet | python3 -c "$medians" "mesa-system $(basename "$b")"
 done; done
 for _ in 1 2; do for b in "$BASE" "$HEAD"; do
-  run "$b" "${MESA25[@]}" -- bench "$T" -l "$L" "${A[@]}" --backends vulkan,gl --repeat 20 --json --quiet | python3 -c "$medians" "mesa-25.0 $(basename "$b")"
+  run "$b" "${MESA25[@]}" :: bench "$T" -l "$L" "${A[@]}" --backends vulkan,gl --repeat 20 --json --quiet | python3 -c "$medians" "mesa-25.0 $(basename "$b")"
 done; done
 load
 for _ in 1 2 3 4 5; do for b in "$BASE" "$HEAD"; do for backend in cpu vulkan gl; do
-  run "$b" /usr/bin/time -o "$tmp/time" -f "%e s %M KB" -- deform "$T" -l "$L" "${A[@]}" -o "$tmp/t.ply" --binary \
+  run "$b" /usr/bin/time -o "$tmp/time" -f "%e s %M KB" :: deform "$T" -l "$L" "${A[@]}" -o "$tmp/t.ply" --binary \
     --backend $backend --quiet --stats "$tmp/s.json"
   python3 -c 'import json,sys
 h=json.load(open(sys.argv[1]))["host_ms"]
@@ -51,7 +51,7 @@ done; done; done
 load
 for mesa in system 25.0; do for backend in vulkan gl; do for _ in 1 2; do for b in "$BASE" "$HEAD"; do
   prefix=(); [ $mesa = system ] || prefix=("${MESA25[@]}")
-  MESA_SHADER_CACHE_DISABLE=true SFFD_TRACE_COMPILE=1 run "$b" /usr/bin/time -o "$tmp/time" -f "%U %S" "${prefix[@]}" -- \
+  MESA_SHADER_CACHE_DISABLE=true SFFD_TRACE_COMPILE=1 run "$b" /usr/bin/time -o "$tmp/time" -f "%U %S" "${prefix[@]}" :: \
     bench "$T" -l "$L" "${A[@]}" --backends $backend --repeat 1 --warmup 0 --json --quiet > "$tmp/c.json" 2> "$tmp/c.err"
   python3 -c 'import json,sys
 r=json.load(open(sys.argv[1]))["runs"][0]; u,s=open(sys.argv[2]).read().split()
