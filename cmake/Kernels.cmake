@@ -53,8 +53,8 @@ target_compile_options(embed_kernels PRIVATE ${SFFD_WARNINGS})
 set(SFFD_SPECIALIZED_deform_smooth
     DEGREE2|LATTICE_IN_PARAMS|FIT_IN_PARAMS                 # degree 2, lattice and fit table in the parameter block
     DEGREE2|LATTICE_IN_PARAMS|FIT_IN_PARAMS|ROLLED_LOOPS)   # the same on llvmpipe of Mesa 23 on (forDevice)
-# The kernels before it have two loop forms (prelude.glsl sffdRollsLoops) and no other assumption: both
-# compiled ahead (NONE: no bit), so that the form a driver does not use is not in its SPIR-V at all.
+# The pre-compute's kernels have two loop forms (prelude.glsl sffdRollsLoops) and no other assumption:
+# both compiled ahead (NONE: no bit), so that the form a driver does not use is not in its SPIR-V at all.
 # With the choice left to the specialization constant, lavapipe 22.3 ran clip_write's straight form
 # 9 to 25 % slower than the same code compiled alone (callgrind), and translated both forms.
 set(SFFD_SPECIALIZED_pn_triangles NONE ROLLED_LOOPS)
