@@ -47,9 +47,8 @@ add_executable(embed_kernels ${PROJECT_SOURCE_DIR}/tools/embed_kernels.cpp)
 target_compile_options(embed_kernels PRIVATE ${SFFD_WARNINGS})
 
 # Kernels also compiled for their most common dispatches, the assumptions (layout.h SFFD_ASSUME_*, named
-# without the prefix) a constant as on GL rather than the specialization constant: lavapipe translates a
-# pipeline's SPIR-V in every process, and deform_smooth's general form, every lattice case in it, takes
-# 75-110 ms there, the degree-2 one 30-50 (docs/PERFORMANCE.md, "SPIR-V made for the usual dispatch").
+# without the prefix) a constant as on GL rather than the specialization constant, so that the module
+# lavapipe translates (above) holds that case only.
 set(SFFD_SPECIALIZED_deform_smooth
     DEGREE2|LATTICE_IN_PARAMS|FIT_IN_PARAMS                 # degree 2, lattice and fit table in the parameter block
     DEGREE2|LATTICE_IN_PARAMS|FIT_IN_PARAMS|ROLLED_LOOPS)   # the same on llvmpipe of Mesa 23 on (forDevice)
