@@ -41,7 +41,8 @@ set(SFFD_KERNEL_DIR ${PROJECT_SOURCE_DIR}/kernels)
 set(SFFD_SPV_DIR ${PROJECT_BINARY_DIR}/spv)
 set(SFFD_GLES_DIR ${PROJECT_BINARY_DIR}/gles)
 file(MAKE_DIRECTORY ${SFFD_SPV_DIR} ${SFFD_GLES_DIR})
-file(GLOB SFFD_KERNEL_INCLUDES CONFIGURE_DEPENDS ${SFFD_KERNEL_DIR}/*/*.glsl ${SFFD_KERNEL_DIR}/common/layout.h)
+file(GLOB SFFD_KERNEL_INCLUDES CONFIGURE_DEPENDS ${SFFD_KERNEL_DIR}/*/*.glsl ${SFFD_KERNEL_DIR}/common/layout.h
+     ${SFFD_KERNEL_DIR}/common/correctly_rounded.h)
 
 add_executable(embed_kernels ${PROJECT_SOURCE_DIR}/tools/embed_kernels.cpp)
 target_compile_options(embed_kernels PRIVATE ${SFFD_WARNINGS})

@@ -40,9 +40,9 @@ layout(std430, SFFD_SET binding = SFFD_BINDING_ACC_SCRATCH) buffer AccScratch { 
 // variant): on a shared edge one weight is 0 and the sum of the other two terms is the same bits from
 // both sides only without contraction into fma.
 real3 accFlatPoint(real3 c0, real3 c1, real3 c2, uint i, uint j, uint k, uint d) {
-  SFFD_PRECISE real l0 = real(i) / real(d);
-  SFFD_PRECISE real l1 = real(j) / real(d);
-  SFFD_PRECISE real l2 = real(k) / real(d);
+  SFFD_PRECISE real l0 = sdiv(real(i), real(d));
+  SFFD_PRECISE real l1 = sdiv(real(j), real(d));
+  SFFD_PRECISE real l2 = sdiv(real(k), real(d));
   SFFD_PRECISE real3 r = (c0 * l0 + c1 * l1) + c2 * l2;
   return r;
 }

@@ -74,8 +74,8 @@ ClipSetup clipSetupOf(uvec4 welds, real3 corner[3]) {
     uint a = e, b = (e + 1u) % 3u;
     if (welds[b] < welds[a]) { uint x = a; a = b; b = x; }
     P real3 d = corner[b] - corner[a];
-    P real len = sqrt(sdot(d, d));
-    P real q = len / real(params.target.x);
+    P real len = ssqrt(sdot(d, d));
+    P real q = sdiv(len, real(params.target.x));
     real segs = ceil(q);
     n[e] = uint(clamp(segs, real(1), real(nmax)));
   }
@@ -223,7 +223,8 @@ SiteValue evaluateSite(Parent p, Site s) {
     r.xpn = pnEdgeCurve(vLo, slotCp(p, slotOf(lo, e)), slotCp(p, slotOf(hi, e)), vHi, t);
     P real3 xf = vLo + (vHi - vLo) * t;
     r.xflat = xf;
-    r.nlin = snormalize(nLo * u + nHi * t);
+    P real3 nl = nLo * u + nHi * t;
+    r.nlin = snormalize(nl);
     r.npn = pnEdgeNormalCurve(nLo, edgeNormalCp(p, e), nHi, t);
   } else {
     P real3 l = s.lam;

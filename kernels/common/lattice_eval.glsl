@@ -146,7 +146,8 @@ void latticeAxis(uint first, uint n, real p, inout bool inside, out uint span, o
   span = latticeSpan(first, n, p);
   real k0 = latticeFrameAt(first + span), k1 = latticeFrameAt(first + span + 1u);
   P real hh = k1 - k0;
-  P real sa = (p - k0) / hh;
+  P real pk = p - k0;
+  P real sa = sdiv(pk, hh);
   s = sa;
   h = hh;
 }

@@ -80,6 +80,8 @@
 #define SFFD_ASSUME_FIT_IN_PARAMS 16u      // DeformParams.inline_lattice holds the fit table
 #define SFFD_ASSUME_FIT_IN_STORAGE 32u     // the lattice frame range holds it
 #define SFFD_ASSUME_ROLLED_LOOPS 64u       // keep the loops bounded by sffdRolled() rolled (prelude.glsl)
+#define SFFD_ASSUME_LOOSE_DIVISION 128u    // strict kernels: the driver's a / b and sqrt may miss the correctly
+                                           // rounded result, so round them (correctly_rounded.h)
 
 // The lattice part of every parameter block.
 SFFD_STRUCT_BEGIN(LatticeParams)

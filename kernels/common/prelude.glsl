@@ -1,7 +1,8 @@
 // kernels/common/prelude.glsl: included first by every kernel.
 // Maps the layout words of layout.h onto GLSL and selects the arithmetic variant:
 //   SFFD_STRICT 0 (fast): built-in dot/cross/normalize, the compiler may fuse and reorder.
-//   SFFD_STRICT 1 (strict): every operation `precise`, no fma, hand-written dot/cross/normalize in a
+//   SFFD_STRICT 1 (strict): every operation `precise`, no fma, a / b and sqrt correctly rounded
+//   (correctly_rounded.h), hand-written dot/cross/normalize in a
 //   fixed order, so GL, Vulkan and the C++ reference built with -ffp-contract=off agree bit for bit
 //   (see docs/ARCHITECTURE.md, "Strict kernels").
 #ifndef SFFD_PRELUDE_GLSL
@@ -106,6 +107,20 @@ const bool sffdRollsLoopsHere = (sffdAssumptions & SFFD_ASSUME_ROLLED_LOOPS) != 
 #define sffdRollsLoops() sffdRollsLoopsHere
 
 #if SFFD_STRICT
+#include "correctly_rounded.h"
+// a / b and sqrt(x) correctly rounded on every driver, as the C++ twin computes them (the header says why).
+// Drivers known to round exactly (forDevice) skip the fix-up, which costs lavapipe 3 to 4 times the
+// strict kernels' time.
+const bool sffdLooseDivision = (sffdAssumptions & SFFD_ASSUME_LOOSE_DIVISION) != 0u;
+real sdiv(real a, real b) {
+  P real q = a / b;
+  return sffdLooseDivision ? sffdRoundedQuotient(a, b, q) : q;
+}
+real3 sdiv(real3 v, real s) { return real3(sdiv(v.x, s), sdiv(v.y, s), sdiv(v.z, s)); }
+real ssqrt(real x) {
+  P real s = sqrt(x);
+  return sffdLooseDivision ? sffdRoundedRoot(x, s) : s;
+}
 real sdot(real3 a, real3 b) {
   P real xy = a.x * b.x + a.y * b.y;
   P real r = xy + a.z * b.z;
@@ -116,11 +131,14 @@ real3 scross(real3 a, real3 b) {
   return r;
 }
 real3 snormalize(real3 v) {
-  P real len = sqrt(sdot(v, v));
-  P real3 r = v / len;
+  P real len = ssqrt(sdot(v, v));
+  P real3 r = sdiv(v, len);
   return r;
 }
 #else
+real sdiv(real a, real b) { return a / b; }
+real3 sdiv(real3 v, real s) { return v / s; }
+real ssqrt(real x) { return sqrt(x); }
 real sdot(real3 a, real3 b) { return dot(a, b); }
 real3 scross(real3 a, real3 b) { return cross(a, b); }
 real3 snormalize(real3 v) { return normalize(v); }

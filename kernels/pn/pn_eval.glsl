@@ -20,13 +20,14 @@ real3 pnEdgePoint(real3 Vc, real3 Vo, real4 nFirst, real3 nSecond) {
     P real3 c = scross(nFirst.xyz, nSecond);
     P real len2 = sdot(c, c);
     if (len2 > real(1e-12)) {
-      P real3 t = c / sqrt(len2);
-      P real3 r = Vc + t * (sdot(d, t) / real(3));
+      P real3 t = sdiv(c, ssqrt(len2));
+      P real3 r = Vc + t * sdiv(sdot(d, t), real(3));
       return r;
     }
   }
   P real3 n = nFirst.xyz;
-  P real3 r = ((Vc + Vc) + Vo - n * sdot(d, n)) / real(3);
+  P real3 sum = (Vc + Vc) + Vo - n * sdot(d, n);
+  P real3 r = sdiv(sum, real(3));
   return r;
 }
 
@@ -38,12 +39,13 @@ real3 pnEdgeNormal(real3 Pi, real3 Pj, real3 Ni, real3 Nj) {
   P real dd = sdot(d, d);
   P real3 r = s;
   if (dd > real(0)) {
-    P real k = real(2) * sdot(d, s) / dd;
+    P real ds2 = real(2) * sdot(d, s);
+    P real k = sdiv(ds2, dd);
     r = s - d * k;
   }
   P real len2 = sdot(r, r);
   if (!(len2 > real(0))) return Ni;
-  P real3 n = r / sqrt(len2);
+  P real3 n = sdiv(r, ssqrt(len2));
   return n;
 }
 

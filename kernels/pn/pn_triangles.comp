@@ -50,8 +50,9 @@ void main() {
     b[5] = e;
     edgeSum = edgeSum + e;
   }
-  P real3 E = edgeSum / real(6);
-  P real3 Vm = ((V0 + V1) + V2) / real(3);
+  P real3 E = sdiv(edgeSum, real(6));
+  P real3 V3 = (V0 + V1) + V2;
+  P real3 Vm = sdiv(V3, real(3));
   P real3 centre = E + (E - Vm) / real(2);
   // Each edge's middle normal control point, computed in weld-id order: edges (0,1) -> 110, (1,2) -> 011, (2,0) -> 101.
   real3 en[3];

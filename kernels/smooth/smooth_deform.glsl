@@ -52,7 +52,8 @@ bool lexLess(real3 a, real3 b) {
 
 // (-5 q0 + 18 q1 - 9 q2 + 2 q3) / 6: the cubic through q0..q3 at 0, 1/3, 2/3, 1, control point near q0.
 real3 nearControlPoint(real3 q0, real3 q1, real3 q2, real3 q3) {
-  P real3 r = (((q0 * real(-5) + q1 * real(18)) + q2 * real(-9)) + q3 * real(2)) / real(6);
+  P real3 sum = ((q0 * real(-5) + q1 * real(18)) + q2 * real(-9)) + q3 * real(2);
+  P real3 r = sdiv(sum, real(6));
   return r;
 }
 
@@ -123,8 +124,8 @@ real3 subCornerN(SubCorners C, uint c) { return c == 0u ? C.n0 : (c == 1u ? C.n1
 // Edge sample k (E[2e] a third from corner e, E[2e+1] a third from e+1): its point and its normal
 // before the deformation.
 void smoothEdgePoint(SubCorners C, uint k, out real3 x, out real3 n) {
-  P real third = real(1) / real(3);
-  P real twoThirds = real(2) / real(3);
+  P real third = sdiv(real(1), real(3));
+  P real twoThirds = sdiv(real(2), real(3));
   uint e = k / 2u, b = e == 2u ? 0u : e + 1u;
   P real wa = k % 2u == 0u ? twoThirds : third;
   P real wb = k % 2u == 0u ? third : twoThirds;
@@ -217,7 +218,7 @@ void smoothAdjust(uint creaseBits, real3 adj[3], real3 adjNbr[6], inout real3 cp
       P real3 cr = scross(n1, n2);
       P real len2 = sdot(cr, cr);
       if (len2 > real(1e-12)) {
-        P real3 t = cr / sqrt(len2);
+        P real3 t = sdiv(cr, ssqrt(len2));
         b = X + t * sdot(d, t);
         adjusted = true;
       }
@@ -227,7 +228,7 @@ void smoothAdjust(uint creaseBits, real3 adj[3], real3 adjNbr[6], inout real3 cp
   }
   P real3 edgeSum = ((((cp[1] + cp[2]) + cp[3]) + cp[5]) + cp[7]) + cp[8];
   P real3 cornerSum = (cp[0] + cp[6]) + cp[9];
-  P real3 centre = edgeSum / real(4) - cornerSum / real(6);
+  P real3 centre = edgeSum / real(4) - sdiv(cornerSum, real(6));
   cp[4] = centre;
 }
 
@@ -279,7 +280,7 @@ void smoothTessellate(real3 cp[10], real3 ncp[10], uint L, uint tbase) {
       uint t = a == 0u ? 0u : (a == 1u ? s : L - s);
       uint v = r * (r + 1u) / 2u + t;
       uint steps = reversed ? L - s : s;
-      P real u = real(steps) / real(L);
+      P real u = sdiv(real(steps), real(L));
       tess(tbase + v) = real4(pnEdgeCurve(e0, e1, e2, e3, u), 0);
       tess(tbase + nv + v) = real4(snormalize(pnEdgeCurve(f0, f1, f2, f3, u)), 0);
     }
@@ -287,7 +288,7 @@ void smoothTessellate(real3 cp[10], real3 ncp[10], uint L, uint tbase) {
   for (uint r = 2u; r < L; ++r)
     for (uint t = 1u; t < r; ++t) {
       uint v = r * (r + 1u) / 2u + t;
-      P real3 lam = real3(real(L - r), real(r - t), real(t)) / real(L);
+      P real3 lam = sdiv(real3(real(L - r), real(r - t), real(t)), real(L));
       real w[10];
       pnCubicWeights(lam, w);
       P real3 xs = real3(0), ns = real3(0);

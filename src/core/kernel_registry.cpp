@@ -58,7 +58,13 @@ KernelVariant forLattice(KernelVariant v, const gpu::DeformParams& params) {
 }
 
 KernelVariant forDevice(KernelVariant v, const DeviceInfo& device) {
-  if (device.name.find("llvmpipe") == std::string::npos) return v;
+  const bool llvmpipe = device.name.find("llvmpipe") != std::string::npos;
+  if (v.strict) {
+    const char* rounding = std::getenv("SFFD_STRICT_ROUNDING");
+    const std::string_view r = rounding ? rounding : "";
+    if (r == "fixup" || (r != "driver" && !llvmpipe)) v.assumptions |= SFFD_ASSUME_LOOSE_DIVISION;
+  }
+  if (!llvmpipe) return v;
   const size_t at = device.driver.find("Mesa ");
   if (at != std::string::npos && std::atoi(device.driver.c_str() + at + 5) >= 23) v.assumptions |= SFFD_ASSUME_ROLLED_LOOPS;
   return v;
