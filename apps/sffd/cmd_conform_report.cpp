@@ -47,6 +47,9 @@ CompareTolerance toleranceFor(const Case& c, const std::string& buffer, bool wit
   // The accurate control points solve A_n^{-1} S: the samples' rounding grows by up to |A_n^{-1}|_inf
   // (412 for n = 7), which the tessellated values do not see.
   if (buffer == "accurate.patches" && !c.f64()) t.absOfScale = 1e-4;
+  // The smooth patches fit 19 samples by least squares, which amplifies their rounding less, but beyond
+  // 2e-6 with a driver that fuses multiply-adds: NVIDIA's (H200, driver 580) reached 2.2e-6 of the scale.
+  if (buffer == "deform.patches" && !c.f64()) t.absOfScale = 1e-5;
   return t;
 }
 
