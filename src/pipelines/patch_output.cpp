@@ -83,6 +83,17 @@ bool sameBits(const double* a, const double* b) {
   return same;
 }
 
+// Whether two unit normals at one location are one vertex's: the same bits, or apart by rounding alone.
+// The kernels give a shared point's normal the same bits from both patches where they run in a fixed
+// order (strict, and the CPU and Mesa's drivers in fast mode too); a GPU that fuses multiply-adds can
+// differ by an ulp or two from one patch to the next, which must not split a smooth surface's vertex.
+// Creases, the splits that matter, part normals by degrees.
+bool sameNormal(const double* a, const double* b) {
+  if (sameBits<3>(a, b)) return true;
+  constexpr double kRounding = 1e-6;
+  return std::abs(a[0] - b[0]) <= kRounding && std::abs(a[1] - b[1]) <= kRounding && std::abs(a[2] - b[2]) <= kRounding;
+}
+
 struct Key3Hash {
   size_t operator()(const std::array<uint64_t, 3>& k) const {
     uint64_t h = k[0] * 0x9E3779B97F4A7C15ull;
@@ -269,7 +280,7 @@ struct PatchWelder::Impl {
     const int nv = tessVertexCount(level);
     const bool uv = !P.texcoord.empty(), rgba = !P.color.empty();
     auto sameVertex = [&](uint32_t i, size_t g) {
-      return sameBits<3>(&m.normals[i][0], &P.normal[3 * g]) && (!uv || sameBits<2>(&m.texcoords[i][0], &P.texcoord[2 * g])) &&
+      return sameNormal(&m.normals[i][0], &P.normal[3 * g]) && (!uv || sameBits<2>(&m.texcoords[i][0], &P.texcoord[2 * g])) &&
              (!rgba || sameBits<4>(&m.colors[i][0], &P.color[4 * g]));
     };
     auto newVertex = [&](size_t g, uint32_t loc) {

@@ -65,7 +65,8 @@ void carryPatchAttributes(PatchVertices& patches, const Mesh& input);
 // for every triangle on that edge (also a non-manifold fin, whose sheets bend the edge each its own
 // way), a point inside a parent one location for its sub-triangles. Each location has one position,
 // that of the patch of the lowest parent there, so the output is closed where the input is, and one
-// vertex per distinct normal, texture coordinate and colour bits (creases and seams split vertices,
+// vertex per distinct normal (apart by more than rounding, 1e-6), texture coordinate and colour bits
+// (creases and seams split vertices,
 // never positions); its vertices share a weldId, the location's index (Mesh::weldIdIsLocation, so the
 // writers keep locations that round to one position apart). A triangle with two corners at
 // one location (of a degenerate patch) is dropped. The carried fields become the Mesh's.

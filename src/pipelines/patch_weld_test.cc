@@ -278,6 +278,24 @@ class PatchWeldOf : public ::testing::TestWithParam<Method> {};
 INSTANTIATE_TEST_SUITE_P(Methods, PatchWeldOf, ::testing::Values(Method::Smooth, Method::Accurate),
                          [](const ::testing::TestParamInfo<Method>& m) { return m.param == Method::Smooth ? "smooth" : "accurate"; });
 
+// A GPU that fuses multiply-adds gives a shared point's normal from two patches a few ulps apart: one
+// vertex still; normals apart by more than rounding (a crease's) are two.
+TEST_P(PatchWeldOf, NormalsApartByRoundingAreOneVertex) {
+  const TwistedSphere t = twistedSphere(GetParam());
+  const size_t nv = size_t(tessVertexCount(t.P.level));
+  auto nudged = [&](double by) {
+    PatchVertices P = t.P;
+    for (size_t p = 1; p < P.patchCount(); p += 2)
+      for (size_t i = 3 * nv * p; i < 3 * nv * (p + 1); ++i) P.normal[i] += by * (i % 3 == 0 ? 1 : -1);
+    return weldPatchVertices(P);
+  };
+  const Mesh ulps = nudged(2.4e-7), apart = nudged(1e-3);   // 2 float ulps of 1; far beyond rounding
+  EXPECT_EQ(ulps.normals.size(), t.whole.normals.size());
+  EXPECT_EQ(ulps.triangles, t.whole.triangles);
+  EXPECT_GT(apart.normals.size(), t.whole.normals.size());
+  EXPECT_EQ(apart.positions.size(), apart.normals.size());
+}
+
 // The results weld the downloaded patches in slices (PatchWelder): the same mesh as all of them welded
 // at once, whatever the slices.
 TEST_P(PatchWeldOf, SlicesWeldAsOne) {
