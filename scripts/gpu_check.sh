@@ -10,6 +10,7 @@
 #   teapot (first process: cold; then warm, fast and strict); five whole `deform --binary` runs per
 #   backend; strict outputs of every backend cmp'ed with the CPU's (smooth, accurate; float, double);
 #   a 1,000,000-triangle mesh at level 3 per backend (wall, peak RSS); the gtest binaries.
+# STEPS="conform bench whole strict big tests" (the default) picks steps.
 set -uo pipefail
 cd "$(dirname "$0")/.."
 [ $# -ge 1 ] || { echo "usage: scripts/gpu_check.sh OUT_DIR [DUMP_DIR]" >&2; exit 2; }
@@ -23,6 +24,8 @@ W=$(mktemp -d)
 trap 'rm -rf "$W"' EXIT
 export SFFD_DEVICE_TIMEOUT=${SFFD_DEVICE_TIMEOUT:-120}
 t0=$(date +%s)
+STEPS=" ${STEPS:-conform bench whole strict big tests} "
+want() { [[ $STEPS == *" $1 "* ]]; }
 step() { echo "== [$(( $(date +%s) - t0 )) s] $*"; }
 medians() {  # JSON files of `sffd bench --json`: one line per run
   python3 - "$@" <<'PY'
@@ -39,6 +42,7 @@ step devices
 { command -v nvidia-smi > /dev/null && nvidia-smi --query-gpu=name,driver_version --format=csv,noheader; "$S" devices; } | tee "$OUT/devices.txt"
 "$S" devices --json > "$OUT/devices.json"
 
+if want conform; then
 step "conform --cases default"
 timeout 300 "$S" conform --cases default --backends vulkan,gl-egl,gles,cpu --require vulkan,gl-egl \
   --json "$OUT/conform.json" > "$OUT/conform.log" 2>&1
@@ -50,7 +54,9 @@ if [ -n "$DUMP" ]; then
   echo "against $DUMP: exit $?; strict comparisons not at 0 ulp: $(grep strict "$OUT/conform_against.log" | grep -vc ' max_ulp=0 ')"
   grep -E "Fail|Skip|Timeout|Crash" "$OUT/conform_against.log" | cut -c1-240
 fi
+fi
 
+if want bench; then
 step "bench (the first process finds the driver's shader cache as the machine left it)"
 timeout 200 "$S" bench "$T" -l "$L" "${A[@]}" --backends vulkan,gl --repeat 20 --json > "$OUT/bench_first.json" 2> "$W/err" || tail -3 "$W/err"
 for m in fast strict; do
@@ -58,7 +64,9 @@ for m in fast strict; do
   timeout 200 "$S" bench "$T" -l "$L" "${A[@]}" --backends vulkan,gl,cpu --repeat 50 "${flag[@]}" --json > "$OUT/bench_$m.json" 2> "$W/err" || tail -3 "$W/err"
 done
 medians "$OUT"/bench_first.json "$OUT"/bench_fast.json "$OUT"/bench_strict.json
+fi
 
+want whole && {
 step "whole deform --binary of the teapot, five runs per backend (ms)"
 for b in cpu vulkan gl; do
   ms=()
@@ -69,7 +77,9 @@ for b in cpu vulkan gl; do
   done
   echo "$b: ${ms[*]}; host phases of the last: $(python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['host_ms'])" "$OUT/whole_$b.json")"
 done
+}
 
+want strict && {
 step "strict outputs against the CPU's"
 for method in smooth accurate; do
   for p in float double; do
@@ -85,7 +95,9 @@ for method in smooth accurate; do
     done
   done
 done | tee "$OUT/strict_files.txt"
+}
 
+want big && {
 step "1,000,000 triangles at level 3"
 python3 tools/make_big_mesh.py --triangles 1000000 "$W/big.ply" > /dev/null
 "$S" lattice "$W/big.ply" -o "$W/big.json" --preset twist:0.3 --quiet
@@ -99,13 +111,14 @@ print("%s: exit %d, wall %.1f s, peak RSS %.0f MiB" % (sys.argv[1], rc, time.tim
 PY
 done | tee "$OUT/big.txt"
 rm -f "$W"/big*
+}
 
-if [ -n "${TESTS:-}" ]; then
+if [ -n "${TESTS:-}" ] && want tests; then
   step "gtest binaries of $TESTS"
   for t in "$TESTS"/sffd_*_tests; do
     n=$(basename "$t")
     [ "$n" = sffd_view_tests ] && [ -z "${DISPLAY:-}" ] && continue
-    (cd "$(dirname "$t")" && timeout 400 "$t" > "$OUT/$n.log" 2>&1; echo "exit $?" >> "$OUT/$n.log") &
+    (cd "$(dirname "$t")" && timeout "${TEST_TIMEOUT:-400}" "$t" > "$OUT/$n.log" 2>&1; echo "exit $?" >> "$OUT/$n.log") &
   done
   wait
   for f in "$OUT"/sffd_*_tests.log; do
