@@ -17,6 +17,9 @@
 #ifndef SFFD_CR_INLINE
 #define SFFD_CR_INLINE
 #endif
+#ifndef SFFD_CR_PRECISE
+#define SFFD_CR_PRECISE SFFD_PRECISE
+#endif
 
 // Whether m * 2^d > M for a significand m (< 2^24) and a 64-bit M (hi, lo) >= 2^47.
 SFFD_CR_INLINE bool sffdShiftedAbove(uint m, int d, uint hi, uint lo) {
@@ -141,10 +144,20 @@ SFFD_CR_INLINE bool sffdRootAbove64(uvec2 ux, uvec2 m) {
   return sffdShiftedAbove64(sffdSignificand64(ux), sffdExponent64(ux) - 2 * sffdExponent64(m) + 1077, sffdMul64(s2, s2));
 }
 
+// A driver may divide doubles no better than floats (NVIDIA's GL seemed to, 2^29 ulp): two Newton steps
+// take such a q to within an ulp or two before the check (r = a - q b is within half an ulp of a).
 SFFD_CR_INLINE double sffdRoundedQuotient(double a, double b, double q) {
-  uvec2 ua = unpackDouble2x32(a), ub = unpackDouble2x32(b), uq = unpackDouble2x32(q);
-  int ea = sffdExponent64(ua), eb = sffdExponent64(ub), eq = sffdExponent64(uq);
-  if (ea == 0 || ea == 2047 || eb == 0 || eb == 2047 || eq < 2 || eq > 2045) return q;
+  uvec2 ua = unpackDouble2x32(a), ub = unpackDouble2x32(b);
+  int ea = sffdExponent64(ua), eb = sffdExponent64(ub);
+  if (ea == 0 || ea == 2047 || eb == 0 || eb == 2047) return q;
+  for (int i = 0; i < 2; ++i) {
+    SFFD_CR_PRECISE double r = a - q * b;
+    SFFD_CR_PRECISE double n = q + r / b;
+    q = n;
+  }
+  uvec2 uq = unpackDouble2x32(q);
+  int eq = sffdExponent64(uq);
+  if (eq < 2 || eq > 2045) return q;
   uvec2 m = uvec2(uq.x, uq.y & 0x7fffffffu);
   for (int i = 0; i < 4; ++i) {
     if (sffdQuotientAbove64(ua, ub, m)) m = sffdNext64(m);
@@ -155,9 +168,16 @@ SFFD_CR_INLINE double sffdRoundedQuotient(double a, double b, double q) {
 }
 
 SFFD_CR_INLINE double sffdRoundedRoot(double x, double s) {
-  uvec2 ux = unpackDouble2x32(x), us = unpackDouble2x32(s);
+  uvec2 ux = unpackDouble2x32(x);
+  if (ux.y >= 0x7ff00000u || ux.y < 0x00100000u || !(s > 0.0)) return s;
+  for (int i = 0; i < 2; ++i) {
+    SFFD_CR_PRECISE double r = x - s * s;
+    SFFD_CR_PRECISE double n = s + r / (s + s);
+    s = n;
+  }
+  uvec2 us = unpackDouble2x32(s);
   int es = sffdExponent64(us);
-  if (ux.y >= 0x7ff00000u || ux.y < 0x00100000u || us.y >= 0x80000000u || es < 2 || es > 2045) return s;
+  if (us.y >= 0x80000000u || es < 2 || es > 2045) return s;
   uvec2 m = us;
   for (int i = 0; i < 4; ++i) {
     if (sffdRootAbove64(ux, m)) m = sffdNext64(m);

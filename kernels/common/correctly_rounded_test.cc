@@ -64,6 +64,16 @@ TEST(CorrectlyRounded, DoubleQuotientsFromApproximations) { checkQuotients<doubl
 TEST(CorrectlyRounded, FloatRootsFromApproximations) { checkRoots<float>(200000); }
 TEST(CorrectlyRounded, DoubleRootsFromApproximations) { checkRoots<double>(100000); }
 
+// A double quotient or root no better than a float's, as a driver may give it, is still rounded right.
+TEST(CorrectlyRounded, DoublesFromFloatPrecision) {
+  std::mt19937_64 rng(91);
+  for (int i = 0; i < 100000; ++i) {
+    double a = randomValue<double>(rng), b = randomValue<double>(rng), x = std::abs(a);
+    ASSERT_EQ(bits(sffdRoundedQuotient(a, b, double(float(a / b)))), bits(a / b)) << a << " / " << b;
+    ASSERT_EQ(bits(sffdRoundedRoot(x, double(float(std::sqrt(x))))), bits(std::sqrt(x))) << "sqrt " << x;
+  }
+}
+
 // Exact results at binade edges, approached from below (the neighbour below has half the ulp).
 TEST(CorrectlyRounded, ExactPowersOfTwoFromBelow) {
   for (float p : {0.25f, 1.0f, 2.0f, 1024.0f}) {

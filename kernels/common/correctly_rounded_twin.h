@@ -25,6 +25,8 @@ inline uint uaddCarry(uint a, uint b, uint& carry) {
   return a + b;
 }
 #define SFFD_CR_INLINE inline
+#define SFFD_CR_PRECISE   // the project builds with -ffp-contract=off
 #include "correctly_rounded.h"
 #undef SFFD_CR_INLINE
+#undef SFFD_CR_PRECISE
 }  // namespace sffd::kernels::rounded
