@@ -66,6 +66,10 @@ inline std::vector<std::string> backendsHere(const std::vector<std::string>& nam
   return kept;
 }
 
+// Skips the test when this machine cannot open backend `name` (and does not require it).
+#define SFFD_SKIP_WITHOUT(name) \
+  if (sffd::testing::backendsHere({name}).empty()) GTEST_SKIP() << name << " cannot be opened here"
+
 // Declares `var`, the backend `name` opened for a test, or skips the test when this machine has none.
 #define SFFD_OPEN_OR_SKIP(var, name)                                                                      \
   std::string var##Why_;                                                                                 \
