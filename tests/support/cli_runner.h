@@ -10,6 +10,8 @@
 #include <sstream>
 #include <string>
 
+#include "backends/backend_test_support.h"
+
 namespace sffd::test {
 
 namespace fs = std::filesystem;
@@ -55,6 +57,15 @@ inline RunResult runSffd(const std::string& args, const std::string& env = "") {
   fs::remove_all(dir);
   return r;
 }
+
+// Whether `sffd devices` lists a backend of that name here (asked once a process).
+inline bool hasDevice(const std::string& backend) {
+  static const std::string listed = "\n" + runSffd("devices").out;
+  return listed.find("\n" + backend + " ") != std::string::npos;
+}
+
+// Whether a test may run on backend `name`: this machine has it, or must have it (then its absence fails).
+inline bool usable(const std::string& backend) { return hasDevice(backend) || sffd::testing::requiredHere(backend); }
 
 // An axis-aligned box as OBJ with one normal per face: 8 positions, 12 triangles, every edge a crease.
 inline void writeBoxObj(const fs::path& path, double cx, double cy, double cz, double half) {
