@@ -71,10 +71,10 @@ inline std::vector<std::string> backendsHere(const std::vector<std::string>& nam
   if (sffd::testing::backendsHere({name}).empty()) GTEST_SKIP() << name << " cannot be opened here"
 
 // Declares `var`, the backend `name` opened for a test, or skips the test when this machine has none.
-#define SFFD_OPEN_OR_SKIP(var, name)                                                                      \
-  std::string var##Why_;                                                                                 \
+#define SFFD_OPEN_OR_SKIP(var, name)                                                                \
+  std::string var##Why_;                                                                            \
   auto var##Opened_ = sffd::testing::openUnlessAbsent(name, sffd::testing::openForTest, var##Why_); \
-  if (!var##Opened_) GTEST_SKIP() << var##Why_;                                                          \
+  if (!var##Opened_) GTEST_SKIP() << var##Why_;                                                     \
   OpenedBackend var = std::move(*var##Opened_)
 
 // The CPU backend, shared by a test program's tests: the reference the other backends are compared with.

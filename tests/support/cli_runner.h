@@ -40,14 +40,18 @@ inline fs::path tempDir(const std::string& name) {
 // the device timeout (60 s), so that a hung driver fails its test instead of waiting forever.
 constexpr int kRunTimeoutSeconds = 600;
 
+// The shell command line `command` ("VAR=value ... PROGRAM ARGS") bounded by kRunTimeoutSeconds.
+inline std::string bounded(const std::string& command) {
+  return "timeout -k 10 " + std::to_string(kRunTimeoutSeconds) + " env " + command;
+}
+
 // Runs the sffd binary (SFFD_BINARY) with arguments shell-quoted by the caller, after an optional
 // environment prefix ("VAR=value ...", or a command that runs the rest, such as "env -u DISPLAY").
 inline RunResult runSffd(const std::string& args, const std::string& env = "") {
   static int serial = 0;
   fs::path dir = tempDir("run" + std::to_string(serial++));
   const std::string outFile = (dir / "stdout").string(), errFile = (dir / "stderr").string();
-  const std::string cmd = "timeout -k 10 " + std::to_string(kRunTimeoutSeconds) + " env " + env + " " + SFFD_BINARY +
-                          " " + args + " >" + outFile + " 2>" + errFile;
+  const std::string cmd = bounded(env + " " + SFFD_BINARY + " " + args) + " >" + outFile + " 2>" + errFile;
   const int raw = std::system(cmd.c_str());
   RunResult r;
   r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : 128;
