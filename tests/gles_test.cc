@@ -12,7 +12,7 @@ namespace {
 class Gles : public ::testing::Test {
  protected:
   void SetUp() override {
-    if (runSffd("devices").out.find("gles ") == std::string::npos) GTEST_SKIP() << "no gles device here";
+    if (!hasDevice("gles")) GTEST_SKIP() << "no gles device here";
     dir = tempDir("gles");
     mesh = std::string(SFFD_TEST_DATA) + "/sphere.obj";
     lattice = std::string(SFFD_TEST_DATA) + "/lattices/sphere_twist.npy";

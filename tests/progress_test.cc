@@ -34,7 +34,7 @@ TEST(Progress, OneLineRedrawnAndErasedOnATerminal) {
   const fs::path log = dir / "tty.txt";
   // script(1) runs the command on a pseudo-terminal and copies what it wrote there to stdout.
   for (const char* quiet : {"", " --quiet"}) {
-    const std::string cmd = "script -qec '" + std::string(SFFD_BINARY) + " " + longJob(dir) + quiet + "' /dev/null > " + log.string();
+    const std::string cmd = bounded("script -qec '" + std::string(SFFD_BINARY) + " " + longJob(dir) + quiet + "' /dev/null") + " > " + log.string();
     const auto t0 = std::chrono::steady_clock::now();
     ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
     const std::string tty = slurp(log);

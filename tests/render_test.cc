@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "apps/render/gl_renderer.h"
+#include "tests/support/cli_runner.h"
 
 namespace fs = std::filesystem;
 
@@ -31,7 +32,7 @@ Result sffd(const std::string& args, const std::string& env = "") {
   fs::path dir = fs::temp_directory_path() / ("sffd_render_cli_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   std::string errFile = (dir / "stderr").string();
-  std::string cmd = "LIBGL_ALWAYS_SOFTWARE=1 " + env + " " + kSffd + " " + args + " >/dev/null 2>" + errFile;
+  std::string cmd = sffd::test::bounded("LIBGL_ALWAYS_SOFTWARE=1 " + env + " " + kSffd + " " + args) + " >/dev/null 2>" + errFile;
   int raw = std::system(cmd.c_str());
   Result r;
   r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : 128;

@@ -8,6 +8,11 @@
 layout(std430, SFFD_SET binding = SFFD_BINDING_SUB_HEADERS) writeonly buffer SubHeaders { uvec4 subHeaders[]; };
 layout(std430, SFFD_SET binding = SFFD_BINDING_SUB_RECORDS) writeonly buffer SubRecords { real4 subRecords[]; };
 
+// v with component i set to x, as one select per component: NVIDIA's GLSL compiler (580) cannot store
+// into a double vector at a variable index ("can't find __setVectorIndex"), so no kernel does that.
+real3 withComponent(real3 v, uint i, real x) { return real3(i == 0u ? x : v.x, i == 1u ? x : v.y, i == 2u ? x : v.z); }
+uvec3 withComponent(uvec3 v, uint i, uint x) { return uvec3(i == 0u ? x : v.x, i == 1u ? x : v.y, i == 2u ? x : v.z); }
+
 void main() {
   uint t = sffdThreadIndex();
   if (t >= params.range.y) return;
@@ -29,8 +34,8 @@ void main() {
   for (uint k = 0u; k < S.entry.w; ++k) {
     // Per corner c of the sub-triangle: its pattern vertex's edge and step, and its site's kind and
     // parameter, as vector components (see ClipSetup), for the crease test of its sub-edges.
-    uvec3 edge, step, kind;
-    real3 siteT;
+    uvec3 edge = uvec3(0u), step = uvec3(0u), kind = uvec3(0u);
+    real3 siteT = real3(0);
     real3 npn0, npn1, npn2;
     uint o = out0 + k;
     uint rec = SFFD_SUB_STRIDE * o;
@@ -43,11 +48,11 @@ void main() {
       uvec4 vw = clipWords4(v);   // splitTable(v ..)
       real3 lamCanon = real3(uintBitsToFloat(vw.x), uintBitsToFloat(vw.y), uintBitsToFloat(vw.z));
       uint w = vw.w;
-      edge[c] = w & 255u;
-      step[c] = w >> 16u;
-      Site site = patternSite(T, S, edge[c], step[c], lamCanon);
-      kind[c] = site.kind;
-      siteT[c] = site.t;
+      edge = withComponent(edge, c, w & 255u);
+      step = withComponent(step, c, w >> 16u);
+      Site site = patternSite(T, S, w & 255u, w >> 16u, lamCanon);
+      kind = withComponent(kind, c, site.kind);
+      siteT = withComponent(siteT, c, site.t);
       SiteValue val = evaluateSite(par, site);
       if (!sffdRollsLoops()) {
         subRecords[rec + SFFD_SUB_LAM + c] = real4(val.lam, 0);

@@ -19,6 +19,7 @@
 #include "backends/opengl/gl_backend.h"
 #include "backends/opengl/gl_context.h"
 #include "backends/vulkan/vk_interop.h"
+#include "backends/backend_test_support.h"
 #include "backends/cpu/cpu_backend.h"
 #include "pipelines/deform_session.h"
 
@@ -140,6 +141,7 @@ struct AppVulkan {
 };
 
 TEST(VulkanInterop, AdoptedDeviceRunsStrictSessionAndStaysTheApplications) {
+  SFFD_SKIP_WITHOUT("vulkan");
   Job j = strictJob();
   {
     AppVulkan app;
@@ -166,6 +168,7 @@ TEST(VulkanInterop, AdoptedDeviceRunsStrictSessionAndStaysTheApplications) {
 }
 
 TEST(VulkanInterop, QueueFamilyWithoutComputeIsRefused) {
+  SFFD_SKIP_WITHOUT("vulkan");
   AppVulkan app;
   vulkan::DeviceConfig c = app.config(false);
   c.queueFamily = 99;
@@ -180,6 +183,7 @@ TEST(VulkanInterop, QueueFamilyWithoutComputeIsRefused) {
 
 // bufferOf on sffd's own Vulkan device too, refused where the output is not a Vulkan (or GL) buffer.
 TEST(VulkanInterop, BufferOfNamesTheDeformersBuffersAndRefusesOtherDevices) {
+  SFFD_SKIP_WITHOUT("vulkan");
   Job j = strictJob();
   DeformOptions classic;
   classic.method = Method::Classic;

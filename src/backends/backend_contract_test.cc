@@ -162,14 +162,17 @@ class BackendContract : public ::testing::TestWithParam<std::string> {
   void SetUp() override {
     const bool staging = GetParam() == "vulkan-staging";
     if (staging) setenv("SFFD_VK_STAGING", "1", 1);   // read when the device is created
+    std::string why;
+    std::optional<OpenedBackend> opened;
     try {
-      opened_ = sffd::testing::openForTest(staging ? "vulkan" : GetParam());
-    } catch (const Error& e) {
+      opened = sffd::testing::openUnlessAbsent(staging ? "vulkan" : GetParam(), sffd::testing::openForTest, why);
+    } catch (...) {
       if (staging) unsetenv("SFFD_VK_STAGING");
-      if (e.kind() == ErrorKind::Device) GTEST_SKIP() << GetParam() << " cannot be opened here: " << e.what();
       throw;
     }
     if (staging) unsetenv("SFFD_VK_STAGING");
+    if (!opened) GTEST_SKIP() << why;
+    opened_ = std::move(*opened);
   }
   void TearDown() override { EXPECT_EQ(vk::validationMessageCount(), 0u); }
   Backend& backend() { return *opened_.backend; }

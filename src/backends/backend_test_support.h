@@ -1,25 +1,46 @@
 // What the backend tests share: which backends every parameterised test runs on, opening one with
-// validation on, gtest-safe names for them, and the CPU backend as the reference.
+// validation on (or skipping where this machine has none), gtest-safe names for them, and the CPU
+// backend as the reference.
 #pragma once
+#include <cstdio>
 #include <cstdlib>
+#include <map>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include <sffd/error.h>
 #include "backends/backend_select.h"
 #include "backends/cpu/cpu_backend.h"
 
 namespace sffd::testing {
 
-// Backends that must be present: by default every one Debian 12's Mesa gives and the CPU backend
-// (SFFD_REQUIRE_BACKENDS overrides).
-inline std::vector<std::string> requiredBackends() {
+// The backends the parameterised tests run on: every one Debian 12's Mesa gives, and the CPU backend.
+inline std::vector<std::string> testBackends() { return {"vulkan", "gl-egl", "gl-osmesa", "cpu"}; }
+
+// Whether this machine must have `name`: SFFD_REQUIRE_BACKENDS lists them (ctest sets it from
+// SFFD_TEST_REQUIRE_BACKENDS, tests/CMakeLists.txt); unset, none is required.
+inline bool requiredHere(const std::string& name) {
   const char* env = std::getenv("SFFD_REQUIRE_BACKENDS");
-  std::stringstream ss(env ? env : "vulkan,gl-egl,gl-osmesa,cpu");
-  std::vector<std::string> names;
+  std::stringstream ss(env ? env : "");
   for (std::string n; std::getline(ss, n, ',');)
-    if (!n.empty()) names.push_back(n);
-  return names;
+    if (n == name) return true;
+  return false;
+}
+
+// open(name), or nothing when this machine has no such device (a device error) and does not require it:
+// `why` then says so, and the caller skips that backend. Any other error is thrown.
+template <class Open>
+auto openUnlessAbsent(const std::string& name, Open&& open, std::string& why) -> std::optional<decltype(open(name))> {
+  try {
+    return open(name);
+  } catch (const Error& e) {
+    if (e.kind() != ErrorKind::Device || requiredHere(name)) throw;
+    why = name + " cannot be opened here: " + e.what();
+    std::printf("skipping %s\n", why.c_str());
+    return std::nullopt;
+  }
 }
 
 // The backend of that name with Vulkan validation on; gles held to the ES 3.1 minimum limits, within
@@ -30,6 +51,31 @@ inline OpenedBackend openForTest(const std::string& name) {
   r.validation = true;
   return openBackend(r);
 }
+
+// `names` less those this machine has no device for (and does not require), each opened once a process to see.
+inline std::vector<std::string> backendsHere(const std::vector<std::string>& names) {
+  static std::map<std::string, bool> here;
+  std::vector<std::string> kept;
+  for (const std::string& n : names) {
+    if (!here.count(n)) {
+      std::string why;
+      here[n] = openUnlessAbsent(n, openForTest, why).has_value();
+    }
+    if (here[n]) kept.push_back(n);
+  }
+  return kept;
+}
+
+// Skips the test when this machine cannot open backend `name` (and does not require it).
+#define SFFD_SKIP_WITHOUT(name) \
+  if (sffd::testing::backendsHere({name}).empty()) GTEST_SKIP() << name << " cannot be opened here"
+
+// Declares `var`, the backend `name` opened for a test, or skips the test when this machine has none.
+#define SFFD_OPEN_OR_SKIP(var, name)                                                                \
+  std::string var##Why_;                                                                            \
+  auto var##Opened_ = sffd::testing::openUnlessAbsent(name, sffd::testing::openForTest, var##Why_); \
+  if (!var##Opened_) GTEST_SKIP() << var##Why_;                                                     \
+  OpenedBackend var = std::move(*var##Opened_)
 
 // The CPU backend, shared by a test program's tests: the reference the other backends are compared with.
 inline Backend& cpuBackend() {

@@ -56,13 +56,10 @@ Reference reference(const Mesh& m, const Lattice& L, const DeformSessionOptions&
   return r;
 }
 
-class DeformSessionTest : public ::testing::TestWithParam<std::string> {
- protected:
-  OpenedBackend open() { return sffd::testing::openForTest(GetParam()); }
-};
+class DeformSessionTest : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(DeformSessionTest, StrictSessionEqualsCpuReferenceAcrossRedeforms) {
-  OpenedBackend b = open();
+  SFFD_OPEN_OR_SKIP(b, GetParam());
   for (auto [file, l] : {std::pair{"/cube2.obj", 0.5}, std::pair{"/torus.obj", 0.05}}) {
     SCOPED_TRACE(file);
     Mesh m = readMesh(std::string(SFFD_TEST_DATA) + file);
@@ -93,7 +90,7 @@ TEST_P(DeformSessionTest, StrictSessionEqualsCpuReferenceAcrossRedeforms) {
 }
 
 TEST_P(DeformSessionTest, ChunkedSplitAndKnotBoxSessionsEqualCpuReference) {
-  OpenedBackend b = open();
+  SFFD_OPEN_OR_SKIP(b, GetParam());
   Mesh m = readMesh(std::string(SFFD_TEST_DATA) + "/sphere.obj");
   Lattice A = latticeFor(m, 3, 0.15);
   DeformSessionOptions o;
@@ -130,7 +127,7 @@ TEST_P(DeformSessionTest, ChunkedSplitAndKnotBoxSessionsEqualCpuReference) {
 // the same records and output as in one chunk, with pre-split parents (cube2 at a short edge length),
 // sub-triangle chunks across the pre-compute's, a repeated precompute, and knot-box clipping.
 TEST_P(DeformSessionTest, PrecomputeChunksGiveTheSameRecordsAndOutput) {
-  OpenedBackend b = open();
+  SFFD_OPEN_OR_SKIP(b, GetParam());
   for (auto [file, l] : {std::pair{"/cube2.obj", 0.05}, std::pair{"/sphere.obj", 0.3}}) {
     for (bool knotBox : {false, true}) {
       SCOPED_TRACE(std::string(file) + (knotBox ? " knot-box" : " regular"));
@@ -165,7 +162,7 @@ TEST_P(DeformSessionTest, PrecomputeChunksGiveTheSameRecordsAndOutput) {
 // every stage a few parents at a time (streamChunks): in many small chunks, with pre-split parents (cube2
 // at l = 0.05), the same pre-images, tessellation and patches as a session that keeps everything.
 TEST_P(DeformSessionTest, StreamedChunksGiveTheSameOutput) {
-  OpenedBackend b = open();
+  SFFD_OPEN_OR_SKIP(b, GetParam());
   for (auto [file, l] : {std::pair{"/cube2.obj", 0.05}, std::pair{"/sphere.obj", 0.3}}) {
     SCOPED_TRACE(file);
     const Mesh m = readMesh(std::string(SFFD_TEST_DATA) + file);
@@ -219,7 +216,7 @@ TEST_P(DeformSessionTest, StreamedChunksGiveTheSameOutput) {
 // A lattice too large for the deform kernels' parameter block is read from the storage buffers:
 // the same bits.
 TEST_P(DeformSessionTest, LatticeTooLargeToInlineGivesTheSameOutput) {
-  OpenedBackend b = open();
+  SFFD_OPEN_OR_SKIP(b, GetParam());
   Mesh m = readMesh(std::string(SFFD_TEST_DATA) + "/sphere.obj");
   Lattice big = jitteredLattice(m, 12, 2, 7, 0.03);
   ASSERT_EQ(deformParamsFor(packLattice(big), false).lattice.break_offset.w, 0u) << "the lattice should not fit inline";
@@ -265,7 +262,7 @@ class ForwardingBackend final : public Backend {
 // Kernels compiled with no assumptions give the bits of those compiled for their lattice: degree 2
 // inline, degree 3, a lattice read from the storage buffers, the split kernels.
 TEST_P(DeformSessionTest, KernelsWithoutLatticeAssumptionsGiveTheSameBits) {
-  OpenedBackend b = open();
+  SFFD_OPEN_OR_SKIP(b, GetParam());
   ForwardingBackend plain(*b.backend);
   Mesh m = readMesh(std::string(SFFD_TEST_DATA) + "/sphere.obj");
   for (auto [counts, degree, split] : {std::tuple{5, 2, false}, std::tuple{6, 3, true}, std::tuple{12, 2, false}}) {
@@ -290,7 +287,7 @@ TEST_P(DeformSessionTest, KernelsWithoutLatticeAssumptionsGiveTheSameBits) {
 // A device whose storage binding cannot hold the job's vertices and one triangle's pre-compute inputs:
 // an input error that says so.
 TEST_P(DeformSessionTest, RefusesVerticesBeyondOneStorageBinding) {
-  OpenedBackend b = open();
+  SFFD_OPEN_OR_SKIP(b, GetParam());
   ForwardingBackend small(*b.backend, 4096);
   Mesh m = readMesh(std::string(SFFD_TEST_DATA) + "/sphere.obj");
   Lattice A = latticeFor(m, 1, 0.1);
@@ -307,7 +304,7 @@ TEST_P(DeformSessionTest, RefusesVerticesBeyondOneStorageBinding) {
 }
 
 TEST_P(DeformSessionTest, RefusesALatticeOfAnotherStructureAndBadOptions) {
-  OpenedBackend b = open();
+  SFFD_OPEN_OR_SKIP(b, GetParam());
   Mesh m = readMesh(std::string(SFFD_TEST_DATA) + "/cube2.obj");
   Lattice A = latticeFor(m, 1, 0.1);
   DeformSession s(*b.backend, m, A, {});
@@ -326,7 +323,7 @@ TEST_P(DeformSessionTest, RefusesALatticeOfAnotherStructureAndBadOptions) {
   EXPECT_THROW(DeformSession(*b.backend, m, A, bad), Error);
 }
 
-INSTANTIATE_TEST_SUITE_P(Backends, DeformSessionTest, ::testing::ValuesIn(sffd::testing::requiredBackends()),
+INSTANTIATE_TEST_SUITE_P(Backends, DeformSessionTest, ::testing::ValuesIn(sffd::testing::testBackends()),
                          [](const auto& info) { return sffd::testing::backendTestName(info.param); });
 
 }  // namespace

@@ -159,10 +159,10 @@ EdgeCounts countFileEdges(const fs::path& path, size_t& vertices) {
   return n;
 }
 
-// The CPU reference and the required devices that `among` names.
+// The CPU reference and the devices here that `among` names.
 std::vector<std::string> devices(std::set<std::string> among = {"cpu", "vulkan", "gl-egl", "gl-osmesa"}) {
   std::vector<std::string> d{"cpu"};
-  for (const std::string& n : sffd::testing::requiredBackends())
+  for (const std::string& n : sffd::testing::backendsHere(sffd::testing::testBackends()))
     if (n != "cpu" && among.count(n)) d.push_back(n);
   return d;
 }

@@ -10,6 +10,8 @@
 #include <sstream>
 #include <string>
 
+#include "backends/backend_test_support.h"
+
 namespace sffd::test {
 
 namespace fs = std::filesystem;
@@ -34,21 +36,40 @@ inline fs::path tempDir(const std::string& name) {
   return d;
 }
 
+// How long one run may take before it is killed (status 124): past a cold shader cache's compile and
+// the device timeout (60 s), so that a hung driver fails its test instead of waiting forever.
+constexpr int kRunTimeoutSeconds = 600;
+
+// The shell command line `command` ("VAR=value ... PROGRAM ARGS") bounded by kRunTimeoutSeconds.
+inline std::string bounded(const std::string& command) {
+  return "timeout -k 10 " + std::to_string(kRunTimeoutSeconds) + " env " + command;
+}
+
 // Runs the sffd binary (SFFD_BINARY) with arguments shell-quoted by the caller, after an optional
-// environment prefix ("VAR=value ...").
+// environment prefix ("VAR=value ...", or a command that runs the rest, such as "env -u DISPLAY").
 inline RunResult runSffd(const std::string& args, const std::string& env = "") {
   static int serial = 0;
   fs::path dir = tempDir("run" + std::to_string(serial++));
   const std::string outFile = (dir / "stdout").string(), errFile = (dir / "stderr").string();
-  const std::string cmd = env + " " + SFFD_BINARY + " " + args + " >" + outFile + " 2>" + errFile;
+  const std::string cmd = bounded(env + " " + SFFD_BINARY + " " + args) + " >" + outFile + " 2>" + errFile;
   const int raw = std::system(cmd.c_str());
   RunResult r;
   r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : 128;
   r.out = slurp(outFile);
   r.err = slurp(errFile);
+  if (r.status == 124) r.err += "runSffd: killed after " + std::to_string(kRunTimeoutSeconds) + " s: " + args + "\n";
   fs::remove_all(dir);
   return r;
 }
+
+// Whether `sffd devices` lists a backend of that name here (asked once a process).
+inline bool hasDevice(const std::string& backend) {
+  static const std::string listed = "\n" + runSffd("devices").out;
+  return listed.find("\n" + backend + " ") != std::string::npos;
+}
+
+// Whether a test may run on backend `name`: this machine has it, or must have it (then its absence fails).
+inline bool usable(const std::string& backend) { return hasDevice(backend) || sffd::testing::requiredHere(backend); }
 
 // An axis-aligned box as OBJ with one normal per face: 8 positions, 12 triangles, every edge a crease.
 inline void writeBoxObj(const fs::path& path, double cx, double cy, double cz, double half) {

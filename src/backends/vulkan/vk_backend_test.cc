@@ -13,6 +13,7 @@
 #include <vector>
 
 #include <sffd/error.h>
+#include "backends/backend_test_support.h"
 #include "kernels/common/shader_layout.h"
 
 namespace sffd {
@@ -176,6 +177,7 @@ struct ClassicJob {
 };
 
 TEST_F(VkBackendTest, ListsDevices) {
+  SFFD_SKIP_WITHOUT("vulkan");
   std::vector<DeviceInfo> devices = vk::listDevices();
   ASSERT_FALSE(devices.empty());
   for (const DeviceInfo& d : devices) {
@@ -192,6 +194,7 @@ TEST_F(VkBackendTest, ListsDevices) {
 }
 
 TEST_F(VkBackendTest, PicksDeviceBySubstring) {
+  SFFD_SKIP_WITHOUT("vulkan");
   std::string name = vk::listDevices().front().name;
   std::string upper = name.substr(0, 4);
   for (char& c : upper) c = char(std::toupper(static_cast<unsigned char>(c)));
@@ -209,6 +212,7 @@ void runIdentity(Backend& gpu, KernelVariant variant, double tol) {
 // A device without shaderFloat64 (simulated with SFFD_VK_DISABLE_F64=1) refuses f64 kernels with a
 // device Error and still runs the float ones.
 TEST_F(VkBackendTest, RefusesF64WithoutShaderFloat64) {
+  SFFD_SKIP_WITHOUT("vulkan");
   ScopedEnv env("SFFD_VK_DISABLE_F64", "1");
   auto gpu = vk::createBackend({});
   EXPECT_FALSE(gpu->info().limits.float64);
@@ -219,6 +223,7 @@ TEST_F(VkBackendTest, RefusesF64WithoutShaderFloat64) {
 
 // Validation requested but the layer is not installed: one warning, and the backend works.
 TEST_F(VkBackendTest, RunsWithoutValidationLayer) {
+  SFFD_SKIP_WITHOUT("vulkan");
   ScopedEnv layers("VK_LAYER_PATH", "/nonexistent");
   auto gpu = vk::createBackend({"", true});
   runIdentity<float>(*gpu, {}, 1e-6);
