@@ -357,16 +357,16 @@ Site clipCornerSite(ClipTriangle T, uint c) {
 // Site of a pattern vertex of the clip triangle. `edge`/`step` come from the table.
 Site patternSite(ClipTriangle T, ClipSetup S, uint edge, uint step, real3 lamCanon) {
   if (edge < 3u && step == 0u) return clipCornerSite(T, S.perm[edge]);
-  real3 lamLocal;
-  lamLocal[S.perm[0]] = lamCanon.x;
-  lamLocal[S.perm[1]] = lamCanon.y;
-  lamLocal[S.perm[2]] = lamCanon.z;
+  real3 lamLocal = real3(0);
+  lamLocal = withComponent(lamLocal, S.perm[0], lamCanon.x);
+  lamLocal = withComponent(lamLocal, S.perm[1], lamCanon.y);
+  lamLocal = withComponent(lamLocal, S.perm[2], lamCanon.z);
   if (edge < 3u) {
     // On clip edge between local corners a and b: the parameter from the lower-weld end is that
     // end's partner's weight, bit-identical from both sides (the table's symmetric pairs).
     uint a = S.perm[edge], b = S.perm[(edge + 1u) % 3u];
     uint lo = T.welds[a] <= T.welds[b] ? a : b, hi = lo == a ? b : a;
-    P real tl = lamLocal[hi];
+    P real tl = componentOf(lamLocal, hi);
     uint ce = (b == (a + 1u) % 3u) ? a : b;   // local clip edge index (corner ce -> ce+1)
     real4 ep = clipEdgeParams(T, ce);
     Site s;

@@ -8,11 +8,6 @@
 layout(std430, SFFD_SET binding = SFFD_BINDING_SUB_HEADERS) writeonly buffer SubHeaders { uvec4 subHeaders[]; };
 layout(std430, SFFD_SET binding = SFFD_BINDING_SUB_RECORDS) writeonly buffer SubRecords { real4 subRecords[]; };
 
-// v with component i set to x, as one select per component: NVIDIA's GLSL compiler (580) cannot store
-// into a double vector at a variable index ("can't find __setVectorIndex"), so no kernel does that.
-real3 withComponent(real3 v, uint i, real x) { return real3(i == 0u ? x : v.x, i == 1u ? x : v.y, i == 2u ? x : v.z); }
-uvec3 withComponent(uvec3 v, uint i, uint x) { return uvec3(i == 0u ? x : v.x, i == 1u ? x : v.y, i == 2u ? x : v.z); }
-
 void main() {
   uint t = sffdThreadIndex();
   if (t >= params.range.y) return;

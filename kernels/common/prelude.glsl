@@ -106,8 +106,16 @@ uint sffdRolled(uint n) { return sffdAssumes(SFFD_ASSUME_ROLLED_LOOPS) ? n + (gl
 const bool sffdRollsLoopsHere = (sffdAssumptions & SFFD_ASSUME_ROLLED_LOOPS) != 0u;
 #define sffdRollsLoops() sffdRollsLoopsHere
 
-#if SFFD_STRICT
+// v with component i set to x, as one select per component: NVIDIA's GLSL compiler (580) cannot store
+// into a double vector at a variable index ("can't find __setVectorIndex"), so no kernel does that.
+real3 withComponent(real3 v, uint i, real x) { return real3(i == 0u ? x : v.x, i == 1u ? x : v.y, i == 2u ? x : v.z); }
+uvec3 withComponent(uvec3 v, uint i, uint x) { return uvec3(i == 0u ? x : v.x, i == 1u ? x : v.y, i == 2u ? x : v.z); }
+// Component i of v, likewise without a variable index.
+real componentOf(real3 v, uint i) { return i == 0u ? v.x : (i == 1u ? v.y : v.z); }
+
+// Included once for both uses below (the kernels' sources are inlined with each file once).
 #include "correctly_rounded.h"
+#if SFFD_STRICT
 // a / b and sqrt(x) correctly rounded on every driver, as the C++ twin computes them (the header says why).
 // Drivers known to round exactly (forDevice) skip the fix-up, which costs lavapipe 3 to 4 times the
 // strict kernels' time.
@@ -135,6 +143,17 @@ real3 snormalize(real3 v) {
   P real3 r = sdiv(v, len);
   return r;
 }
+#elif SFFD_F64
+// Fast double: a / b and sqrt to double precision where the driver gives less (the header says why).
+real sdiv(real a, real b) {
+  real q = a / b;
+  return (q == real(0) || isinf(q) || isnan(q)) ? q : sffdRefinedQuotient(a, b, q);
+}
+real3 sdiv(real3 v, real s) { return real3(sdiv(v.x, s), sdiv(v.y, s), sdiv(v.z, s)); }
+real ssqrt(real x) { return x > real(0) && !isinf(x) ? sffdRefinedRoot(x, sqrt(x)) : sqrt(x); }
+real sdot(real3 a, real3 b) { return dot(a, b); }
+real3 scross(real3 a, real3 b) { return cross(a, b); }
+real3 snormalize(real3 v) { return sdiv(v, ssqrt(dot(v, v))); }
 #else
 real sdiv(real a, real b) { return a / b; }
 real3 sdiv(real3 v, real s) { return v / s; }
