@@ -128,8 +128,8 @@ class VulkanBackend final : public Backend {
 
   void destroyBuffer(BufferId id) override {
     Buffer& b = lookup(id);
-    if (b.pending)
-      recorder_.releaseAfterSubmit(b.memory);   // recorded work still refers to it
+    if (b.pending || recorder_.hung())
+      recorder_.releaseAfterSubmit(b.memory);   // recorded, or still running, work refers to it
     else
       device_.release(b.memory);
     b = Buffer{};
@@ -175,7 +175,10 @@ class VulkanBackend final : public Backend {
       finish();
       std::memcpy(data, staging.mapped, bytes);
     } catch (...) {
-      device_.release(staging);
+      // After a timed-out wait the copy may still be running: freeing its memory under a GPU's feet
+      // crashed NVIDIA's driver (segmentation fault); the recorder frees it once the device settles.
+      if (recorder_.hung()) recorder_.releaseAfterSubmit(staging);
+      else device_.release(staging);
       throw;
     }
     device_.release(staging);

@@ -22,6 +22,8 @@ class Recorder {
 
   // After a wait that timed out: waits once more (10 s); false when the device is still busy.
   bool settled();
+  // Whether the last wait timed out: the device may still be running what was submitted.
+  bool hung() const { return hung_; }
   // Forgets every handle without destroying it: what a device still using them needs (a hung driver).
   void abandon();
   // Whether commands were recorded since the last submission.
