@@ -1,5 +1,6 @@
 // kernels/common/correctly_rounded.h: IEEE-754 round-to-nearest quotients and square roots from a
-// driver's approximate ones, for the strict kernels. Valid GLSL (included by prelude.glsl) and C++
+// driver's approximate ones, for the strict kernels (the fast double ones take only the Newton steps
+// below). Valid GLSL (included by prelude.glsl) and C++
 // (after correctly_rounded_twin.h, which correctly_rounded_test.cc runs on perturbed approximations).
 //
 // Why: GLSL and SPIR-V ask only +, - and * to be correctly rounded; a / b may be off by 2.5 ulp and
