@@ -131,8 +131,9 @@ TEST(Cli, DevicesListsEveryRequiredBackend) {
   RunResult r = runSffd("devices");
   ASSERT_EQ(r.status, 0) << r.err;
   for (const std::string& n : sffd::testing::testBackends())
-    if (n == "cpu" || sffd::testing::requiredHere(n))
+    if (n == "cpu" || sffd::testing::requiredHere(n)) {
       EXPECT_NE(("\n" + r.out).find("\n" + n + " "), std::string::npos) << n << "\n" << r.out;
+    }
   std::stringstream lines(r.out);
   for (std::string line; std::getline(lines, line);) {
     std::string backend, device;

@@ -78,7 +78,7 @@ TEST(Formats, ObjKeepsTexcoordsThroughEveryMethod) {
     const Mesh r = readMesh(out.string());
     ASSERT_EQ(r.texcoords.size(), r.positions.size()) << method;
     // Classic: the same vertices with the same texture coordinates (17 digits: exact).
-    if (std::string(method) == "classic") EXPECT_EQ(r.texcoords, input.texcoords);
+    if (std::string(method) == "classic") { EXPECT_EQ(r.texcoords, input.texcoords); }
   }
   fs::remove_all(dir);
 }

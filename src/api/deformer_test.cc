@@ -96,7 +96,7 @@ TEST(Deformer, EveryMethodOnEveryDeviceGivesTheCpuReferenceBits) {
     reference.deform(lattice);
     const Mesh expected = reference.result();
     EXPECT_GT(expected.triangles.size(), 0u);
-    if (method != Method::Classic) EXPECT_GT(reference.subTriangles(), mesh.triangles.size() - 1);
+    if (method != Method::Classic) { EXPECT_GT(reference.subTriangles(), mesh.triangles.size() - 1); }
     for (const std::string& name : deviceNames()) {
       if (name == "cpu") continue;
       Device device = openDevice(name);
@@ -226,7 +226,7 @@ TEST(Deformer, SmallChunksGiveTheSameBits) {
       Deformer chunked(device, mesh, lattice, o);
       chunked.deform(lattice);
       expectSameBits(chunked.result(), whole.result(), "chunked");
-      if (name != "cpu") EXPECT_GT(chunked.deviceOutput().size(), 2u);
+      if (name != "cpu") { EXPECT_GT(chunked.deviceOutput().size(), 2u); }
     }
 }
 

@@ -93,7 +93,7 @@ TEST(CarriedAttributes, ReadFromObj) {
   // A seam is no crease: the two vertices of a seam position get one computed normal.
   for (size_t v = 0; v < mesh.positions.size(); ++v)
     for (size_t w = v + 1; w < mesh.positions.size(); ++w)
-      if (mesh.weldId[v] == mesh.weldId[w]) EXPECT_EQ(mesh.normals[v], mesh.normals[w]) << v << " " << w;
+      if (mesh.weldId[v] == mesh.weldId[w]) { EXPECT_EQ(mesh.normals[v], mesh.normals[w]) << v << " " << w; }
 }
 
 TEST(CarriedAttributes, EveryMethodKeepsThemAndEveryDeviceAgrees) {
