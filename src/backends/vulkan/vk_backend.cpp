@@ -106,6 +106,7 @@ class VulkanBackend final : public Backend {
     else
       device_.api().vkQueueWaitIdle(device_.queue());
     for (Buffer& b : buffers_) device_.release(b.memory);
+    device_.release(downloadStaging_);
   }
 
   const DeviceInfo& info() const override { return device_.info(); }
@@ -166,22 +167,22 @@ class VulkanBackend final : public Backend {
       return;
     }
     if (bytes == 0) return finish();
-    // Staged: copy into host-visible memory behind all recorded work, submit, read it.
-    Allocation staging = device_.allocate(bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUse::Download);
-    try {
-      recorder_.memoryBarrier(kWorkStages, kWorkWrites, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
-      VkBufferCopy region{offset, 0, bytes};
-      device_.api().vkCmdCopyBuffer(recorder_.commands(), b.memory.buffer, staging.buffer, 1, &region);
-      finish();
-      std::memcpy(data, staging.mapped, bytes);
-    } catch (...) {
-      // After a timed-out wait the copy may still be running: freeing its memory under a GPU's feet
-      // crashed NVIDIA's driver (segmentation fault); the recorder frees it once the device settles.
-      if (recorder_.hung()) recorder_.releaseAfterSubmit(staging);
-      else device_.release(staging);
-      throw;
+    // Staged: copy into host-visible memory behind all recorded work, submit, read it. The staging
+    // memory grows, at least doubling, to the largest download. After a timed-out wait a copy may
+    // still run into it: it is then freed only once the device settles (freeing memory under a
+    // running GPU crashed NVIDIA's driver).
+    if (downloadStaging_.size < bytes) {
+      const uint64_t size = std::max(bytes, 2 * downloadStaging_.size);
+      if (recorder_.hung()) recorder_.releaseAfterSubmit(downloadStaging_);
+      else device_.release(downloadStaging_);
+      downloadStaging_ = Allocation{};
+      downloadStaging_ = device_.allocate(size, VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUse::Download);
     }
-    device_.release(staging);
+    recorder_.memoryBarrier(kWorkStages, kWorkWrites, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
+    VkBufferCopy region{offset, 0, bytes};
+    device_.api().vkCmdCopyBuffer(recorder_.commands(), b.memory.buffer, downloadStaging_.buffer, 1, &region);
+    finish();
+    std::memcpy(data, downloadStaging_.mapped, bytes);
   }
 
   void dispatch(const Dispatch& d) override {
@@ -294,6 +295,9 @@ class VulkanBackend final : public Backend {
   std::vector<Buffer> buffers_;   // index id - 1
   std::vector<BufferId> freeIds_;
   std::vector<DispatchTiming> timings_;
+  // The staging memory downloads read through, kept from one to the next: a discrete GPU's driver pins
+  // host memory at each allocation (the streamed 1 M mesh downloads 3 times a chunk, 70 chunks).
+  Allocation downloadStaging_;
 };
 
 }  // namespace
