@@ -1,6 +1,7 @@
 // kernels/common/prelude.glsl: included first by every kernel.
 // Maps the layout words of layout.h onto GLSL and selects the arithmetic variant:
-//   SFFD_STRICT 0 (fast): built-in dot/cross/normalize, the compiler may fuse and reorder.
+//   SFFD_STRICT 0 (fast): built-in dot/cross/normalize, the compiler may fuse and reorder (in double,
+//   a / b and sqrt refined to double precision, which GLSL does not ask of a driver).
 //   SFFD_STRICT 1 (strict): every operation `precise`, no fma, a / b and sqrt correctly rounded
 //   (correctly_rounded.h), hand-written dot/cross/normalize in a
 //   fixed order, so GL, Vulkan and the C++ reference built with -ffp-contract=off agree bit for bit
@@ -117,8 +118,8 @@ real componentOf(real3 v, uint i) { return i == 0u ? v.x : (i == 1u ? v.y : v.z)
 #include "correctly_rounded.h"
 #if SFFD_STRICT
 // a / b and sqrt(x) correctly rounded on every driver, as the C++ twin computes them (the header says why).
-// Drivers known to round exactly (forDevice) skip the fix-up, which costs lavapipe 3 to 4 times the
-// strict kernels' time.
+// Drivers known to round exactly (forDevice) skip the fix-up, which would cost lavapipe 2.4 times its
+// strict deform time.
 const bool sffdLooseDivision = (sffdAssumptions & SFFD_ASSUME_LOOSE_DIVISION) != 0u;
 real sdiv(real a, real b) {
   P real q = a / b;
