@@ -118,8 +118,8 @@ real componentOf(real3 v, uint i) { return i == 0u ? v.x : (i == 1u ? v.y : v.z)
 #include "correctly_rounded.h"
 #if SFFD_STRICT
 // a / b and sqrt(x) correctly rounded on every driver, as the C++ twin computes them (the header says why).
-// Drivers known to round exactly (forDevice) skip the fix-up, which would cost lavapipe 2.4 times its
-// strict deform time.
+// Drivers known to round exactly (forDevice) skip the fix-up, which would cost lavapipe about twice its
+// strict deform time (docs/CONFORMANCE.md "Strict kernels").
 const bool sffdLooseDivision = (sffdAssumptions & SFFD_ASSUME_LOOSE_DIVISION) != 0u;
 real sdiv(real a, real b) {
   P real q = a / b;

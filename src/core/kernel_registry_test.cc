@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdlib>
+
 using namespace sffd;
 
 namespace {
@@ -26,6 +28,26 @@ TEST(KernelRegistry, RolledLoopsOnlyForMesaFrom23OnTheCpu) {
   EXPECT_EQ(forDevice(v, device("AMD Radeon RX 7600 (RADV NAVI33)", "Mesa 25.0.7")).assumptions, SFFD_ASSUME_DEGREE2);
   EXPECT_EQ(forDevice(v, device("NVIDIA H100", "550.54.15")).assumptions, SFFD_ASSUME_DEGREE2);
   EXPECT_EQ(forDevice(v, device(llvmpipe, "")).assumptions, SFFD_ASSUME_DEGREE2);
+}
+
+// Strict variants round a / b and sqrt themselves (SFFD_ASSUME_LOOSE_DIVISION) on every driver but
+// llvmpipe and lavapipe, which round them exactly; fast variants never; SFFD_STRICT_ROUNDING overrides.
+TEST(KernelRegistry, StrictVariantsRoundDivisionWhereTheDriverDoesNot) {
+  ::unsetenv("SFFD_STRICT_ROUNDING");
+  KernelVariant fast, strict;
+  strict.strict = true;
+  const DeviceInfo lavapipe = device("llvmpipe (LLVM 15.0.6, 256 bits)", "llvmpipe Mesa 22.3.6 (LLVM 15.0.6), Vulkan 1.3.230");
+  const DeviceInfo nvidia = device("NVIDIA H200", "NVIDIA 580.159.04"), radv = device("AMD Radeon RX 7600 (RADV NAVI33)", "Mesa 25.0.7");
+  EXPECT_EQ(forDevice(strict, lavapipe).assumptions, 0u);
+  EXPECT_EQ(forDevice(strict, nvidia).assumptions, SFFD_ASSUME_LOOSE_DIVISION);
+  EXPECT_EQ(forDevice(strict, radv).assumptions, SFFD_ASSUME_LOOSE_DIVISION);
+  EXPECT_EQ(forDevice(fast, nvidia).assumptions, 0u);
+  ::setenv("SFFD_STRICT_ROUNDING", "fixup", 1);
+  EXPECT_EQ(forDevice(strict, lavapipe).assumptions, SFFD_ASSUME_LOOSE_DIVISION);
+  EXPECT_EQ(forDevice(fast, lavapipe).assumptions, 0u);
+  ::setenv("SFFD_STRICT_ROUNDING", "driver", 1);
+  EXPECT_EQ(forDevice(strict, nvidia).assumptions, 0u);
+  ::unsetenv("SFFD_STRICT_ROUNDING");
 }
 
 // deform_smooth is embedded compiled for its usual dispatch (a degree-2 lattice and its fit table in the
