@@ -84,10 +84,34 @@ struct DeformSession::Impl {
     if (realSize == 8) writeClipVertexSection(mesh, reinterpret_cast<double*>(vertexSection.data()));
     else writeClipVertexSection(mesh, reinterpret_cast<float*>(vertexSection.data()));
   }
-  PreChunkInputs uploadStreamedInputs(Backend& b, const ClipRanges& r, const PackedClip& pc) {
-    PreChunkInputs c{r};
-    c.reals = make(b, r.byteOf(r.realElements));
-    b.upload(c.reals, 0, vertexSection.data(), vertexSection.size());
+  // A buffer of the stream's, kept from chunk to chunk and made again only when a chunk needs more room: a
+  // fresh buffer is fresh memory, which the CPU device and llvmpipe zero-fill, lavapipe faults in page by
+  // page and a discrete GPU's driver allocates (at 1 M triangles 71 chunks made five buffers each). The
+  // kernels read only the ranges their parameters name, so what an earlier chunk left beyond them is inert.
+  struct StreamBuffer {
+    BufferId id = 0;
+    uint64_t room = 0;
+    // The buffer, with at least `bytes`; `fresh` says whether it was made now. It grows by a quarter at
+    // least, within the binding limit (which every chunk's ranges keep to), so that slowly growing chunks
+    // do not make it again each time.
+    BufferId atLeast(Impl& I, Backend& B, uint64_t bytes, bool* fresh = nullptr) {
+      bytes = std::max<uint64_t>(bytes, 16);
+      if (fresh) *fresh = bytes > room;
+      if (bytes > room) {
+        I.drop(B, id);   // first: the old and the new never exist at once
+        room = std::max(bytes, std::min(room + room / 4, B.info().limits.maxStorageBufferRange));
+        id = I.make(B, room);
+      }
+      return id;
+    }
+    void drop(Impl& I, Backend& B) { I.drop(B, id), room = 0; }
+  };
+  // Into the stream's buffers (StreamBuffer), which a chunk before may have filled: the vertices' section is
+  // uploaded only into a fresh reals buffer.
+  PreChunkInputs uploadStreamedInputs(Backend& b, const ClipRanges& r, const PackedClip& pc, BufferId reals,
+                                      bool freshReals, BufferId words) {
+    PreChunkInputs c{r, reals, words};
+    if (freshReals) b.upload(c.reals, 0, vertexSection.data(), vertexSection.size());
     auto upload = [&](auto zero) {
       using Real = decltype(zero);
       std::vector<Real> own;
@@ -96,7 +120,8 @@ struct DeformSession::Impl {
       b.upload(c.reals, r.byteOf(r.slotNormals), own.data(), own.size() * sizeof(Real));
     };
     realSize == 8 ? upload(0.0) : upload(0.0f);
-    c.words = uploadVector(b, clipWordRange(r, mesh, pc));
+    const std::vector<uint32_t> w = clipWordRange(r, mesh, pc);
+    b.upload(c.words, 0, w.data(), w.size() * 4);
     return c;
   }
 };

@@ -1,6 +1,7 @@
 // DeformSession::streamChunks: a one-shot session (DeformSessionOptions::once, regular clipping) runs from
-// the mesh a few parents at a time, each chunk's inputs, records and outputs made, used and freed before
-// the next, so that only one chunk's exist at a time (docs/PERFORMANCE.md "Scaling").
+// the mesh a few parents at a time, each chunk's inputs, records and outputs made, used and done with before
+// the next, so that only one chunk's exist at a time (docs/PERFORMANCE.md "Scaling"), in device buffers the
+// chunks share (Impl::StreamBuffer).
 #include <chrono>
 
 #include "core/huge_pages.h"
@@ -39,6 +40,7 @@ const SessionTimings& DeformSession::streamChunks(const ChunkReader& read, const
   std::vector<uint32_t> counts, chunkOffsets;
   std::vector<uint64_t> offsets;
   std::vector<ChunkPlan> plan;
+  Impl::StreamBuffer realsBuffer, wordsBuffer, outputBuffer, headersBuffer, recordsBuffer;
   uint64_t p = 0, firstClip = 0;
   subCount_ = 0;
   I.makeVertexSection(clipRanges(nv, 0, 0, 0, 0, I.realSize));
@@ -57,7 +59,9 @@ const SessionTimings& DeformSession::streamChunks(const ChunkReader& read, const
       nextMade = false;
     }
     if (!r.parents) throw tooLargeForOneBinding(nv, p0, I.realSize, lim.maxStorageBufferRange);
-    const PreChunkInputs in = I.uploadStreamedInputs(B, r, packClip(clips));
+    bool freshReals = false;
+    const BufferId reals = realsBuffer.atLeast(I, B, r.byteOf(r.realElements), &freshReals);
+    const PreChunkInputs in = I.uploadStreamedInputs(B, r, packClip(clips), reals, freshReals, wordsBuffer.atLeast(I, B, r.words * 4));
     K.pn(in);
     counts.assign(r.clips, 0);
     K.clipCount(in, counts.data());
@@ -71,25 +75,22 @@ const SessionTimings& DeformSession::streamChunks(const ChunkReader& read, const
       Chunk c;
       c.first = subCount_ + pl.first;
       c.count = pl.count;
-      c.output = I.make(B, pl.count * bytes.out);
+      c.output = outputBuffer.atLeast(I, B, pl.count * bytes.out);
       c.patchesOffset = pl.count * bytes.tess;
-      BufferId headers = I.make(B, pl.count * 16), records = I.make(B, pl.count * bytes.record);
+      const BufferId headers = headersBuffer.atLeast(I, B, pl.count * 16), records = recordsBuffer.atLeast(I, B, pl.count * bytes.record);
       chunkOffsets.resize(pl.clipCount);
       for (size_t i = 0; i < pl.clipCount; ++i) chunkOffsets[i] = uint32_t(offsets[pl.firstClip + i] - offsets[pl.firstClip]);
       K.clipWrite(in, pl.firstClip, pl.clipCount, chunkOffsets.data(), headers, records);
       K.deform(I.deformParams, c.count, I.fit.points, {I.coeffs, I.frame, records, c.output});
       SubTrianglePreImages pre;
       readPreImages(headers, records, c.count, pre);
-      I.drop(B, headers), I.drop(B, records);
       read(c, pre);
-      I.drop(B, c.output);
     }
     subCount_ += offsets.back();
     firstClip += r.clips;
-    BufferId reals = in.reals, words = in.words;
-    I.drop(B, reals), I.drop(B, words);
     if (progress) progress("deform", double(p) / double(nt + 1));
   }
+  for (Impl::StreamBuffer* b : {&realsBuffer, &wordsBuffer, &outputBuffer, &headersBuffer, &recordsBuffer}) b->drop(I, B);
   freeStorage(I.vertexSection);
   B.finish();
   timings_.dispatches = B.takeTimings();

@@ -323,6 +323,46 @@ TEST_P(DeformSessionTest, RefusesALatticeOfAnotherStructureAndBadOptions) {
   EXPECT_THROW(DeformSession(*b.backend, m, A, bad), Error);
 }
 
+// Vulkan through staging memory, as on a discrete GPU (SFFD_VK_STAGING=1): once warm, a lattice edit (deform,
+// output) and a repeated pre-compute allocate no device memory (each allocation costs a discrete GPU's driver
+// a fraction of a millisecond; uploads staged through memory of their own did), and a streamed one-shot job
+// keeps its buffers from chunk to chunk instead of making five a chunk.
+TEST(DeformSessionVulkan, WarmEditsAndStreamedChunksAllocateNoDeviceMemory) {
+  setenv("SFFD_VK_STAGING", "1", 1);   // read when the device is created
+  std::string why;
+  auto opened = sffd::testing::openUnlessAbsent("vulkan", sffd::testing::openForTest, why);
+  unsetenv("SFFD_VK_STAGING");
+  if (!opened) GTEST_SKIP() << why;
+  Backend& b = *opened->backend;
+  const Mesh m = readMesh(std::string(SFFD_TEST_DATA) + "/torus.obj");
+  const Lattice A = latticeFor(m, 1, 0.1), B = latticeFor(m, 2, 0.2);
+  DeformSessionOptions o;
+  o.edgeLength = 0.1;
+  o.level = 4;
+  {
+    DeformSession s(b, m, A, o);
+    s.deform(A);
+    const SmoothOutput a = s.output();
+    const size_t warm = vk::deviceMemoryAllocations();
+    s.deform(B);
+    EXPECT_NE(s.output().tess, a.tess);
+    s.precompute();
+    s.deform(A);
+    EXPECT_EQ(s.output().tess, a.tess);
+    EXPECT_EQ(vk::deviceMemoryAllocations(), warm);
+  }
+  o.once = true;
+  o.maxChunkParents = 20;
+  DeformSession streamed(b, m, A, o);
+  streamed.deform(A);
+  const size_t before = vk::deviceMemoryAllocations();
+  size_t chunks = 0;
+  streamed.streamChunks([&](const DeformSession::Chunk&, const SubTrianglePreImages&) { ++chunks; });
+  EXPECT_GT(chunks, 20u);
+  EXPECT_LT(vk::deviceMemoryAllocations() - before, chunks / 2);
+  EXPECT_EQ(vk::validationMessageCount(), 0u);
+}
+
 INSTANTIATE_TEST_SUITE_P(Backends, DeformSessionTest, ::testing::ValuesIn(sffd::testing::testBackends()),
                          [](const auto& info) { return sffd::testing::backendTestName(info.param); });
 

@@ -147,12 +147,10 @@ class VulkanBackend final : public Backend {
       std::memcpy(static_cast<char*>(b.memory.mapped) + offset, data, bytes);
       return;
     }
-    // Staged: the copy is recorded in order with the dispatches around it.
-    Allocation staging = device_.allocate(bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, MemoryUse::Upload);
-    std::memcpy(staging.mapped, data, bytes);
-    recorder_.releaseAfterSubmit(staging);
+    // Staged through the recorder's ring: the copy is recorded in order with the dispatches around it.
+    const Recorder::RingRange staging = recorder_.staging(data, bytes);
     recorder_.memoryBarrier(kWorkStages, kWorkWrites, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT);
-    VkBufferCopy region{0, offset, bytes};
+    VkBufferCopy region{staging.offset, offset, bytes};
     device_.api().vkCmdCopyBuffer(recorder_.commands(), staging.buffer, b.memory.buffer, 1, &region);
     recorder_.memoryBarrier(VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, kWorkStages, kWorkAccess);
     b.pending = true;
@@ -218,7 +216,7 @@ class VulkanBackend final : public Backend {
     // Everything that may throw is done: from here on the dispatch is recorded.
     for (const BufferBinding& bb : d.buffers) lookup(bb.buffer).pending = true;
     if (d.params && d.paramsSize > 0) {
-      Recorder::ParamsRange p = recorder_.params(d.params, d.paramsSize);
+      Recorder::RingRange p = recorder_.params(d.params, d.paramsSize);
       write(SFFD_BINDING_PARAMS, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, p.buffer, p.offset, d.paramsSize);
     }
     VkDescriptorSet set = recorder_.descriptorSet();

@@ -20,5 +20,8 @@ std::vector<DeviceInfo> listDevices();
 std::unique_ptr<Backend> createBackend(const Options& options);
 // Warnings and errors the validation layer reported so far in this process (tests require 0).
 size_t validationMessageCount();
+// Device memory allocations (vkAllocateMemory) sffd made so far in this process: tests check that a warm
+// edit makes none (a discrete GPU's driver takes a fraction of a millisecond for each).
+size_t deviceMemoryAllocations();
 
 }  // namespace sffd::vk

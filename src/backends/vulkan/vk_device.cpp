@@ -1,11 +1,13 @@
 #include "backends/vulkan/vk_device.h"
 
+#include <atomic>
 #include <bit>
 #include <string>
 #include <vector>
 
 #include <sffd/error.h>
 #include "core/huge_pages.h"
+#include "backends/vulkan/vk_backend.h"
 
 namespace sffd::vk {
 
@@ -16,8 +18,11 @@ constexpr VkMemoryPropertyFlags kMappable = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT 
 constexpr VkMemoryPropertyFlags kExcluded = VK_MEMORY_PROPERTY_LAZILY_ALLOCATED_BIT | VK_MEMORY_PROPERTY_PROTECTED_BIT |
                                             VK_MEMORY_PROPERTY_DEVICE_COHERENT_BIT_AMD;
 
+std::atomic<size_t> gAllocations{0};   // deviceMemoryAllocations()
 
 }  // namespace
+
+size_t deviceMemoryAllocations() { return gAllocations.load(); }
 
 Device::Device(const Instance& instance, const PhysicalDevice& physical)
     : api_(instance.api()), info_(physical.info), family_(physical.computeFamily), timestampBits_(physical.timestampBits) {
@@ -136,6 +141,7 @@ Allocation Device::allocate(uint64_t bytes, VkBufferUsageFlags usage, MemoryUse 
     if (r == VK_ERROR_OUT_OF_DEVICE_MEMORY || r == VK_ERROR_OUT_OF_HOST_MEMORY)
       throw deviceError("Vulkan: out of memory allocating a buffer of " + std::to_string(bytes) + " bytes.");
     check(r, "vkAllocateMemory");
+    gAllocations.fetch_add(1, std::memory_order_relaxed);
     check(api_.vkBindBufferMemory(device_, a.buffer, a.memory, 0), "vkBindBufferMemory");
     bool mappable = (memory_.memoryTypes[type].propertyFlags & kMappable) == kMappable;
     if (mappable && (use != MemoryUse::Storage || unified_))

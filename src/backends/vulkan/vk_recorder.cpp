@@ -13,11 +13,19 @@ namespace {
 
 constexpr uint32_t kSetsPerPool = 256;
 constexpr VkDeviceSize kParamChunkBytes = 64 << 10;
+// Staging: the lattice and the clip offsets of an interactive edit fit the first chunk; a streamed chunk's
+// inputs (about 8 MiB beyond the vertices, docs/PERFORMANCE.md "Scaling") fit what is kept.
+constexpr VkDeviceSize kStagingChunkBytes = 1 << 20;
+constexpr VkDeviceSize kStagingKeptBytes = 64 << 20;
 constexpr uint32_t kQueriesPerPool = 512;   // 256 dispatches
 
 }  // namespace
 
-Recorder::Recorder(Device& device, VkDescriptorSetLayout setLayout) : device_(device), setLayout_(setLayout) {
+Recorder::Recorder(Device& device, VkDescriptorSetLayout setLayout)
+    : device_(device),
+      setLayout_(setLayout),
+      params_{VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, MemoryUse::Params, kParamChunkBytes, ~VkDeviceSize(0)},
+      staging_{VK_BUFFER_USAGE_TRANSFER_SRC_BIT, MemoryUse::Upload, kStagingChunkBytes, kStagingKeptBytes} {
   const Api& api = device_.api();
   VkDevice dev = device_.handle();
   timestamps_ = device_.info().limits.timestamps;
@@ -53,7 +61,8 @@ bool Recorder::settled() {
 
 void Recorder::abandon() {
   releases_.clear();
-  paramChunks_.clear();
+  params_.chunks.clear();
+  staging_.chunks.clear();
   descriptorPools_.clear();
   queryPools_.clear();
   fence_ = VK_NULL_HANDLE;
@@ -64,13 +73,15 @@ void Recorder::destroy() {
   const Api& api = device_.api();
   VkDevice dev = device_.handle();
   for (Allocation& a : releases_) device_.release(a);
-  for (Allocation& a : paramChunks_) device_.release(a);
+  for (Ring* ring : {&params_, &staging_})
+    for (Allocation& a : ring->chunks) device_.release(a);
   for (VkDescriptorPool p : descriptorPools_) api.vkDestroyDescriptorPool(dev, p, nullptr);
   for (VkQueryPool q : queryPools_) api.vkDestroyQueryPool(dev, q, nullptr);
   if (fence_) api.vkDestroyFence(dev, fence_, nullptr);
   if (commandPool_) api.vkDestroyCommandPool(dev, commandPool_, nullptr);   // frees the command buffer
   releases_.clear();
-  paramChunks_.clear();
+  params_.chunks.clear();
+  staging_.chunks.clear();
   descriptorPools_.clear();
   queryPools_.clear();
   fence_ = VK_NULL_HANDLE;
@@ -122,26 +133,43 @@ VkDescriptorSet Recorder::descriptorSet() {
   return set;
 }
 
-Recorder::ParamsRange Recorder::params(const void* data, size_t bytes) {
+Recorder::RingRange Recorder::params(const void* data, size_t bytes) {
   const VkPhysicalDeviceLimits& limits = device_.properties().limits;
   if (bytes > limits.maxUniformBufferRange)
     throw Error(ErrorKind::Internal, "parameter block of " + std::to_string(bytes) + " bytes exceeds the device's " +
                                          std::to_string(limits.maxUniformBufferRange) + "-byte uniform range");
-  const VkDeviceSize align = std::max<VkDeviceSize>(limits.minUniformBufferOffsetAlignment, 16);
-  paramOffset_ = (paramOffset_ + align - 1) / align * align;
-  // Move to the next chunk (allocating it the first time) when this one is full.
-  while (paramChunk_ < paramChunks_.size() && paramOffset_ + bytes > paramChunks_[paramChunk_].size) {
-    ++paramChunk_;
-    paramOffset_ = 0;
+  return take(params_, data, bytes, std::max<VkDeviceSize>(limits.minUniformBufferOffsetAlignment, 16));
+}
+
+Recorder::RingRange Recorder::staging(const void* data, uint64_t bytes) { return take(staging_, data, bytes, 16); }
+
+Recorder::RingRange Recorder::take(Ring& ring, const void* data, uint64_t bytes, VkDeviceSize align) {
+  ring.offset = (ring.offset + align - 1) / align * align;
+  // Move to the next chunk with room (allocating one when none is left).
+  while (ring.chunk < ring.chunks.size() && ring.offset + bytes > ring.chunks[ring.chunk].size) {
+    ++ring.chunk;
+    ring.offset = 0;
   }
-  if (paramChunk_ == paramChunks_.size())
-    paramChunks_.push_back(device_.allocate(std::max<VkDeviceSize>(kParamChunkBytes, bytes),
-                                            VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, MemoryUse::Params));
-  Allocation& chunk = paramChunks_[paramChunk_];
-  std::memcpy(static_cast<char*>(chunk.mapped) + paramOffset_, data, bytes);
-  ParamsRange range{chunk.buffer, paramOffset_};
-  paramOffset_ += bytes;
+  if (ring.chunk == ring.chunks.size())
+    ring.chunks.push_back(device_.allocate(std::max<VkDeviceSize>(ring.chunkBytes, bytes), ring.usage, ring.use));
+  Allocation& chunk = ring.chunks[ring.chunk];
+  std::memcpy(static_cast<char*>(chunk.mapped) + ring.offset, data, bytes);
+  RingRange range{chunk.buffer, ring.offset};
+  ring.offset += bytes;
   return range;
+}
+
+// The submission that used the ring completed: its chunks are free again, those beyond `keep` freed.
+void Recorder::rewind(Ring& ring) {
+  ring.chunk = 0;
+  ring.offset = 0;
+  VkDeviceSize kept = 0;
+  size_t n = 0;
+  for (Allocation& a : ring.chunks) {
+    if (kept + a.size <= ring.keep) kept += a.size, ring.chunks[n++] = a;
+    else device_.release(a);
+  }
+  ring.chunks.resize(n);
 }
 
 // The start timestamp waits for earlier compute work, so that each record times its own dispatch.
@@ -229,8 +257,8 @@ void Recorder::recycle() {
   uint32_t poolsUsed = (setsAllocated_ + kSetsPerPool - 1) / kSetsPerPool;
   for (uint32_t i = 0; i < poolsUsed; ++i) check(api.vkResetDescriptorPool(dev, descriptorPools_[i], 0), "vkResetDescriptorPool");
   setsAllocated_ = 0;
-  paramChunk_ = 0;
-  paramOffset_ = 0;
+  rewind(params_);
+  rewind(staging_);
   labels_.clear();
   for (Allocation& a : releases_) device_.release(a);
   releases_.clear();

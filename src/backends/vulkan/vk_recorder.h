@@ -1,7 +1,7 @@
 // One submission's worth of recorded work and the transient resources it uses: the command buffer,
-// descriptor sets, the parameter-block ring, timestamp queries and staging buffers. Everything is
-// recycled in one go when the submission completes, so chunked jobs may record thousands of
-// dispatches with no per-dispatch fence or allocation. Submissions are synchronous (finish() waits),
+// descriptor sets, the rings of parameter blocks and of upload staging, timestamp queries and what is freed
+// once the work is done. Everything is recycled in one go when the submission completes, so chunked jobs
+// may record thousands of dispatches with no per-dispatch fence or allocation. Submissions are synchronous (finish() waits),
 // hence one command buffer and one fence suffice.
 #pragma once
 #include <cstdint>
@@ -35,12 +35,16 @@ class Recorder {
 
   // A descriptor set of the shared kernel layout, valid until the submission completes.
   VkDescriptorSet descriptorSet();
-  // Copies a parameter block into the ring; returns where to bind it as a uniform buffer.
-  struct ParamsRange {
+  // Where a ring put what it was given.
+  struct RingRange {
     VkBuffer buffer;
     VkDeviceSize offset;
   };
-  ParamsRange params(const void* data, size_t bytes);
+  // Copies a parameter block into its ring; returns where to bind it as a uniform buffer.
+  RingRange params(const void* data, size_t bytes);
+  // Copies an upload's bytes into host-visible staging memory, valid until the submission completes;
+  // returns the buffer and offset to copy from.
+  RingRange staging(const void* data, uint64_t bytes);
 
   // Brackets one dispatch: names its timing record and writes its timestamps when the device has them.
   void beginDispatch(std::string label);
@@ -68,9 +72,20 @@ class Recorder {
   std::vector<VkDescriptorPool> descriptorPools_;
   uint32_t setsAllocated_ = 0;   // in this submission, across pools
 
-  std::vector<Allocation> paramChunks_;
-  size_t paramChunk_ = 0;        // chunk being filled
-  VkDeviceSize paramOffset_ = 0;   // next free byte in it
+  // Host-visible memory handed out in order and rewound when a submission completes: its chunks are kept
+  // from one submission to the next (a discrete GPU's driver pins host memory at each allocation), up to
+  // `keep` bytes in all; larger ones are freed once their submission completes.
+  struct Ring {
+    VkBufferUsageFlags usage;
+    MemoryUse use;
+    VkDeviceSize chunkBytes, keep;
+    std::vector<Allocation> chunks;
+    size_t chunk = 0;          // chunk being filled
+    VkDeviceSize offset = 0;   // next free byte in it
+  };
+  RingRange take(Ring& ring, const void* data, uint64_t bytes, VkDeviceSize align);
+  void rewind(Ring& ring);
+  Ring params_, staging_;
 
   bool timestamps_ = false;
   uint64_t timestampMask_ = 0;
