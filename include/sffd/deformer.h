@@ -64,8 +64,10 @@ struct DeformOptions {
   // takes the lattice, and result() or streamResult() runs the pre-compute and the deform stage a few
   // parents at a time, each chunk's records and output freed once welded (timings() and subTriangles() are
   // then the run's; deviceOutput() is empty, patchControlPoints() throws). Knot-box clipping: the pre-compute's
-  // inputs go once it ran, the records as each chunk is deformed. Smooth and accurate: each chunk's output
-  // goes once read. A second deform(), or a second result() or streamResult(), throws an input Error.
+  // inputs go once it ran, the records as each chunk is deformed, each chunk's output once read. Accurate:
+  // deform() only takes the lattice, and the result runs the kernels a chunk at a time in one device buffer
+  // (timings() are then the run's; deviceOutput() is empty). A second deform(), or a second result() or
+  // streamResult(), throws an input Error.
   bool once = false;
 };
 

@@ -7,10 +7,13 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <optional>
 
 #include <sffd/sffd.h>
 
 #include "api/api_test_support.h"
+#include "backends/backend_test_support.h"
+#include "backends/vulkan/vk_backend.h"
 
 namespace {
 
@@ -102,6 +105,42 @@ TEST_F(StreamResult, AccurateAndFarFromTheOriginAndColoursToo) {
   o.method = Method::Smooth;
   o.edgeLength = 0.5;
   expectSameFiles(far, o);
+}
+
+// A one-shot accurate Deformer keeps no chunk on the device: its result runs the chunks one after another
+// in one buffer (before, every chunk's output was made at once: the whole output on the device). Vulkan as
+// a discrete GPU, counting its device memory allocations; the bytes are the kept Deformer's.
+TEST_F(StreamResult, AccurateOneShotRunsItsChunksInOneBuffer) {
+  setenv("SFFD_VK_STAGING", "1", 1);   // read when the device is opened
+  std::optional<Device> device;
+  try {
+    device = sffd::testing::openTestDevice("vulkan");
+  } catch (const Error& e) {
+    unsetenv("SFFD_VK_STAGING");
+    if (e.kind() != ErrorKind::Device || sffd::testing::requiredHere("vulkan")) throw;
+    GTEST_SKIP() << e.what();
+  }
+  unsetenv("SFFD_VK_STAGING");
+  DeformOptions o;
+  o.method = Method::Accurate;
+  o.tess = 2;
+  o.maxChunkElements = 20;
+  const Lattice L = twisted(mesh_);
+  Deformer kept(*device, mesh_, L, o);
+  kept.deform(L);
+  const size_t chunks = kept.deviceOutput().size();
+  ASSERT_GT(chunks, 20u);
+  const Mesh whole = kept.result();
+  o.once = true;
+  const size_t before = vk::deviceMemoryAllocations();
+  Deformer once(*device, mesh_, L, o);
+  once.deform(L);
+  EXPECT_TRUE(once.deviceOutput().empty());
+  const Mesh streamed = once.result();
+  EXPECT_LT(vk::deviceMemoryAllocations() - before, 10u);
+  EXPECT_EQ(streamed.positions, whole.positions);
+  EXPECT_EQ(streamed.triangles, whole.triangles);
+  EXPECT_GT(once.timings().deformMs, 0.0);
 }
 
 TEST_F(StreamResult, NonFiniteVertexLeavesNoFile) {

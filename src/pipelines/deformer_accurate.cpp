@@ -2,7 +2,8 @@
 // uploaded once in chunks; each deform() uploads the lattice's coefficients and runs kernels/accurate
 // (samples, control points, tessellation) into per-chunk output buffers that stay on the device
 // (per patch nv positions, all of the chunk's, then the normals from half the buffer, then the
-// chunk's corners: one storage range for the kernel, layout.h).
+// chunk's corners: one storage range for the kernel, layout.h). A one-shot run (DeformOptions::once)
+// keeps no chunk on the device: its result runs each chunk in one reused buffer as the weld takes it.
 #include <algorithm>
 #include <chrono>
 #include <memory>
@@ -24,7 +25,7 @@ class AccurateRun final : public MethodRun {
  public:
   AccurateRun(Backend& backend, const Mesh& input, const Lattice& lattice, const ResolvedOptions& r, Timings& t,
               const ProgressReporter& progress)
-      : B_(backend), input_(input), variant_(r.variant), once_(r.once) {
+      : B_(backend), input_(input), timings_(t), variant_(r.variant), once_(r.once) {
     const auto t0 = std::chrono::steady_clock::now();
     progress("clip", 0);
     job_ = makeAccurateJob(input, lattice, clipAgainstKnotBoxes(input, lattice), r.tess);
@@ -45,23 +46,25 @@ class AccurateRun final : public MethodRun {
     frame_ = accurateFrame(packed.frame, job_.degree, job_.level);   // the frame, then the patch tables
     frameBuffer_ = uploadReals(owned_, frame_.reals, variant_.f64);
     coeffs_ = uploadReals(owned_, packed.coeffs, variant_.f64);
-    const size_t ns = job_.count(), chunk = accurateChunkPatches(lim, job_, realBytes, r.maxChunkElements);
+    const size_t ns = job_.count();
+    size_t chunk = accurateChunkPatches(lim, job_, realBytes, r.maxChunkElements);
+    // One-shot: chunks of at most kOnceChunkBytes, so that the one chunk alive at a time stays small also
+    // where a binding is large (the CPU device's is its whole memory).
+    if (once_) chunk = std::max<size_t>(1, std::min(chunk, size_t(kOnceChunkBytes / ((2 * nv + SFFD_ACC_CORNER_STRIDE) * 4 * realBytes))));
     if (ns) {
       // Scratch of one chunk, shared by all: the samples, then the control points.
       patchesAt_ = uint32_t(std::min(chunk, ns) * m);
       scratch_ = makeBuffer(owned_, 2 * uint64_t(patchesAt_) * 4 * realBytes);
     }
-    const size_t cw = 4 * SFFD_ACC_CORNER_STRIDE;
     for (size_t first = 0; first < ns; first += chunk) {
       Chunk c;
       c.first = first;
       c.count = std::min(chunk, ns - first);
       c.half = alignUp(c.count * nv * 4 * realBytes, lim.storageOffsetAlignment);
-      const std::vector<unsigned char> corners = sffd::realBytes(
-          std::vector<double>(job_.corners.begin() + cw * first, job_.corners.begin() + cw * (first + c.count)), variant_.f64);
-      c.out = makeBuffer(owned_, 2 * c.half + corners.size());
-      B_.upload(c.out, 2 * c.half, corners.data(), corners.size());
       chunks_.push_back(c);
+      if (once_) continue;   // made as the result is taken (runChunk)
+      chunks_.back().out = makeBuffer(owned_, chunkBytes(c));
+      uploadCorners(chunks_.back());
       progress("prepare", 0.5 + 0.5 * double(first + c.count) / double(ns));
     }
   }
@@ -73,14 +76,9 @@ class AccurateRun final : public MethodRun {
     PackedLattice packed = packLattice(lattice);
     std::vector<unsigned char> coeffs = realBytes(packed.coeffs, variant_.f64);
     B_.upload(coeffs_, 0, coeffs.data(), coeffs.size());
-    const uint32_t r4 = variant_.f64 ? 32 : 16;
+    if (once_) return;   // the kernels run chunk by chunk as the result is taken (forEachChunk)
     for (size_t i = 0; i < chunks_.size(); ++i) {
-      const Chunk& c = chunks_[i];
-      const uint32_t normalsAt = uint32_t(c.half / r4);
-      AccurateBindings b{{SFFD_BINDING_LATTICE_COEFFS, coeffs_}, {SFFD_BINDING_LATTICE_FRAME, frameBuffer_},
-                         {SFFD_BINDING_ACC_CHUNK, c.out}, {SFFD_BINDING_ACC_SCRATCH, scratch_},
-                         normalsAt, 2 * normalsAt, patchesAt_};
-      dispatchAccurateChunk(B_, params_, variant_, job_, frame_, c.count, b);
+      runChunk(chunks_[i]);
       progress("deform", double(i + 1) / double(chunks_.size() + 1));
     }
     B_.finish();
@@ -154,9 +152,12 @@ class AccurateRun final : public MethodRun {
     std::unique_ptr<Real[]> pos(new Real[most * nv * 4]), nrm(new Real[most * nv * 4]);   // not zero-filled: overwritten
     adviseHugePages(pos.get(), most * patchBytes);
     adviseHugePages(nrm.get(), most * patchBytes);
+    BufferId shared = 0;   // once: every chunk's, in turn (the first chunk is the largest)
+    if (once_ && !chunks_.empty()) shared = makeBuffer(owned_, chunkBytes(chunks_.front()));
     for (Chunk& c : chunks_) {
       if (!c.count) continue;
       if (c.first != done) throw std::logic_error("AccurateRun: chunks out of order");
+      if (once_) c.out = shared, uploadCorners(c), runChunk(c);
       if (!c.out) throw Error(ErrorKind::Input, "the outputs were freed after one deformation (DeformOptions::once)");
       for (size_t b = 0; b < c.count; b += block) {
         const size_t n = std::min(block, c.count - b);
@@ -165,11 +166,14 @@ class AccurateRun final : public MethodRun {
         add(c.first + b, n, static_cast<const Real*>(pos.get()), static_cast<const Real*>(nrm.get()));
       }
       done += c.count;
-      if (once_) {
-        B_.destroyBuffer(c.out);
-        owned_.ids.erase(std::find(owned_.ids.begin(), owned_.ids.end(), c.out));
-        c.out = 0;
-      }
+      if (once_) c.out = 0;   // the shared buffer goes below
+    }
+    if (shared) {
+      B_.destroyBuffer(shared);
+      owned_.ids.erase(std::find(owned_.ids.begin(), owned_.ids.end(), shared));
+      std::vector<DispatchTiming> dispatches = B_.takeTimings();
+      timings_.deformMs = stageMs(dispatches, 0);
+      timings_.steps = stepsOf(dispatches);
     }
     if (done != job_.count()) throw std::logic_error("AccurateRun: chunks do not cover the sub-triangles");
   }
@@ -178,6 +182,7 @@ class AccurateRun final : public MethodRun {
 
   std::vector<OutputChunk> deviceOutput() const override {
     std::vector<OutputChunk> out;
+    if (once_) return out;   // no chunk is kept on the device
     for (const Chunk& c : chunks_) out.push_back({c.first, c.count, c.out, 0, 2 * c.half});
     return out;
   }
@@ -185,14 +190,36 @@ class AccurateRun final : public MethodRun {
  private:
   static constexpr size_t kWeldSlice = 64;   // patches a slice: their vertices in double fit the cache
   static constexpr size_t kDownloadBytes = size_t(16) << 20;   // a download's block (rounded to whole slices)
+  static constexpr uint64_t kOnceChunkBytes = uint64_t(32) << 20;   // a one-shot chunk's positions, normals and corners
   struct Chunk {
     size_t first = 0, count = 0;
     uint64_t half = 0;   // bytes from the positions to the normals, and from the normals to the corners
     BufferId out = 0;
   };
+
+  // Chunk c's bytes on the device: positions, normals, corners.
+  uint64_t chunkBytes(const Chunk& c) const { return 2 * c.half + c.count * 4 * SFFD_ACC_CORNER_STRIDE * (variant_.f64 ? 8 : 4); }
+
+  // Chunk c's sub-triangle corners into its buffer, after the normals.
+  void uploadCorners(const Chunk& c) const {
+    const size_t cw = 4 * SFFD_ACC_CORNER_STRIDE;
+    const std::vector<unsigned char> corners = sffd::realBytes(
+        std::vector<double>(job_.corners.begin() + cw * c.first, job_.corners.begin() + cw * (c.first + c.count)), variant_.f64);
+    B_.upload(c.out, 2 * c.half, corners.data(), corners.size());
+  }
+
+  // The kernels of chunk c (recorded; they run at the next finish or download).
+  void runChunk(const Chunk& c) const {
+    const uint32_t normalsAt = uint32_t(c.half / (variant_.f64 ? 32 : 16));
+    AccurateBindings b{{SFFD_BINDING_LATTICE_COEFFS, coeffs_}, {SFFD_BINDING_LATTICE_FRAME, frameBuffer_},
+                       {SFFD_BINDING_ACC_CHUNK, c.out}, {SFFD_BINDING_ACC_SCRATCH, scratch_},
+                       normalsAt, 2 * normalsAt, patchesAt_};
+    dispatchAccurateChunk(B_, params_, variant_, job_, frame_, c.count, b);
+  }
   Backend& B_;
   mutable OwnedBuffers owned_{B_};   // first: destroyed last, after everything that names its buffers
   const Mesh& input_;   // Deformer::Impl::input, which outlives the run
+  Timings& timings_;    // Deformer::Impl::timings: a one-shot run's kernels run when its result is taken
   KernelVariant variant_;
   AccurateJob job_;
   gpu::LatticeParams params_;
