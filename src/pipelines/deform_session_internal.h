@@ -18,6 +18,11 @@
 
 namespace sffd {
 
+// The most bytes of reals a streamed chunk (DeformSession::streamChunks) takes beyond the vertices, which
+// every chunk repeats: its inputs, records and outputs are all there is of the job's at a time (and what
+// estimateStreamedSmoothJob, stream_budget.h, sizes a chunk by).
+constexpr uint64_t kStreamedChunkBytes = uint64_t(8) << 20;
+
 // A pre-compute chunk's inputs: the clip kernels' two input ranges (all the vertices, then its parents'
 // and clip triangles' sections) in buffers of its own, so that no binding exceeds the device's limit;
 // pn_triangles reads the mesh's sections and writes the PN records'.
