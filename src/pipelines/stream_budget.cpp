@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <vector>
-#include <cstdio>
-#include <cstdlib>
 
 #include "kernels/clip/split_pattern_table.h"
 #include "pipelines/deform_session_internal.h"
@@ -91,11 +89,13 @@ JobEstimate estimateStreamedSmoothJob(const Mesh& mesh, const DeformSessionOptio
   const double nv = tessVertexCount(o.level), tris = tessTriangleCount(o.level), nmax = splitPatternTable().nmax();
   // A chunk's parents: each takes its slot normals, its PN record and at least one clip triangle within
   // kStreamedChunkBytes, which one parent may exceed alone (DeformSession::streamChunks).
-  uint64_t chunkParents = kStreamedChunkBytes / uint64_t((SFFD_SLOT_NORMAL_STRIDE + SFFD_PN_STRIDE + SFFD_CLIP_REAL_STRIDE) * r4) + 1;
+  uint64_t chunkParents = kStreamedChunkBytes / uint64_t((SFFD_SLOT_NORMAL_STRIDE + SFFD_PN_STRIDE + SFFD_CLIP_REAL_STRIDE) * r4);
+  ++chunkParents;
   if (o.maxChunkParents) chunkParents = std::min<uint64_t>(chunkParents, o.maxChunkParents);
   const StreamShape s = streamShape(mesh, o.edgeLength, o.level, chunkParents);
   const bool host = deviceIsHost(device);
-  const double copies = double(meshHeldBytes(mesh) + otherMeshBytes) + kProgramBytes + (device.api == "cpu" ? 0 : kDriverBytes);
+  // Throughout: the program, a graphics driver, the mesh's copies.
+  const double always = kProgramBytes + (device.api == "cpu" ? 0 : kDriverBytes) + double(meshHeldBytes(mesh) + otherMeshBytes);
 
   // Phase 1, the creases applied to the Deformer's copy where the normals were not read (applyCreaseAngle):
   // per triangle its face normal, corner and dihedral angles, adjacency (and the sorted edge records that
@@ -114,8 +114,8 @@ JobEstimate estimateStreamedSmoothJob(const Mesh& mesh, const DeformSessionOptio
   // clip triangles (made, gathered, room to grow), packed (8 words and 36 doubles each), counts and offsets.
   const double parents = std::min(T, double(chunkParents));
   const double clips = std::min(s.chunkSubTriangles, double(kStreamedChunkBytes) / (SFFD_CLIP_REAL_STRIDE * r4) + s.parentClips);
-  const double sections = std::min(double(kStreamedChunkBytes) + (SFFD_SLOT_NORMAL_STRIDE + SFFD_PN_STRIDE + s.parentClips * SFFD_CLIP_REAL_STRIDE) * r4,
-                                   ((SFFD_SLOT_NORMAL_STRIDE + SFFD_PN_STRIDE) * parents + SFFD_CLIP_REAL_STRIDE * clips) * r4) +
+  const double perParent = (SFFD_SLOT_NORMAL_STRIDE + SFFD_PN_STRIDE) * r4, perClip = SFFD_CLIP_REAL_STRIDE * r4;
+  const double sections = std::min(double(kStreamedChunkBytes) + perParent + s.parentClips * perClip, perParent * parents + perClip * clips) +
                           3 * SFFD_SECTION_ALIGN;
   const double words = 4.0 * (double(packedTable().words.size()) + 8 * parents + 9 * clips) + 3 * SFFD_SECTION_ALIGN;
   const double inputs = 2 * V * r4 + sections + words;   // on the device: the vertex section again
@@ -133,14 +133,13 @@ JobEstimate estimateStreamedSmoothJob(const Mesh& mesh, const DeformSessionOptio
   // the job's whole output.
   const double carried = (mesh.texcoords.empty() ? 0 : 16) + (mesh.colors.empty() ? 0 : 32);
   const double slicePatches = kWeldSlicePatches, patchVertices = s.subTriangles * nv;
-  const double block = std::min(std::max(double(kSmoothDownloadBytes), slicePatches * double(sub.tess)), deformSubs * double(sub.tess));
+  const double block = std::min(std::max(double(kSmoothDownloadBytes), slicePatches * sub.tess), deformSubs * sub.tess);
   const double slice = slicePatches * (nv * (72 + 2 * carried + 60) + tris * 20);
   const double writer = std::min(4 * (kMiB + slicePatches * (nv * 400 + tris * 40)), 2 * s.subTriangles * (nv * 400 + tris * 40));
   // The weld (PatchWelder::forgetPassedLocations): between compactions up to twice the front (at least
   // kCompactAt) and a slice's; per location its record, until and number (grown: twice) and up to 8 hash
   // slots (grown twice, the old table beside the new); per vertex its normal, carried values, location,
-  // next and number (grown: twice).
-  // No more than the job's patch vertices, though.
+  // next and number (grown: twice). No more than the job's patch vertices, though.
   const double locations = std::min(patchVertices, std::max(double(PatchWelder::kCompactAt), 2 * s.frontLocations) + slicePatches * nv);
   const double vertices = std::min(patchVertices, locations + s.frontVertices);
   const double weld = locations * (2 * 40 + 8 * 32 + 4) + vertices * (2 * (36 + carried) + 4);
@@ -148,9 +147,8 @@ JobEstimate estimateStreamedSmoothJob(const Mesh& mesh, const DeformSessionOptio
   const double staging = host ? 0 : inputs + std::max(block, deformSubs * double(sub.record));
   const double stream = kept + clipHost + preImages + block + slice + writer + weld + (host ? chunkDevice : staging);
 
-  if (getenv("SFFD_DEBUG_BUDGET")) fprintf(stderr, "copies %.1f creases %.1f prepare %.1f | kept %.1f clipHost %.1f pre %.1f block %.1f slice %.1f writer %.1f weld %.1f (front %.0f %.0f loc %.0f) chunkDevice %.1f words %.1f sections %.1f staging %.1f stream %.1f chunkSubs %.0f deformSubs %.0f\n", copies/1e6, creases/1e6, prepare/1e6, kept/1e6, clipHost/1e6, preImages/1e6, block/1e6, slice/1e6, writer/1e6, weld/1e6, s.frontLocations, s.frontVertices, locations, chunkDevice/1e6, words/1e6, sections/1e6, staging/1e6, stream/1e6, s.chunkSubTriangles, deformSubs);
   JobEstimate e;
-  e.hostBytes = bytesOf(copies + std::max({creases, prepare, stream}));
+  e.hostBytes = bytesOf(always + std::max({creases, prepare, stream}));
   e.deviceBytes = bytesOf(chunkDevice);
   e.chunkVertices = bytesOf(deformSubs * nv);
   e.chunks = std::max<uint64_t>(1, (uint64_t(T) + chunkParents - 1) / chunkParents);
