@@ -1,13 +1,60 @@
 // Memory bounded before allocating (issue 12, item 4): a tiny lattice file asking for a huge lattice,
-// and a smooth job above SFFD_MEMORY_LIMIT, are refused up front with exit 2 and the estimate.
+// and a smooth job above SFFD_MEMORY_LIMIT, are refused up front with exit 2 and the estimate. A job
+// streamed from the mesh (into .ply or .stl) is estimated from what stays alive (stream_budget.h): an
+// upper bound of its peak RSS, far below the whole job's estimate.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <chrono>
+#include <cmath>
+#include <random>
+
+#include <nlohmann/json.hpp>
 
 #include "tests/support/cli_runner.h"
 
 namespace sffd::test {
 namespace {
+
+// A latitude-longitude sphere of radius 1 (tools/make_big_mesh.py's) of 4 r^2 triangles for r rings as
+// OBJ; `shuffled`: its triangles in a random order, which makes the streamed weld's front most of the mesh.
+void writeSphereObj(const fs::path& path, int rings, bool shuffled) {
+  const int lon = 2 * rings;
+  std::ofstream f(path);
+  f << "v 0 0 1\n";
+  for (int i = 1; i <= rings; ++i) {
+    const double theta = M_PI * i / (rings + 1);
+    for (int j = 0; j < lon; ++j)
+      f << "v " << std::sin(theta) * std::cos(2 * M_PI * j / lon) << ' ' << std::sin(theta) * std::sin(2 * M_PI * j / lon) << ' '
+        << std::cos(theta) << '\n';
+  }
+  f << "v 0 0 -1\n";
+  std::vector<std::array<int, 3>> t;   // 1-based
+  const int south = 2 + rings * lon;
+  auto at = [&](int ring, int j) { return 2 + (ring - 1) * lon + (j % lon); };
+  for (int j = 0; j < lon; ++j) t.push_back({1, at(1, j), at(1, j + 1)});
+  for (int i = 1; i < rings; ++i)
+    for (int j = 0; j < lon; ++j) t.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)}), t.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+  for (int j = 0; j < lon; ++j) t.push_back({south, at(rings, j + 1), at(rings, j)});
+  if (shuffled) std::shuffle(t.begin(), t.end(), std::mt19937(3));
+  for (const auto& c : t) f << "f " << c[0] << ' ' << c[1] << ' ' << c[2] << '\n';
+}
+
+nlohmann::json statsOf(const fs::path& path) { return nlohmann::json::parse(slurp(path)); }
+
+// The bytes of "needs about 1.50 GiB" in a refusal (0 when it has none).
+double estimateIn(const std::string& err) {
+  const size_t at = err.find("needs about ");
+  if (at == std::string::npos) return 0;
+  std::istringstream in(err.substr(at + 12));
+  double v = 0;
+  std::string unit;
+  in >> v >> unit;
+  const std::vector<std::string> units = {"bytes", "KiB", "MiB", "GiB", "TiB"};
+  const size_t u = size_t(std::find(units.begin(), units.end(), unit) - units.begin());
+  return v * std::pow(1024.0, double(u));
+}
 
 const char* kBigLattice = R"({"format":"sffd-lattice","version":1,"degree":[2,2,2],"counts":[256,256,256],
   "box":{"min":[-1,-1,-1],"max":[1,1,1]}})";
@@ -57,6 +104,76 @@ TEST(MemoryLimit, SmoothJobAboveTheLimitIsRefusedWithTheEstimate) {
   RunResult bad = runSffd("deform " + box + " -l " + lattice + " --backend cpu -o " + (dir / "p.obj").string(), "SFFD_MEMORY_LIMIT=lots");
   EXPECT_EQ(bad.status, 2) << bad.err;
   EXPECT_NE(bad.err.find("SFFD_MEMORY_LIMIT must be a size"), std::string::npos) << bad.err;
+  fs::remove_all(dir);
+}
+
+// The streamed estimate (--stats host_memory_estimate) bounds the peak RSS: 20,000 triangles in order and
+// shuffled (the weld's front most of the mesh), at levels 3 and 8 and a shorter edge length, and a box whose
+// faces are pre-split, on the CPU device and Vulkan.
+TEST(MemoryLimit, StreamedEstimateBoundsThePeak) {
+  fs::path dir = tempDir("memory_limit_streamed_peak");
+  writeSphereObj(dir / "s.obj", 71, false);
+  writeSphereObj(dir / "t.obj", 71, true);
+  writeBoxObj(dir / "box.obj", 0, 0, 0, 0.5);
+  for (const char* m : {"s", "t", "box"})
+    ASSERT_EQ(runSffd("lattice " + (dir / m).string() + ".obj -o " + (dir / m).string() + ".json --preset twist:0.3 --quiet").status, 0);
+  struct Job {
+    const char* mesh;
+    std::string args;
+  };
+  const std::vector<Job> jobs = {{"s", "--tess 3"}, {"s", "--tess 8"}, {"s", "--tess 3 --edge-length 0.03"},
+                                 {"t", "--tess 3"}, {"t", "--tess 8"}, {"box", "--tess 3 --edge-length 0.02"}};
+  for (const char* backend : {"cpu", "vulkan"}) {
+    if (!usable(backend)) continue;
+    for (const Job& j : jobs) {
+      const std::string m = (dir / j.mesh).string();
+      RunResult r = runSffd("deform " + m + ".obj -l " + m + ".json -o " + (dir / "o.ply").string() + " --binary --backend " + backend +
+                            " --stats " + (dir / "stats.json").string() + " --quiet " + j.args);
+      ASSERT_EQ(r.status, 0) << r.err;
+      const double estimate = statsOf(dir / "stats.json")["host_memory_estimate"].get<double>(), peak = 1024.0 * double(r.maxRssKiB);
+      EXPECT_GT(peak, 8e6) << "the peak RSS was not measured";
+      EXPECT_LE(peak, estimate) << backend << " " << j.mesh << " " << j.args;
+    }
+  }
+  fs::remove_all(dir);
+}
+
+// A limit between the streamed and the whole job's estimate: the job into .ply runs under it and peaks below
+// it, into .obj (not streamed) and with knot-box clipping (not streamed) it is refused with the whole job's
+// estimate, and into .stl, whose writer keeps every output vertex, it is refused once the limit leaves no room
+// for them.
+TEST(MemoryLimit, StreamedJobRunsUnderALimitTheWholeJobsEstimateExceeds) {
+  fs::path dir = tempDir("memory_limit_streamed_limit");
+  writeSphereObj(dir / "s.obj", 100, false);   // 40,000 triangles
+  const std::string mesh = (dir / "s.obj").string(), lattice = (dir / "l.json").string();
+  ASSERT_EQ(runSffd("lattice " + mesh + " -o " + lattice + " --preset twist:0.3 --quiet").status, 0);
+  const std::string job = "deform " + mesh + " -l " + lattice + " --backend cpu --tess 3 --quiet -o ";
+  auto limited = [&](const std::string& out, const std::string& extra, double limit) {
+    return runSffd(job + (dir / out).string() + " " + extra, "SFFD_MEMORY_LIMIT=" + std::to_string(uint64_t(limit)));
+  };
+  const double whole = estimateIn(limited("o.obj", "", 1 << 20).err), knotBox = estimateIn(limited("o.ply", "--clip knot-box", 1 << 20).err);
+  const double streamed = estimateIn(limited("o.ply", "--binary", 1 << 20).err);
+  EXPECT_EQ(knotBox, whole);
+  ASSERT_GT(streamed, 0);
+  ASSERT_GT(whole, 1.5 * streamed);
+  const double limit = (streamed + whole) / 2;
+  for (const char* out : {"o.obj", "o.off"}) {
+    RunResult r = limited(out, "", limit);
+    EXPECT_EQ(r.status, 2) << r.err;
+    EXPECT_EQ(estimateIn(r.err), whole) << r.err;
+  }
+  EXPECT_EQ(estimateIn(limited("o.ply", "--clip knot-box", limit).err), whole);
+  RunResult ok = limited("o.ply", "--binary", limit);
+  EXPECT_EQ(ok.status, 0) << ok.err;
+  EXPECT_LT(1024.0 * double(ok.maxRssKiB), limit);
+  // STL: 40,000 patches of 10 vertices, 96 bytes each, more than the 1 MiB left above the estimate.
+  ok = limited("o.ply", "--binary", streamed + (1 << 20));
+  EXPECT_EQ(ok.status, 0) << ok.err;
+  RunResult stl = limited("o.stl", "--binary", streamed + (1 << 20));
+  EXPECT_EQ(stl.status, 2) << stl.err;
+  EXPECT_GE(estimateIn(stl.err), streamed + 40000.0 * 10 * 96 * 0.99) << stl.err;
+  EXPECT_NE(stl.err.find("sffd: error: the smooth job needs about "), std::string::npos) << stl.err;
+  EXPECT_FALSE(fs::exists(dir / "o.stl"));
   fs::remove_all(dir);
 }
 

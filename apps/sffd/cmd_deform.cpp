@@ -13,6 +13,7 @@
 #include <sffd/error.h>
 #include "apps/sffd/deform_job.h"
 #include "core/job_budget.h"
+#include "pipelines/deformer_internal.h"
 
 namespace sffd::cli {
 namespace {
@@ -61,8 +62,10 @@ int run(const ParsedArgs& args) {
   const bool streamed = methodOf(args.get("--method", "smooth")) != Method::Classic && !args.has("--patches") &&
                         MeshFileWriter::streams(out, {.binary = args.has("--binary")}, !job.mesh.colors.empty());
   std::unique_ptr<MeshFileWriter> writer;
-  auto writerFor = [&](const Deformer& d) -> MeshSink& {
-    writer = std::make_unique<MeshFileWriter>(out, MeshWriteOptions{.significantDigits = d.resultDigits(), .binary = args.has("--binary")});
+  auto writerFor = [&](Deformer& d) -> MeshSink& {
+    const MeshWriteOptions options{.significantDigits = d.resultDigits(), .binary = args.has("--binary")};
+    checkSinkFits(d, MeshFileWriter::heldBytesPerVertex(out, options));
+    writer = std::make_unique<MeshFileWriter>(out, options);
     return *writer;
   };
   DeformRun run = runDeformJob(args, job, device, streamed ? SinkFor(writerFor) : SinkFor());
@@ -107,6 +110,9 @@ int run(const ParsedArgs& args) {
     };
     // Smooth: the target edge length used (given, or a tenth of the mesh's largest extent); others: null.
     j["edge_length"] = run.method == "smooth" ? nlohmann::ordered_json(edgeLengthOf(args, job.mesh)) : nlohmann::ordered_json();
+    // Smooth: the host-memory estimate checked against SFFD_MEMORY_LIMIT (bytes); others: null.
+    const std::optional<JobEstimate>& estimate = run.deformer.internal().estimate;
+    j["host_memory_estimate"] = estimate ? nlohmann::ordered_json(estimate->hostBytes) : nlohmann::ordered_json();
     // --split: the deform steps (deform.sample, ...), which the fused kernel does not have.
     if (args.has("--split"))
       for (const auto& [step, ms] : t.steps)

@@ -89,6 +89,14 @@ DeformRun runMethod(const ParsedArgs& args, Job& job, Device& device, Method met
   return run;
 }
 
+void checkSinkFits(Deformer& deformer, size_t bytesPerVertex) {
+  const Deformer::Impl& I = deformer.internal();
+  if (!I.wholeEstimate || !bytesPerVertex) return;   // not streamed, or a sink that keeps nothing per vertex
+  JobEstimate e = *I.estimate;
+  e.hostBytes += e.outputVertices * bytesPerVertex;
+  checkHostFits(e, memoryLimitFromEnvironment(), "SFFD_MEMORY_LIMIT", "smooth job");
+}
+
 DeformRun runDeformJob(const ParsedArgs& args, Job& job, Device& device, const SinkFor& sinkFor) {
   const std::string warnings[] = {foldWarning(checkLatticeFold(packLattice(job.lattice)), job.latticePath),
                                   discontinuityWarning(job.lattice, job.latticePath),

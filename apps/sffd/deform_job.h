@@ -40,10 +40,15 @@ struct DeformRun {
 // how far it is (progress_line.h).
 // Where to stream a result (Deformer::streamResult), asked once the Deformer is made (the writer's digits
 // depend on it); empty: the result is kept in DeformRun::mesh.
-using SinkFor = std::function<MeshSink&(const Deformer&)>;
+using SinkFor = std::function<MeshSink&(Deformer&)>;
 // With `sinkFor`, the result is streamed instead of kept (DeformRun::mesh stays empty), and the Deformer is
 // made for one deformation (DeformOptions::once); job.mesh is emptied while it runs (then the Deformer's).
 DeformRun runMethod(const ParsedArgs& args, Job& job, Device& device, Method method, const SinkFor& sinkFor = {});
+
+// A streamed smooth job's memory estimate (Deformer::Impl::estimate) with what its sink keeps per output
+// vertex added (MeshFileWriter::heldBytesPerVertex: an STL's positions and normals), checked against
+// SFFD_MEMORY_LIMIT before the stream starts: the input Error of the limit when it does not fit.
+void checkSinkFits(Deformer& deformer, size_t bytesPerVertex);
 
 // runMethod for --method, then the lattice's fold warning (after the work, so a job that fails prints
 // its one error line only; shown even with --quiet: it is about the result).

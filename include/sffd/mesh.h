@@ -150,6 +150,9 @@ class MeshFileWriter final : public MeshSink {
   // Whether a file of this name and these options is written as the pieces come (not gathered), for a
   // mesh with colours or without.
   static bool streams(const std::string& path, const MeshWriteOptions& options, bool colors = false);
+  // The host bytes a streaming writer of this name keeps per vertex until end(), with its arrays' growth:
+  // an .stl's positions and normals (96), a .ply's none (0).
+  static size_t heldBytesPerVertex(const std::string& path, const MeshWriteOptions& options);
 
  private:
   struct Impl;

@@ -46,6 +46,12 @@ uint64_t meshBytes(const Mesh& m, bool withPatches) {
 
 }  // namespace
 
+uint64_t meshHeldBytes(const Mesh& m) {
+  auto held = [](const auto& v) { return uint64_t(v.capacity()) * sizeof(v[0]); };
+  return held(m.positions) + held(m.normals) + held(m.weldId) + held(m.triangles) + held(m.patches) + held(m.vertexPatch) +
+         held(m.vertexUV) + held(m.texcoords) + held(m.colors) + held(m.triangleMaterial) + held(m.triangleGroup);
+}
+
 uint64_t parseByteSize(const char* s) {
   char* end = nullptr;
   double v = std::strtod(s, &end);

@@ -26,7 +26,11 @@ struct JobEstimate {
   uint64_t deviceBytes = 0;     // device memory held at once (0 on the CPU reference)
   uint64_t chunkVertices = 0;   // vertices per dispatch (the whole mesh when it fits the limits)
   uint64_t chunks = 0;
+  uint64_t outputVertices = 0;  // at most this many vertices in the result (streamed smooth: for a sink that keeps them)
 };
+
+// The bytes a Mesh's arrays hold (their capacity), carried attributes included.
+uint64_t meshHeldBytes(const Mesh& mesh);
 
 // Smooth FFD with target edge length l splits a mesh into about area / (sqrt(3)/4 l^2) sub-triangles,
 // and at least one a triangle; jobs above kMaxSubTriangles are refused.

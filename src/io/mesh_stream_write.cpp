@@ -191,4 +191,9 @@ bool MeshFileWriter::streams(const std::string& path, const MeshWriteOptions& op
   return ext == ".stl" || (ext == ".ply" && !colors);
 }
 
+size_t MeshFileWriter::heldBytesPerVertex(const std::string& path, const MeshWriteOptions& options) {
+  // Impl::held's positions and normals, appended piece by piece (a vector grows to at most twice its size).
+  return meshio::checkWriteTarget(path, options) == ".stl" ? 2 * 2 * sizeof(glm::dvec3) : 0;
+}
+
 }  // namespace sffd

@@ -39,6 +39,8 @@ struct DeformSessionOptions {
   // inputs are freed once it ran (precompute() then throws); releaseRecords() and releaseOutput() free the
   // rest as the caller reads it.
   bool once = false;
+  // Whether the session runs chunk by chunk from the mesh (DeformSession::streamed): one-shot, regular clipping.
+  bool streamed() const { return once && !knotBoxClip; }
 };
 
 // Told the stage and the fraction of the call done, at stage boundaries and after each chunk; it may
@@ -86,12 +88,12 @@ class DeformSession {
 
   // A one-shot job with regular clipping (options().once): the whole mesh is never clipped at once. After
   // deform(), streamChunks() makes the clip triangles of a few consecutive parents (their inputs beyond the
-  // vertices within deform_session.cpp's kStreamedChunkBytes, and options().maxChunkParents), uploads them, runs pn_triangles,
+  // vertices within kStreamedChunkBytes, deform_session_internal.h, and options().maxChunkParents), uploads them, runs pn_triangles,
   // clip_count and clip_write, deforms each chunk of their sub-triangles, hands its output (still on the
   // device) and its pre-images to `read`, and frees it before the next: only one chunk's records and
   // outputs exist at a time. Chunks come in order, with the same bits as a session that is not once;
   // their `first` counts from the job's first sub-triangle. Once only (then an input Error).
-  bool streamed() const { return options_.once && !options_.knotBoxClip; }
+  bool streamed() const { return options_.streamed(); }
   using ChunkReader = std::function<void(const Chunk& chunk, const SubTrianglePreImages& preImages)>;
   const SessionTimings& streamChunks(const ChunkReader& read, const StageProgress& progress = {});
   size_t precomputeChunks() const;   // the pre-compute's chunks of mesh triangles (options().maxChunkParents)

@@ -18,6 +18,14 @@
 
 namespace sffd {
 
+// The most bytes of reals a streamed chunk (DeformSession::streamChunks) takes beyond the vertices, which
+// every chunk repeats: its inputs, records and outputs are all there is of the job's at a time (and what
+// estimateStreamedSmoothJob, stream_budget.h, sizes a chunk by).
+constexpr uint64_t kStreamedChunkBytes = uint64_t(8) << 20;
+// A streamed chunk's buffers (Impl::StreamBuffer) grow by at least 1/kStreamBufferGrowth of their room, so
+// they hold up to (1 + 1/kStreamBufferGrowth) times the largest chunk's bytes.
+constexpr uint64_t kStreamBufferGrowth = 4;
+
 // A pre-compute chunk's inputs: the clip kernels' two input ranges (all the vertices, then its parents'
 // and clip triangles' sections) in buffers of its own, so that no binding exceeds the device's limit;
 // pn_triangles reads the mesh's sections and writes the PN records'.
@@ -91,15 +99,15 @@ struct DeformSession::Impl {
   struct StreamBuffer {
     BufferId id = 0;
     uint64_t room = 0;
-    // The buffer, with at least `bytes`; `fresh` says whether it was made now. It grows by a quarter at
-    // least, within the binding limit (which every chunk's ranges keep to), so that slowly growing chunks
-    // do not make it again each time.
+    // The buffer, with at least `bytes`; `fresh` says whether it was made now. It grows by a quarter
+    // (kStreamBufferGrowth) at least, within the binding limit (which every chunk's ranges keep to), so
+    // that slowly growing chunks do not make it again each time.
     BufferId atLeast(Impl& I, Backend& B, uint64_t bytes, bool* fresh = nullptr) {
       bytes = std::max<uint64_t>(bytes, 16);
       if (fresh) *fresh = bytes > room;
       if (bytes > room) {
         I.drop(B, id);   // first: the old and the new never exist at once
-        room = std::max(bytes, std::min(room + room / 4, B.info().limits.maxStorageBufferRange));
+        room = std::max(bytes, std::min(room + room / kStreamBufferGrowth, B.info().limits.maxStorageBufferRange));
         id = I.make(B, room);
       }
       return id;

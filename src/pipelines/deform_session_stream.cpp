@@ -9,13 +9,6 @@
 #include "pipelines/deform_session_internal.h"
 
 namespace sffd {
-namespace {
-
-// The most bytes of reals a streamed chunk (DeformSession::streamChunks) takes beyond the vertices, which
-// every chunk repeats: its inputs, records and outputs are all there is of the job's at a time.
-constexpr uint64_t kStreamedChunkBytes = uint64_t(8) << 20;
-
-}  // namespace
 
 const SessionTimings& DeformSession::streamChunks(const ChunkReader& read, const StageProgress& progress) {
   if (!streamed()) throw std::logic_error("DeformSession: streamChunks without options().once (regular clipping)");

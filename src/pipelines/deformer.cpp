@@ -15,6 +15,7 @@
 #include "model/mesh_topology.h"
 #include "pipelines/deform_session.h"
 #include "pipelines/deformer_internal.h"
+#include "pipelines/stream_budget.h"
 
 namespace sffd {
 
@@ -113,12 +114,24 @@ Deformer::Deformer(Device& device, const Mesh& mesh, const Lattice& lattice, con
     // Smooth FFD's pre-images index the mesh with its creases split (the error analysis needs it).
     if (!I.input.normalsFromFile) applyCreaseAngle(I.input, r.creaseAngleDeg);
     checkSubTriangleCount(I.input, r.edgeLength, "the edge length");
-    // Host and device memory before anything is allocated (docs/ROBUSTNESS.md "Limits").
+    // Host and device memory before anything is allocated (docs/ROBUSTNESS.md "Limits"): the whole job at
+    // once, or for a job streamed from the mesh what stays alive (stream_budget.h).
     const DeviceInfo& info = device.info();
-    const bool deviceIsHost = info.api == "cpu" || info.type == "cpu";
-    JobEstimate e = estimateSmoothJob(I.input, estimateSubTriangles(I.input, r.edgeLength), r.tess, r.variant.f64 ? 8 : 4, deviceIsHost);
-    e.hostBytes += estimateLatticeBytes(lattice);
-    checkHostFits(e, options.memoryLimit, kLimitName, "smooth job");
+    const uint64_t latticeBytes = estimateLatticeBytes(lattice);
+    JobEstimate whole = estimateSmoothJob(I.input, estimateSubTriangles(I.input, r.edgeLength), r.tess, r.variant.f64 ? 8 : 4,
+                                          deviceIsHost(info));
+    whole.hostBytes += latticeBytes;
+    const DeformSessionOptions session = sessionOptionsOf(r);
+    if (session.streamed()) {
+      // The caller's mesh and, where the lattice box is away from the origin, the local-frame copy.
+      const uint64_t others = meshHeldBytes(mesh) + (latticeLocalOrigin(lattice) != glm::dvec3(0.0) ? meshHeldBytes(I.input) : 0);
+      I.estimate = estimateStreamedSmoothJob(I.input, session, info, others);
+      I.estimate->hostBytes += latticeBytes;
+      I.wholeEstimate = whole;
+    } else {
+      I.estimate = whole;
+    }
+    checkHostFits(*I.estimate, options.memoryLimit, kLimitName, "smooth job");
   }
   // The devices see the mesh and the lattice relative to the lattice box (deformer_local_frame.cpp).
   I.origin = latticeLocalOrigin(lattice);
@@ -157,6 +170,8 @@ const Timings& Deformer::deform(const Lattice& lattice) {
 const Timings& Deformer::timings() const { return impl_->timings; }
 
 Mesh Deformer::result() const {
+  // A streamed job's estimate counts a sink's pieces, not the welded mesh that result() holds.
+  if (impl_->wholeEstimate) checkHostFits(*impl_->wholeEstimate, impl_->options.memoryLimit, kLimitName, "smooth job");
   ProgressReporter progress(impl_->options.progress, &impl_->device->backend());
   progress("download", 0);
   Mesh mesh = impl_->run->result(progress);

@@ -188,7 +188,7 @@ class AccurateRun final : public MethodRun {
   }
 
  private:
-  static constexpr size_t kWeldSlice = 64;   // patches a slice: their vertices in double fit the cache
+  static constexpr size_t kWeldSlice = kWeldSlicePatches;
   static constexpr size_t kDownloadBytes = size_t(16) << 20;   // a download's block (rounded to whole slices)
   static constexpr uint64_t kOnceChunkBytes = uint64_t(32) << 20;   // a one-shot chunk's positions, normals and corners
   struct Chunk {

@@ -13,6 +13,7 @@
 #include <sffd/deformer.h>
 
 #include "core/backend.h"
+#include "core/job_budget.h"
 #include "pipelines/patch_output.h"
 
 namespace sffd {
@@ -34,6 +35,12 @@ class ProgressReporter {
   double lo_ = 0, hi_ = 1;
 };
 
+// The smooth and accurate results are welded kWeldSlicePatches patches at a time (their vertices in double
+// fit the cache); the smooth run reads its tessellation from the device kSmoothDownloadBytes at a time
+// (rounded to whole slices).
+constexpr size_t kWeldSlicePatches = 64;
+constexpr size_t kSmoothDownloadBytes = size_t(4) << 20;
+
 // DeformOptions with every default resolved, as the method runs use them.
 struct ResolvedOptions {
   Method method = Method::Smooth;
@@ -48,6 +55,10 @@ struct ResolvedOptions {
   size_t maxChunkElements = 0;
   bool once = false;
 };
+
+// The DeformSession options of a smooth run (deformer_smooth.cpp): what its memory estimate reads too.
+struct DeformSessionOptions;
+DeformSessionOptions sessionOptionsOf(const ResolvedOptions& options);
 
 // One method's work on the device: the constructor prepares, deform() runs for a lattice.
 class MethodRun {
@@ -99,6 +110,9 @@ struct Deformer::Impl {
   Mesh localInput;
   Timings timings;
   std::unique_ptr<MethodRun> run;
+  // Smooth: the host-memory estimate checked against the limit (a streamed job's, stream_budget.h), and for
+  // a streamed job the whole job's (estimateSmoothJob), which result() checks before it holds the welded mesh.
+  std::optional<JobEstimate> estimate, wholeEstimate;
 };
 
 // Sums dispatch times by label in first-seen order (GPU time; a negative time counts 0).

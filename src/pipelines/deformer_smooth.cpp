@@ -20,18 +20,7 @@ class SmoothRun final : public MethodRun {
   SmoothRun(Backend& backend, const Mesh& input, const Lattice& lattice, const ResolvedOptions& r, Timings& t,
             const ProgressReporter& progress)
       : input_(input), timings_(t) {
-    DeformSessionOptions o;
-    o.variant = r.variant;
-    o.edgeLength = r.edgeLength;
-    o.level = r.tess;
-    o.samples = r.samples;
-    o.knotBoxClip = r.knotBoxClip;
-    o.split = r.split;
-    o.creaseAngleDeg = r.creaseAngleDeg;
-    o.creasesApplied = true;   // Deformer applied them to its copy of the mesh (deformer.cpp)
-    o.maxChunkSubTriangles = r.maxChunkElements;
-    o.once = r.once;
-    session_ = std::make_unique<DeformSession>(backend, input, lattice, o, progress);
+    session_ = std::make_unique<DeformSession>(backend, input, lattice, sessionOptionsOf(r), progress);
     slice_.level = r.tess;
     slice_.reserve(kWeldSlice);
     t.pnMs = session_->timings().pnMs;
@@ -186,8 +175,7 @@ class SmoothRun final : public MethodRun {
   DeformSession* session() override { return session_.get(); }
 
  private:
-  static constexpr size_t kWeldSlice = 64;   // patches a slice: their vertices in double fit the cache
-  static constexpr size_t kDownloadBytes = size_t(4) << 20;   // a download's block (rounded to whole slices)
+  static constexpr size_t kWeldSlice = kWeldSlicePatches, kDownloadBytes = kSmoothDownloadBytes;
   const Mesh& input_;   // Deformer::Impl::input, which outlives the run
   Timings& timings_;    // Deformer::Impl::timings: a streamed session's kernels run when its result is taken
   std::unique_ptr<DeformSession> session_;
@@ -199,6 +187,21 @@ class SmoothRun final : public MethodRun {
 };
 
 }  // namespace
+
+DeformSessionOptions sessionOptionsOf(const ResolvedOptions& r) {
+  DeformSessionOptions o;
+  o.variant = r.variant;
+  o.edgeLength = r.edgeLength;
+  o.level = r.tess;
+  o.samples = r.samples;
+  o.knotBoxClip = r.knotBoxClip;
+  o.split = r.split;
+  o.creaseAngleDeg = r.creaseAngleDeg;
+  o.creasesApplied = true;   // Deformer applied them to its copy of the mesh (deformer.cpp)
+  o.maxChunkSubTriangles = r.maxChunkElements;
+  o.once = r.once;
+  return o;
+}
 
 std::unique_ptr<MethodRun> makeSmoothRun(Backend& backend, const Mesh& input, const Lattice& lattice, const ResolvedOptions& r,
                                          Timings& t, const ProgressReporter& progress) {

@@ -92,8 +92,10 @@ class PatchWelder {
   // order), so a location no later parent has (a patch's inner point, a parent's inner point once the next
   // parent comes, an input edge or corner after the last triangle on it) is forgotten with its vertices,
   // now and then: what the weld holds is the front of the parents still to come, not the output so far.
-  // `compactAt`: the locations held before the first compaction (smaller only to test it).
-  void forgetPassedLocations(const Mesh& input, size_t compactAt = size_t(1) << 16);
+  // `compactAt`: the locations held before the first compaction (smaller only to test it); later ones
+  // come at twice the locations kept by the last, and never below it.
+  static constexpr size_t kCompactAt = size_t(1) << 16;
+  void forgetPassedLocations(const Mesh& input, size_t compactAt = kCompactAt);
   size_t locationsHeld() const;   // those the weld holds now
   Mesh finish();
   // finish() with the tables of `input` (materials, groups, material libraries), as a result carries them.

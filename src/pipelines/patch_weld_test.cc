@@ -4,11 +4,13 @@
 // files by their vertex indices.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <memory>
+#include <random>
 #include <set>
 #include <sstream>
 
@@ -17,6 +19,7 @@
 #include "backends/backend_test_support.h"
 #include "model/mesh.h"
 #include "pipelines/deformer_internal.h"
+#include "pipelines/stream_budget.h"
 #include "tests/support/cli_runner.h"
 
 namespace {
@@ -338,6 +341,47 @@ TEST_P(PatchWeldOf, ForgettingPassedLocationsStreamsTheSameMesh) {
   expectSameMesh(sink.m, t.whole);
   EXPECT_LT(mostHeld, t.whole.positions.size() / 2);
   EXPECT_THROW(weld.finish(), std::logic_error);
+}
+
+// The streamed job's memory estimate (stream_budget.h) bounds what the weld holds by its front: between
+// compactions twice the front at most (at least PatchWelder::kCompactAt, 1 here) and one slice. Its
+// triangles in a shuffled order make the front most of the mesh, and the bound follows.
+TEST(PatchWeld, HoldsNoMoreThanTheStreamEstimatesFront) {
+  const TwistedSphere t = twistedSphere(Method::Smooth);
+  const Mesh& input = t.deformer->internal().input;
+  const double edgeLength = t.deformer->internal().resolved.edgeLength;
+  std::vector<size_t> order(t.P.patchCount());
+  for (size_t p = 0; p < order.size(); ++p) order[p] = p;
+  const double sliceVertices = double(kWeldSlicePatches * size_t(tessVertexCount(t.P.level)));
+  for (bool shuffled : {false, true}) {
+    // A shuffled mesh's parents are numbered in the new order; its patches come sorted by them.
+    Mesh mesh = input;
+    std::vector<uint32_t> rank(input.triangles.size());
+    for (uint32_t i = 0; i < rank.size(); ++i) rank[i] = i;
+    if (shuffled) std::shuffle(rank.begin(), rank.end(), std::mt19937(5));
+    for (uint32_t i = 0; i < rank.size(); ++i) mesh.triangles[rank[i]] = input.triangles[i];
+    PatchVertices P = t.P;
+    for (uint32_t& parent : P.parent) parent = rank[parent];
+    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return P.parent[a] < P.parent[b]; });
+    PatchVertices sorted = sliceOf(P, 0, 0);
+    for (size_t p : order) {
+      const PatchVertices one = sliceOf(P, p, p + 1);
+      auto append = [](auto& to, const auto& from) { to.insert(to.end(), from.begin(), from.end()); };
+      append(sorted.parent, one.parent), append(sorted.parentWeld, one.parentWeld), append(sorted.lamParent, one.lamParent);
+      append(sorted.position, one.position), append(sorted.normal, one.normal);
+    }
+    const StreamShape shape = streamShape(mesh, edgeLength, t.P.level, 1000);
+    GatheringSink sink;
+    PatchWelder weld(P.level, P.patchCount(), &sink);
+    weld.forgetPassedLocations(mesh, 1);
+    size_t mostHeld = 0;
+    for (size_t first = 0; first < sorted.patchCount(); first += kWeldSlicePatches) {
+      weld.add(sliceOf(sorted, first, std::min(sorted.patchCount(), first + kWeldSlicePatches)));
+      mostHeld = std::max(mostHeld, weld.locationsHeld());
+    }
+    EXPECT_LE(double(mostHeld), 2 * shape.frontLocations + sliceVertices) << (shuffled ? "shuffled" : "in order");
+    EXPECT_GT(2 * double(mostHeld), shape.frontLocations) << "the bound is more than twice what the weld holds";
+  }
 }
 
 }  // namespace

@@ -1,9 +1,11 @@
 // What the end-to-end tests share: running the sffd binary, fresh temporary folders, reading files,
 // and small meshes written by the test itself (so a test needs no data file).
 #pragma once
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -19,6 +21,7 @@ namespace fs = std::filesystem;
 struct RunResult {
   int status = -1;   // exit status; 128 when the process did not exit normally (a crash)
   std::string out, err;
+  long maxRssKiB = 0;   // the peak RSS of the largest process of the run (sffd's)
 };
 
 inline std::string slurp(const fs::path& path) {
@@ -52,8 +55,18 @@ inline RunResult runSffd(const std::string& args, const std::string& env = "") {
   fs::path dir = tempDir("run" + std::to_string(serial++));
   const std::string outFile = (dir / "stdout").string(), errFile = (dir / "stderr").string();
   const std::string cmd = bounded(env + " " + SFFD_BINARY + " " + args) + " >" + outFile + " 2>" + errFile;
-  const int raw = std::system(cmd.c_str());
   RunResult r;
+  // std::system, with wait4's usage: its peak RSS is the largest of the shell's and what it waited for.
+  int raw = -1;
+  if (const pid_t pid = ::fork(); pid == 0) {
+    ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
+    ::_exit(127);
+  } else if (pid > 0) {
+    struct rusage usage {};
+    while (::wait4(pid, &raw, 0, &usage) < 0 && errno == EINTR) {
+    }
+    r.maxRssKiB = usage.ru_maxrss;
+  }
   r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : 128;
   r.out = slurp(outFile);
   r.err = slurp(errFile);
