@@ -125,7 +125,13 @@ void bindDeform(py::module_& m, DeviceFor deviceFor) {
       .def_property_readonly("sub_triangles", [](const PyDeformer& d) { return d.deformer->subTriangles(); })
       .def_property_readonly("timings", [](const PyDeformer& d) {
         const Timings& t = d.deformer->timings();
-        return py::dict("pn_ms"_a = t.pnMs, "clip_ms"_a = t.clipMs, "deform_ms"_a = t.deformMs, "wall_ms"_a = t.wallMs);
+        py::dict steps;   // the last deform()'s dispatches by label, summed over chunks
+        for (const auto& [label, ms] : t.steps) {
+          const py::str key(label);
+          steps[key] = (steps.contains(key) ? steps[key].cast<double>() : 0.0) + ms;
+        }
+        return py::dict("pn_ms"_a = t.pnMs, "clip_ms"_a = t.clipMs, "deform_ms"_a = t.deformMs, "wall_ms"_a = t.wallMs,
+                        "steps_ms"_a = steps);
       });
 
   m.def(

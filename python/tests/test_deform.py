@@ -127,6 +127,9 @@ def test_deformer_redeform_equals_fresh(sphere, method):
         for a, b in zip(again, fresh):
             np.testing.assert_array_equal(a, b)
     assert d.timings["wall_ms"] >= 0
+    steps = d.timings["steps_ms"]   # the last deform's dispatches by label
+    assert set(steps) == ({"deform"} if method == "smooth" else {"classic_ffd"}), steps
+    assert all(ms >= 0 for ms in steps.values())
     with pytest.raises(sffd.InputError, match="differ from the Deformer's"):
         d.deform(sffd.Lattice.fitted(v, counts=(4, 4, 4)))
 
