@@ -60,11 +60,10 @@ struct DeformOptions {
   size_t maxChunkElements = 0;   // 0: chunks as large as the device allows (smaller only to test chunking)
   ProgressCallback progress;     // called during long work; may be empty
   // A one-shot job, deformed and its result taken once (as `sffd deform` does): what only a repeated call
-  // needs is never kept, so a large job's peak memory is lower. Smooth with regular clipping: deform() only
-  // takes the lattice, and result() or streamResult() runs the pre-compute and the deform stage a few
-  // parents at a time, each chunk's records and output freed once welded (timings() and subTriangles() are
-  // then the run's; deviceOutput() is empty, patchControlPoints() throws). Knot-box clipping: the pre-compute's
-  // inputs go once it ran, the records as each chunk is deformed, each chunk's output once read. Accurate:
+  // needs is never kept, so a large job's peak memory is lower. Smooth (either clipping): deform() only
+  // takes the lattice, and result() or streamResult() runs the pre-compute, the clipping and the deform
+  // stage a few parents at a time, each chunk's records and output done with once welded (timings() and
+  // subTriangles() are then the run's; deviceOutput() is empty, patchControlPoints() throws). Accurate:
   // deform() only takes the lattice, and the result runs the kernels a chunk at a time in one device buffer
   // (timings() are then the run's; deviceOutput() is empty). A second deform(), or a second result() or
   // streamResult(), throws an input Error.

@@ -140,6 +140,14 @@ constexpr double kCoincident = 1e-13;
 }  // namespace
 
 std::vector<SubTriangle> clipAgainstKnotBoxes(const Mesh& mesh, const Lattice& lattice) {
+  std::vector<SubTriangle> out;
+  out.reserve(mesh.triangles.size() * 2);
+  clipAgainstKnotBoxes(mesh, lattice, 0, mesh.triangles.size(), out);
+  return out;
+}
+
+void clipAgainstKnotBoxes(const Mesh& mesh, const Lattice& lattice, size_t firstTriangle, size_t endTriangle,
+                          std::vector<SubTriangle>& out) {
   // Interior knots: the distinct values strictly inside the domain, ascending.
   std::array<std::vector<double>, 3> planes;
   for (int a = 0; a < 3; ++a) {
@@ -148,13 +156,11 @@ std::vector<SubTriangle> clipAgainstKnotBoxes(const Mesh& mesh, const Lattice& l
       if (k > lo && k < hi && (planes[a].empty() || planes[a].back() != k)) planes[a].push_back(k);
   }
 
-  std::vector<SubTriangle> out;
-  out.reserve(mesh.triangles.size() * 2);
   std::vector<Polygon> current, next;
   Polygon below, above, rest;
   std::vector<int> sides;
 
-  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+  for (size_t t = firstTriangle; t < endTriangle; ++t) {
     const auto& tri = mesh.triangles[t];
     Parent T;
     for (int c = 0; c < 3; ++c) T.p[c] = lattice.frameLinear * mesh.positions[tri[c]] + lattice.frameOffset;
@@ -226,7 +232,6 @@ std::vector<SubTriangle> clipAgainstKnotBoxes(const Mesh& mesh, const Lattice& l
         out.push_back(s);
       }
   }
-  return out;
 }
 
 }  // namespace sffd

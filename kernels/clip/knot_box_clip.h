@@ -3,6 +3,7 @@
 // into sub-triangles. The baseline that the improved (regular) clipping replaces, and the first step
 // of accurate FFD.
 #pragma once
+#include <cstddef>
 #include <vector>
 
 #include "model/lattice.h"
@@ -17,5 +18,9 @@ namespace sffd {
 // weldId, so both triangles of a shared edge produce bitwise-identical points. Degenerate fans
 // (zero area in the parameter space) are skipped.
 std::vector<SubTriangle> clipAgainstKnotBoxes(const Mesh& mesh, const Lattice& lattice);
+// The same for triangles [firstTriangle, endTriangle), appended to `out`: each triangle is clipped on its
+// own, so consecutive ranges give the whole mesh's sub-triangles in order (a streamed job's chunks).
+void clipAgainstKnotBoxes(const Mesh& mesh, const Lattice& lattice, size_t firstTriangle, size_t endTriangle,
+                          std::vector<SubTriangle>& out);
 
 }  // namespace sffd

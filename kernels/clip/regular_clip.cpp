@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <map>
+#include <stdexcept>
 
 #include "kernels/clip/clip_sites.h"
 #include <sffd/error.h>
@@ -385,15 +386,19 @@ bool siteOnEdge(SubVertexKind kind, int e) {
   return k == 3 + e;
 }
 
+// The parents' data in Real only for parents [firstParent, + parents): a streamed chunk converts its own.
 template <class Real>
-SubTriangleRecords recordsCpu(const PreparedMesh& M, const PnOutput& pn, const std::vector<SubTriangle>& subs) {
-  std::vector<Real> pos = convertReals<Real>(M.positions), nrm = convertReals<Real>(M.normals),
-                    slots(48 * M.triangleCount()), rec = convertReals<Real>(pn.records);
-  M.slotNormals(0, M.triangleCount(), slots.data());
+SubTriangleRecords recordsCpu(const PreparedMesh& M, std::span<const double> pnRecords, size_t firstParent, size_t parents,
+                              const std::vector<SubTriangle>& subs) {
+  std::vector<Real> slots(size_t(SFFD_SLOT_NORMAL_STRIDE) * 4 * parents), rec(pnRecords.size());
+  std::copy(pnRecords.begin(), pnRecords.end(), rec.begin());
+  M.slotNormals(firstParent, parents, slots.data());
   SubTriangleRecords R;
   R.headers.assign(4 * subs.size(), 0);
   R.records.assign(subs.size() * SFFD_SUB_STRIDE * 4, 0.0);
-  auto v3 = [](const std::vector<Real>& a, size_t i) { return RVec3<Real>{a[4 * i], a[4 * i + 1], a[4 * i + 2]}; };
+  // Converted as convertReals does, one vertex at a time.
+  auto v3 = [](const std::vector<double>& a, size_t i) { return RVec3<Real>{Real(a[4 * i]), Real(a[4 * i + 1]), Real(a[4 * i + 2])}; };
+  const std::vector<double>&pos = M.positions, &nrm = M.normals;
   for (size_t s = 0; s < subs.size(); ++s) {
     const SubTriangle& st = subs[s];
     ParentT<Real> par;
@@ -404,8 +409,10 @@ SubTriangleRecords recordsCpu(const PreparedMesh& M, const PnOutput& pn, const s
       par.V[c] = v3(pos, par.verts[c]);
       par.N[c] = v3(nrm, par.verts[c]);
     }
-    par.pn = &rec[size_t(st.parent) * SFFD_PN_STRIDE * 4];
-    par.slot = &slots[size_t(st.parent) * SFFD_SLOT_NORMAL_STRIDE * 4];
+    if (st.parent < firstParent || st.parent - firstParent >= parents)
+      throw std::logic_error("recordsFromSubTriangles: a sub-triangle's parent outside the given parents");
+    par.pn = &rec[size_t(st.parent - firstParent) * SFFD_PN_STRIDE * 4];
+    par.slot = &slots[size_t(st.parent - firstParent) * SFFD_SLOT_NORMAL_STRIDE * 4];
     SiteT<Real> site[3];
     SiteValueT<Real> val[3];
     for (int c = 0; c < 3; ++c) {
@@ -428,8 +435,14 @@ SubTriangleRecords recordsCpu(const PreparedMesh& M, const PnOutput& pn, const s
 
 SubTriangleRecords recordsFromSubTriangles(const PreparedMesh& mesh, const PnOutput& pn,
                                            const std::vector<SubTriangle>& subs, KernelVariant variant) {
+  return recordsFromSubTriangles(mesh, pn.records, 0, mesh.triangleCount(), subs, variant);
+}
+
+SubTriangleRecords recordsFromSubTriangles(const PreparedMesh& mesh, std::span<const double> pnRecords, size_t firstParent,
+                                           size_t parents, const std::vector<SubTriangle>& subs, KernelVariant variant) {
   auto t0 = std::chrono::steady_clock::now();
-  SubTriangleRecords R = variant.f64 ? recordsCpu<double>(mesh, pn, subs) : recordsCpu<float>(mesh, pn, subs);
+  SubTriangleRecords R = variant.f64 ? recordsCpu<double>(mesh, pnRecords, firstParent, parents, subs)
+                                     : recordsCpu<float>(mesh, pnRecords, firstParent, parents, subs);
   R.wallMs = msSince(t0);
   R.timings.push_back({"clip", R.wallMs});
   return R;

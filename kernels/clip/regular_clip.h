@@ -4,6 +4,7 @@
 // (knot_box_clip.h) into the same sub-triangle records, so both clippings feed one deform stage.
 #pragma once
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "core/backend.h"
@@ -73,6 +74,10 @@ SubTriangleRecords regularClip(Backend& backend, const PreparedMesh& mesh, const
 // Records of sub-triangles given by their parent sites (knot-box clipping), on the host (clip_sites.h).
 SubTriangleRecords recordsFromSubTriangles(const PreparedMesh& mesh, const PnOutput& pn,
                                            const std::vector<SubTriangle>& subs, KernelVariant variant);
+// The same where `subs` have parents in [firstParent, + parents) only and `pnRecords` holds those parents'
+// PN records (SFFD_PN_STRIDE real4 each, from firstParent's): what a streamed chunk has.
+SubTriangleRecords recordsFromSubTriangles(const PreparedMesh& mesh, std::span<const double> pnRecords, size_t firstParent,
+                                           size_t parents, const std::vector<SubTriangle>& subs, KernelVariant variant);
 
 // Device inputs of the clip kernels (layout.h): the clip triangles packed as headers (8 uint each) and
 // reals (SFFD_CLIP_REAL_STRIDE real4 each), and the split-pattern table packed into uint words.

@@ -103,7 +103,8 @@ void DeformSession::prepare(const Mesh& input, const Lattice& lattice, const Sta
   if (streamed()) {   // the clip triangles are made, and everything run, a chunk at a time (streamChunks)
     if (&mesh == &withCreases) I.creased = std::move(withCreases);
     I.clipSource = &mesh == &input ? &input : &I.creased;
-    I.clipBuilder = std::make_unique<ClipTriangleBuilder>(*I.clipSource, options.edgeLength, splitPatternTable().nmax());
+    if (!options.knotBoxClip)
+      I.clipBuilder = std::make_unique<ClipTriangleBuilder>(*I.clipSource, options.edgeLength, splitPatternTable().nmax());
     // The chunks read the slot normals' part of the topology (PreparedMesh::slotNormals), not the adjacency.
     freeStorage(I.mesh.topology.neighbour), freeStorage(I.mesh.topology.neighbourEdge);
     return;

@@ -34,13 +34,11 @@ struct DeformSessionOptions {
   bool creasesApplied = false;  // the mesh's normals are applyCreaseAngle's already (the Deformer's copy): not again
   size_t maxChunkSubTriangles = 0;   // 0: chunks as large as the device allows (smaller only to test chunking)
   size_t maxChunkParents = 0;        // the same for the pre-compute's chunks of mesh triangles
-  // One deformation (DeformOptions::once). Regular clipping: nothing runs before streamChunks(), which runs
-  // the pre-compute and the deform stage a chunk at a time (streamed()). Knot-box clipping: the pre-compute's
-  // inputs are freed once it ran (precompute() then throws); releaseRecords() and releaseOutput() free the
-  // rest as the caller reads it.
+  // One deformation (DeformOptions::once): nothing runs before streamChunks(), which runs the pre-compute,
+  // the clipping and the deform stage a chunk at a time (streamed()).
   bool once = false;
-  // Whether the session runs chunk by chunk from the mesh (DeformSession::streamed): one-shot, regular clipping.
-  bool streamed() const { return once && !knotBoxClip; }
+  // Whether the session runs chunk by chunk from the mesh (DeformSession::streamed): one-shot, either clipping.
+  bool streamed() const { return once; }
 };
 
 // Told the stage and the fraction of the call done, at stage boundaries and after each chunk; it may
@@ -86,12 +84,13 @@ class DeformSession {
   const std::vector<Chunk>& chunks() const { return chunks_; }   // streamed: none
   size_t subTriangles() const { return subCount_; }               // streamed: those streamed so far
 
-  // A one-shot job with regular clipping (options().once): the whole mesh is never clipped at once. After
-  // deform(), streamChunks() makes the clip triangles of a few consecutive parents (their inputs beyond the
-  // vertices within kStreamedChunkBytes, deform_session_internal.h, and options().maxChunkParents), uploads them, runs pn_triangles,
-  // clip_count and clip_write, deforms each chunk of their sub-triangles, hands its output (still on the
-  // device) and its pre-images to `read`, and frees it before the next: only one chunk's records and
-  // outputs exist at a time. Chunks come in order, with the same bits as a session that is not once;
+  // A one-shot job (options().once): the whole mesh is never clipped at once. After deform(), streamChunks()
+  // makes the clip triangles of a few consecutive parents (their inputs beyond the vertices within
+  // kStreamedChunkBytes, deform_session_internal.h, and options().maxChunkParents), uploads them, runs
+  // pn_triangles, clip_count and clip_write (knot-box clipping: pn_triangles, then the parents' knot-box
+  // sub-triangles and their records on the host, uploaded), deforms each chunk of their sub-triangles, hands
+  // its output (still on the device) and its pre-images to `read`, and is done with it before the next:
+  // only one chunk's records and outputs exist at a time. Chunks come in order, with the same bits as a session that is not once;
   // their `first` counts from the job's first sub-triangle. Once only (then an input Error).
   bool streamed() const { return options_.streamed(); }
   using ChunkReader = std::function<void(const Chunk& chunk, const SubTrianglePreImages& preImages)>;

@@ -158,19 +158,21 @@ TEST_P(DeformSessionTest, PrecomputeChunksGiveTheSameRecordsAndOutput) {
   EXPECT_EQ(vk::validationMessageCount(), 0u);
 }
 
-// A one-shot session (DeformSessionOptions::once, regular clipping) makes its clip triangles and runs
-// every stage a few parents at a time (streamChunks): in many small chunks, with pre-split parents (cube2
-// at l = 0.05), the same pre-images, tessellation and patches as a session that keeps everything.
+// A one-shot session (DeformSessionOptions::once) makes its clip triangles and runs every stage a few
+// parents at a time (streamChunks): in many small chunks, with pre-split parents (cube2 at l = 0.05) and
+// with knot-box clipping, the same pre-images, tessellation and patches as a session that keeps everything.
 TEST_P(DeformSessionTest, StreamedChunksGiveTheSameOutput) {
   SFFD_OPEN_OR_SKIP(b, GetParam());
-  for (auto [file, l] : {std::pair{"/cube2.obj", 0.05}, std::pair{"/sphere.obj", 0.3}}) {
-    SCOPED_TRACE(file);
+  for (auto [file, l, knotBox] : {std::tuple{"/cube2.obj", 0.05, false}, std::tuple{"/sphere.obj", 0.3, false},
+                                  std::tuple{"/sphere.obj", 0.3, true}, std::tuple{"/torus.obj", 0.3, true}}) {
+    SCOPED_TRACE(std::string(file) + (knotBox ? " knot-box" : ""));
     const Mesh m = readMesh(std::string(SFFD_TEST_DATA) + file);
     const Lattice A = latticeFor(m, 5, 0.1);
     DeformSessionOptions o;
     o.variant = {true, false};
     o.edgeLength = l;
     o.level = 3;
+    o.knotBoxClip = knotBox;
     DeformSession one(*b.backend, m, A, o);
     one.deform(A);
     const SmoothOutput want = one.output();

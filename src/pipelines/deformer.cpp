@@ -122,7 +122,7 @@ Deformer::Deformer(Device& device, const Mesh& mesh, const Lattice& lattice, con
                                           deviceIsHost(info));
     whole.hostBytes += latticeBytes;
     const DeformSessionOptions session = sessionOptionsOf(r);
-    if (session.streamed()) {
+    if (session.streamed() && !session.knotBoxClip) {   // stream_budget.h bounds the regular clipping's sub-triangles
       // The caller's mesh and, where the lattice box is away from the origin, the local-frame copy.
       const uint64_t others = meshHeldBytes(mesh) + (latticeLocalOrigin(lattice) != glm::dvec3(0.0) ? meshHeldBytes(I.input) : 0);
       I.estimate = estimateStreamedSmoothJob(I.input, session, info, others);
