@@ -1,7 +1,7 @@
 // Memory bounded before allocating (issue 12, item 4): a tiny lattice file asking for a huge lattice,
 // and a smooth job above SFFD_MEMORY_LIMIT, are refused up front with exit 2 and the estimate. A job
 // streamed from the mesh (into .ply or .stl) is estimated from what stays alive (stream_budget.h): an
-// upper bound of its peak RSS, far below the whole job's estimate.
+// upper bound of its peak RSS, far below the whole job's estimate; so is a one-shot accurate job's.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -173,6 +173,67 @@ TEST(MemoryLimit, StreamedJobRunsUnderALimitTheWholeJobsEstimateExceeds) {
   EXPECT_EQ(stl.status, 2) << stl.err;
   EXPECT_GE(estimateIn(stl.err), streamed + 40000.0 * 10 * 96 * 0.99) << stl.err;
   EXPECT_NE(stl.err.find("sffd: error: the smooth job needs about "), std::string::npos) << stl.err;
+  EXPECT_FALSE(fs::exists(dir / "o.stl"));
+  fs::remove_all(dir);
+}
+
+// A one-shot accurate job (into .ply: chunks run one at a time as the weld takes them) is estimated from what
+// stays alive too (estimateStreamedAccurateJob): an upper bound of its peak RSS for 20,000 triangles in order
+// and shuffled (the weld's front most of the mesh), at levels 2 to 4, on the CPU device and Vulkan.
+TEST(MemoryLimit, AccurateOneShotEstimateBoundsThePeak) {
+  fs::path dir = tempDir("memory_limit_accurate_peak");
+  writeSphereObj(dir / "s.obj", 71, false);
+  writeSphereObj(dir / "t.obj", 71, true);
+  for (const char* m : {"s", "t"})
+    ASSERT_EQ(runSffd("lattice " + (dir / m).string() + ".obj -o " + (dir / m).string() + ".json --preset twist:0.3 --quiet").status, 0);
+  for (const char* backend : {"cpu", "vulkan"}) {
+    if (!usable(backend)) continue;
+    for (const char* mesh : {"s", "t"})
+      for (int level : {2, 3, 4}) {
+        const std::string m = (dir / mesh).string();
+        RunResult r = runSffd("deform " + m + ".obj -l " + m + ".json --method accurate -o " + (dir / "o.ply").string() +
+                              " --binary --backend " + backend + " --stats " + (dir / "stats.json").string() +
+                              " --quiet --tess " + std::to_string(level));
+        ASSERT_EQ(r.status, 0) << r.err;
+        const nlohmann::json stats = statsOf(dir / "stats.json");
+        ASSERT_TRUE(stats["host_memory_estimate"].is_number()) << stats.dump();
+        const double estimate = stats["host_memory_estimate"].get<double>(), peak = 1024.0 * double(r.maxRssKiB);
+        EXPECT_GT(peak, 8e6) << "the peak RSS was not measured";
+        EXPECT_LE(peak, estimate) << backend << " " << mesh << " --tess " << level;
+      }
+  }
+  fs::remove_all(dir);
+}
+
+// A limit between the one-shot accurate estimate and the whole job's: into .ply the job runs under it and
+// peaks below it; into .obj (the result held whole: not one-shot) it is refused with the whole job's
+// estimate, and into .stl, whose writer keeps every output vertex, once the limit leaves no room for them.
+TEST(MemoryLimit, AccurateOneShotRunsUnderALimitTheWholeJobsEstimateExceeds) {
+  fs::path dir = tempDir("memory_limit_accurate_limit");
+  writeSphereObj(dir / "s.obj", 100, false);   // 40,000 triangles
+  const std::string mesh = (dir / "s.obj").string(), lattice = (dir / "l.json").string();
+  ASSERT_EQ(runSffd("lattice " + mesh + " -o " + lattice + " --preset twist:0.3 --quiet").status, 0);
+  const std::string job = "deform " + mesh + " -l " + lattice + " --method accurate --backend cpu --tess 6 --quiet -o ";
+  auto limited = [&](const std::string& out, const std::string& extra, double limit) {
+    return runSffd(job + (dir / out).string() + " " + extra, "SFFD_MEMORY_LIMIT=" + std::to_string(uint64_t(limit)));
+  };
+  const double whole = estimateIn(limited("o.obj", "", 1 << 20).err), streamed = estimateIn(limited("o.ply", "--binary", 1 << 20).err);
+  ASSERT_GT(streamed, 0);
+  ASSERT_GT(whole, 1.5 * streamed);
+  const double limit = (streamed + whole) / 2;
+  RunResult obj = limited("o.obj", "", limit);
+  EXPECT_EQ(obj.status, 2) << obj.err;
+  EXPECT_EQ(estimateIn(obj.err), whole) << obj.err;
+  EXPECT_NE(obj.err.find("sffd: error: the job needs about "), std::string::npos) << obj.err;
+  EXPECT_FALSE(fs::exists(dir / "o.obj"));
+  RunResult ok = limited("o.ply", "--binary", limit);
+  EXPECT_EQ(ok.status, 0) << ok.err;
+  EXPECT_LT(1024.0 * double(ok.maxRssKiB), limit);
+  // STL: every patch vertex (28 a patch at level 6, over 40,000 patches) 96 bytes, more than 1 MiB.
+  RunResult stl = limited("o.stl", "--binary", streamed + (1 << 20));
+  EXPECT_EQ(stl.status, 2) << stl.err;
+  EXPECT_GE(estimateIn(stl.err), streamed + 40000.0 * 28 * 96 * 0.99) << stl.err;
+  EXPECT_NE(stl.err.find("sffd: error: the job needs about "), std::string::npos) << stl.err;
   EXPECT_FALSE(fs::exists(dir / "o.stl"));
   fs::remove_all(dir);
 }

@@ -110,7 +110,7 @@ int run(const ParsedArgs& args) {
     };
     // Smooth: the target edge length used (given, or a tenth of the mesh's largest extent); others: null.
     j["edge_length"] = run.method == "smooth" ? nlohmann::ordered_json(edgeLengthOf(args, job.mesh)) : nlohmann::ordered_json();
-    // Smooth: the host-memory estimate checked against SFFD_MEMORY_LIMIT (bytes); others: null.
+    // Smooth and accurate: the host-memory estimate checked against SFFD_MEMORY_LIMIT (bytes); classic: null.
     const std::optional<JobEstimate>& estimate = run.deformer.internal().estimate;
     j["host_memory_estimate"] = estimate ? nlohmann::ordered_json(estimate->hostBytes) : nlohmann::ordered_json();
     // --split: the deform steps (deform.sample, ...), which the fused kernel does not have.

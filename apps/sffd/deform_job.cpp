@@ -94,7 +94,7 @@ void checkSinkFits(Deformer& deformer, size_t bytesPerVertex) {
   if (!I.wholeEstimate || !bytesPerVertex) return;   // not streamed, or a sink that keeps nothing per vertex
   JobEstimate e = *I.estimate;
   e.hostBytes += e.outputVertices * bytesPerVertex;
-  checkHostFits(e, memoryLimitFromEnvironment(), "SFFD_MEMORY_LIMIT", "smooth job");
+  checkEstimateFits(I, e, memoryLimitFromEnvironment(), "SFFD_MEMORY_LIMIT");
 }
 
 DeformRun runDeformJob(const ParsedArgs& args, Job& job, Device& device, const SinkFor& sinkFor) {

@@ -45,8 +45,8 @@ using SinkFor = std::function<MeshSink&(Deformer&)>;
 // made for one deformation (DeformOptions::once); job.mesh is emptied while it runs (then the Deformer's).
 DeformRun runMethod(const ParsedArgs& args, Job& job, Device& device, Method method, const SinkFor& sinkFor = {});
 
-// A streamed smooth job's memory estimate (Deformer::Impl::estimate) with what its sink keeps per output
-// vertex added (MeshFileWriter::heldBytesPerVertex: an STL's positions and normals), checked against
+// A streamed smooth or accurate job's memory estimate (Deformer::Impl::estimate) with what its sink keeps per
+// output vertex added (MeshFileWriter::heldBytesPerVertex: an STL's positions and normals), checked against
 // SFFD_MEMORY_LIMIT before the stream starts: the input Error of the limit when it does not fit.
 void checkSinkFits(Deformer& deformer, size_t bytesPerVertex);
 

@@ -123,25 +123,6 @@ void DeformSession::prepare(const Mesh& input, const Lattice& lattice, const Sta
   I.clip = {};
   if (!options.knotBoxClip) I.mesh = {};
   precompute(progress);
-  if (options.once) {   // only a repeated precompute() reads them
-    for (PreChunkInputs& c : I.pre) I.drop(backend, c.reals), I.drop(backend, c.words);
-    inputsReleased_ = true;
-  }
-}
-
-void DeformSession::requireOnce() const {
-  if (!options_.once) throw std::logic_error("DeformSession: release without options().once");
-}
-
-void DeformSession::releaseRecords() {
-  requireOnce();
-  for (Impl::ChunkBuffers& c : impl_->chunkBuffers) impl_->drop(backend_, c.headers), impl_->drop(backend_, c.records);
-  recordsReleased_ = true;
-}
-
-void DeformSession::releaseOutput(size_t chunk) {
-  requireOnce();
-  impl_->drop(backend_, chunks_.at(chunk).output);
 }
 
 size_t DeformSession::precomputeChunks() const { return impl_->pre.size(); }
@@ -151,7 +132,6 @@ DeformSession::~DeformSession() {
 }
 
 const SessionTimings& DeformSession::precompute(const StageProgress& progress) {
-  if (inputsReleased_) throw Error(ErrorKind::Input, "the pre-compute's inputs were freed (DeformOptions::once)");
   if (streamed()) throw Error(ErrorKind::Input, "a one-shot session runs its pre-compute chunk by chunk (streamChunks)");
   Impl& I = *impl_;
   Backend& B = backend_;
@@ -258,7 +238,7 @@ const SessionTimings& DeformSession::deform(const Lattice& lattice, const StageP
   Backend& B = backend_;
   if (!sameLatticeStructure(lattice, I.structure))
     throw Error(ErrorKind::Input, "the lattice's degrees, counts, knots or frame differ from the session's");
-  if (recordsReleased_) throw Error(ErrorKind::Input, "the sub-triangle records were freed after one deformation (DeformOptions::once)");
+  if (recordsReleased_) throw Error(ErrorKind::Input, "the one-shot session's chunks were already streamed (DeformOptions::once)");
   auto t0 = std::chrono::steady_clock::now();
   timings_ = {};
   PackedLattice packed = packLattice(lattice);
@@ -275,15 +255,9 @@ const SessionTimings& DeformSession::deform(const Lattice& lattice, const StageP
     const Chunk& c = chunks_[ci];
     if (!c.count) continue;
     K.deform(I.deformParams, c.count, I.fit.points, {I.coeffs, I.frame, I.chunkBuffers[ci].records, c.output});
-    if (options_.once) {   // one deformation: the records' pre-images read now, so each chunk's records go at once
-      if (!takenPreImages_) takenPreImages_.emplace(), takenPreImages_->parent.reserve(subCount_), takenPreImages_->lam.reserve(9 * subCount_);
-      readPreImages(I.chunkBuffers[ci].headers, I.chunkBuffers[ci].records, c.count, *takenPreImages_);
-      I.drop(B, I.chunkBuffers[ci].headers), I.drop(B, I.chunkBuffers[ci].records);
-    }
     if (progress) progress("deform", double(ci + 1) / double(chunks_.size() + 1));
   }
   B.finish();
-  if (options_.once) recordsReleased_ = true;
   timings_.dispatches = B.takeTimings();
   sumStages(timings_);
   timings_.wallMs = msSince(t0);
@@ -297,7 +271,6 @@ const char* const kStreamedOnly = "a one-shot session's records and outputs exis
 
 SubTriangleRecords DeformSession::records() {
   if (streamed()) throw Error(ErrorKind::Input, kStreamedOnly);
-  if (recordsReleased_) throw Error(ErrorKind::Input, "the sub-triangle records were freed after one deformation (DeformOptions::once)");
   SubTriangleRecords R;
   R.headers.resize(4 * subCount_);
   R.records.resize(subCount_ * SFFD_SUB_STRIDE * 4);
@@ -313,13 +286,7 @@ SubTriangleRecords DeformSession::records() {
 }
 
 SubTrianglePreImages DeformSession::preImages() {
-  if (takenPreImages_) {   // one deformation: read as deform() ran
-    SubTrianglePreImages P = std::move(*takenPreImages_);
-    takenPreImages_.reset();
-    return P;
-  }
   if (streamed()) throw Error(ErrorKind::Input, kStreamedOnly);
-  if (recordsReleased_) throw Error(ErrorKind::Input, "the sub-triangle records were freed after one deformation (DeformOptions::once)");
   SubTrianglePreImages P;
   P.parent.reserve(subCount_);
   P.lam.reserve(9 * subCount_);
@@ -353,7 +320,6 @@ SmoothOutput DeformSession::output() {
   out.tess.resize(subCount_ * tessReals);
   for (const Chunk& c : chunks_) {
     if (!c.count) continue;
-    if (!c.output) throw Error(ErrorKind::Input, "the outputs were freed after one deformation (DeformOptions::once)");
     downloadRealsInto(backend_, c.output, c.patchesOffset, c.count * patchReals, options_.variant.f64,
                       &out.patches[c.first * patchReals], scratch);
     downloadRealsInto(backend_, c.output, 0, c.count * tessReals, options_.variant.f64, &out.tess[c.first * tessReals], scratch);

@@ -105,11 +105,6 @@ class DeformSession {
   SubTriangleRecords records();
   SubTrianglePreImages preImages();   // what of the records the patch vertices need, a chunk at a time
   SmoothOutput output();
-  // With options().once, deform() reads each chunk's pre-images once it ran and frees its records (a second
-  // deform() and records() then throw; preImages() hands over what was read, once). releaseRecords() frees
-  // whatever records are left, releaseOutput() one chunk's output (after it was read; output() then throws).
-  void releaseRecords();
-  void releaseOutput(size_t chunk);
 
  private:
   void prepare(const Mesh& mesh, const Lattice& lattice, const StageProgress& progress);
@@ -119,11 +114,9 @@ class DeformSession {
   std::unique_ptr<Impl> impl_;
   std::vector<Chunk> chunks_;
   size_t subCount_ = 0;
-  bool inputsReleased_ = false, recordsReleased_ = false, deformed_ = false;
-  std::optional<SubTrianglePreImages> takenPreImages_;   // once: read by deform() as each chunk's records went
+  bool recordsReleased_ = false, deformed_ = false;   // streamed: the chunks were streamed; deform() ran
   // Appends the pre-images of `count` sub-triangles from their headers and records on the device.
   void readPreImages(BufferId headers, BufferId records, size_t count, SubTrianglePreImages& to);
-  void requireOnce() const;
   SessionTimings timings_;
 };
 

@@ -143,7 +143,12 @@ Deformer::Deformer(Device& device, const Mesh& mesh, const Lattice& lattice, con
   std::unique_ptr<MethodRun> local;
   if (r.method == Method::Smooth) local = makeSmoothRun(backend, localMesh, localLattice, r, I.timings, progress);
   else if (r.method == Method::Classic) local = makeClassicRun(backend, localMesh, localLattice, r, I.timings, progress);
-  else local = makeAccurateRun(backend, localMesh, localLattice, r, I.timings, progress);
+  else {
+    // Held throughout besides the run's mesh: the caller's, the Deformer's where the run has the local-frame
+    // copy, the lattice.
+    const uint64_t held = meshHeldBytes(mesh) + (moved ? meshHeldBytes(I.input) : 0) + estimateLatticeBytes(lattice);
+    local = makeAccurateRun(backend, localMesh, localLattice, r, I.timings, progress, held, I.estimate, I.wholeEstimate);
+  }
   I.run = inLocalFrame(std::move(local), I.origin);
   progress("prepare", 1);
   I.timings.wallMs = msSince(t0);
@@ -171,7 +176,7 @@ const Timings& Deformer::timings() const { return impl_->timings; }
 
 Mesh Deformer::result() const {
   // A streamed job's estimate counts a sink's pieces, not the welded mesh that result() holds.
-  if (impl_->wholeEstimate) checkHostFits(*impl_->wholeEstimate, impl_->options.memoryLimit, kLimitName, "smooth job");
+  if (impl_->wholeEstimate) checkEstimateFits(*impl_, *impl_->wholeEstimate, impl_->options.memoryLimit, kLimitName);
   ProgressReporter progress(impl_->options.progress, &impl_->device->backend());
   progress("download", 0);
   Mesh mesh = impl_->run->result(progress);
@@ -184,6 +189,11 @@ void Deformer::streamResult(MeshSink& sink) const {
   progress("download", 0);
   impl_->run->streamResult(sink, progress);
   progress("download", 1);
+}
+
+void checkEstimateFits(const Deformer::Impl& impl, const JobEstimate& estimate, uint64_t memoryLimit, const char* limitName) {
+  if (impl.resolved.method == Method::Smooth) checkHostFits(estimate, memoryLimit, limitName, "smooth job");
+  else checkJobFits(estimate, PackedLattice{}, 0, nullptr, memoryLimit, limitName);
 }
 
 void MethodRun::streamResult(MeshSink& sink, const ProgressReporter& progress) const {

@@ -17,6 +17,7 @@
 #include "kernels/clip/knot_box_clip.h"
 #include "pipelines/deformer_internal.h"
 #include "pipelines/device_reals.h"
+#include "pipelines/stream_budget.h"
 
 namespace sffd {
 namespace {
@@ -24,7 +25,8 @@ namespace {
 class AccurateRun final : public MethodRun {
  public:
   AccurateRun(Backend& backend, const Mesh& input, const Lattice& lattice, const ResolvedOptions& r, Timings& t,
-              const ProgressReporter& progress)
+              const ProgressReporter& progress, uint64_t heldBytes, std::optional<JobEstimate>& estimate,
+              std::optional<JobEstimate>& whole)
       : B_(backend), input_(input), timings_(t), variant_(r.variant), once_(r.once) {
     const auto t0 = std::chrono::steady_clock::now();
     progress("clip", 0);
@@ -35,37 +37,50 @@ class AccurateRun final : public MethodRun {
     const DeviceLimits& lim = B_.info().limits;
     const size_t realBytes = variant_.f64 ? 8 : 4;
     PackedLattice packed = packLattice(lattice);
-    // Host memory: kernel outputs (4 doubles a value), the patch vertices (9 doubles a vertex) and the
-    // welded mesh (about 8 doubles and a hash entry a vertex), per tessellation vertex.
-    const uint64_t nv = uint64_t(tessVertexCount(job_.level)), m = uint64_t(triangleControlPoints(job_.degree));
-    JobEstimate est;
-    est.hostBytes = job_.count() * (nv * (8 + 9 + 8) * 8 + nv * 64 + m * 32 + tessTriangleCount(job_.level) * 12);
-    checkJobFits(est, packed, realBytes, &lim, r.memoryLimit, "DeformOptions::memoryLimit");
-
-    params_ = packed.params;
     frame_ = accurateFrame(packed.frame, job_.degree, job_.level);   // the frame, then the patch tables
-    frameBuffer_ = uploadReals(owned_, frame_.reals, variant_.f64);
-    coeffs_ = uploadReals(owned_, packed.coeffs, variant_.f64);
-    const size_t ns = job_.count();
+    const size_t ns = job_.count(), nv = size_t(tessVertexCount(job_.level)), m = size_t(triangleControlPoints(job_.degree));
     size_t chunk = accurateChunkPatches(lim, job_, realBytes, r.maxChunkElements);
     // One-shot: chunks of at most kOnceChunkBytes, so that the one chunk alive at a time stays small also
     // where a binding is large (the CPU device's is its whole memory).
     if (once_) chunk = std::max<size_t>(1, std::min(chunk, size_t(kOnceChunkBytes / ((2 * nv + SFFD_ACC_CORNER_STRIDE) * 4 * realBytes))));
-    if (ns) {
-      // Scratch of one chunk, shared by all: the samples, then the control points.
-      patchesAt_ = uint32_t(std::min(chunk, ns) * m);
-      scratch_ = makeBuffer(owned_, 2 * uint64_t(patchesAt_) * 4 * realBytes);
-    }
+    // Scratch of one chunk, shared by all: the samples, then the control points.
+    patchesAt_ = uint32_t(std::min(chunk, ns) * m);
+    const uint64_t scratchBytes = 2 * uint64_t(patchesAt_) * 4 * realBytes;
     for (size_t first = 0; first < ns; first += chunk) {
       Chunk c;
       c.first = first;
       c.count = std::min(chunk, ns - first);
       c.half = alignUp(c.count * nv * 4 * realBytes, lim.storageOffsetAlignment);
       chunks_.push_back(c);
+    }
+
+    // Host memory. The whole job: kernel outputs (4 doubles a value), the patch vertices (9 doubles a
+    // vertex) and the welded mesh (about 8 doubles and a hash entry a vertex), per tessellation vertex.
+    JobEstimate all;
+    all.hostBytes = ns * (nv * (8 + 9 + 8) * 8 + nv * 64 + m * 32 + tessTriangleCount(job_.level) * 12);
+    whole.reset();
+    if (once_) {
+      // One-shot: what stays alive as the chunks run one at a time (stream_budget.h); result() holds the
+      // welded mesh, so it is checked against the whole job's.
+      AccurateStream s{&job_, realBytes, chunk, 0, frame_.reals.size() * sizeof(double)};
+      s.deviceBytes = (packed.coeffs.size() + frame_.reals.size()) * realBytes + scratchBytes +
+                      (chunks_.empty() ? 0 : chunkBytes(chunks_.front()));
+      estimate = estimateStreamedAccurateJob(input, s, B_.info(), heldBytes);
+      whole = all;
+    } else {
+      estimate = all;
+    }
+    checkJobFits(*estimate, packed, realBytes, &lim, r.memoryLimit, "DeformOptions::memoryLimit");
+
+    params_ = packed.params;
+    frameBuffer_ = uploadReals(owned_, frame_.reals, variant_.f64);
+    coeffs_ = uploadReals(owned_, packed.coeffs, variant_.f64);
+    if (ns) scratch_ = makeBuffer(owned_, scratchBytes);
+    for (Chunk& c : chunks_) {
       if (once_) continue;   // made as the result is taken (runChunk)
-      chunks_.back().out = makeBuffer(owned_, chunkBytes(c));
-      uploadCorners(chunks_.back());
-      progress("prepare", 0.5 + 0.5 * double(first + c.count) / double(ns));
+      c.out = makeBuffer(owned_, chunkBytes(c));
+      uploadCorners(c);
+      progress("prepare", 0.5 + 0.5 * double(c.first + c.count) / double(ns));
     }
   }
 
@@ -141,12 +156,12 @@ class AccurateRun final : public MethodRun {
   }
 
   // Calls add(first, count, positions, normals) for consecutive runs of patches in order, each chunk read
-  // from the device a block of at most kDownloadBytes at a time into one reused buffer each (no host copy
+  // from the device a block of at most kAccurateDownloadBytes at a time into one reused buffer each (no host copy
   // of the whole output, nor of a whole chunk).
   template <class Real, class Add>
   void forEachChunk(const Add& add) const {
     const size_t nv = size_t(tessVertexCount(job_.level)), patchBytes = nv * 4 * sizeof(Real);
-    const size_t block = std::max<size_t>(1, kDownloadBytes / (2 * patchBytes) / kWeldSlice) * kWeldSlice;   // whole weld slices
+    const size_t block = accurateBlockPatches(patchBytes);
     size_t most = 0, done = 0;
     for (const Chunk& c : chunks_) most = std::max(most, std::min(c.count, block));
     std::unique_ptr<Real[]> pos(new Real[most * nv * 4]), nrm(new Real[most * nv * 4]);   // not zero-filled: overwritten
@@ -189,8 +204,6 @@ class AccurateRun final : public MethodRun {
 
  private:
   static constexpr size_t kWeldSlice = kWeldSlicePatches;
-  static constexpr size_t kDownloadBytes = size_t(16) << 20;   // a download's block (rounded to whole slices)
-  static constexpr uint64_t kOnceChunkBytes = uint64_t(32) << 20;   // a one-shot chunk's positions, normals and corners
   struct Chunk {
     size_t first = 0, count = 0;
     uint64_t half = 0;   // bytes from the positions to the normals, and from the normals to the corners
@@ -234,8 +247,9 @@ class AccurateRun final : public MethodRun {
 }  // namespace
 
 std::unique_ptr<MethodRun> makeAccurateRun(Backend& backend, const Mesh& input, const Lattice& lattice, const ResolvedOptions& r,
-                                           Timings& t, const ProgressReporter& progress) {
-  return std::make_unique<AccurateRun>(backend, input, lattice, r, t, progress);
+                                           Timings& t, const ProgressReporter& progress, uint64_t heldBytes,
+                                           std::optional<JobEstimate>& estimate, std::optional<JobEstimate>& whole) {
+  return std::make_unique<AccurateRun>(backend, input, lattice, r, t, progress, heldBytes, estimate, whole);
 }
 
 }  // namespace sffd

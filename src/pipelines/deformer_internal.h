@@ -6,6 +6,7 @@
 //   deformer_classic.cpp   kernels/classic: vertices and normals, in per-chunk device buffers
 //   deformer_accurate.cpp  knot-box clipping (host), then kernels/accurate, in per-chunk device buffers
 #pragma once
+#include <algorithm>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -40,6 +41,15 @@ class ProgressReporter {
 // (rounded to whole slices).
 constexpr size_t kWeldSlicePatches = 64;
 constexpr size_t kSmoothDownloadBytes = size_t(4) << 20;
+// The accurate run reads a chunk kAccurateDownloadBytes at a time (rounded to whole slices); a one-shot run
+// (DeformOptions::once) runs chunks of at most kOnceChunkBytes (positions, normals and corners), one at a
+// time in one buffer: what its memory estimate counts (stream_budget.h).
+constexpr size_t kAccurateDownloadBytes = size_t(16) << 20;
+constexpr uint64_t kOnceChunkBytes = uint64_t(32) << 20;
+// The patches of one accurate download block, of `patchBytes` positions and as many normals: whole slices.
+inline size_t accurateBlockPatches(size_t patchBytes) {
+  return std::max<size_t>(1, kAccurateDownloadBytes / (2 * patchBytes) / kWeldSlicePatches) * kWeldSlicePatches;
+}
 
 // DeformOptions with every default resolved, as the method runs use them.
 struct ResolvedOptions {
@@ -86,8 +96,13 @@ std::unique_ptr<MethodRun> makeSmoothRun(Backend& backend, const Mesh& input, co
                                          const ResolvedOptions& options, Timings& timings, const ProgressReporter& progress);
 std::unique_ptr<MethodRun> makeClassicRun(Backend& backend, const Mesh& input, const Lattice& lattice,
                                           const ResolvedOptions& options, Timings& timings, const ProgressReporter& progress);
+// The accurate run checks its own memory estimate (it needs the clipping's sub-triangles) and leaves it in
+// `estimate` (a one-shot run's from what stays alive, stream_budget.h, the whole job's in `whole`);
+// `heldBytes`: what its caller holds throughout (the other copies of the mesh, the lattice's bytes).
 std::unique_ptr<MethodRun> makeAccurateRun(Backend& backend, const Mesh& input, const Lattice& lattice,
-                                           const ResolvedOptions& options, Timings& timings, const ProgressReporter& progress);
+                                           const ResolvedOptions& options, Timings& timings, const ProgressReporter& progress,
+                                           uint64_t heldBytes, std::optional<JobEstimate>& estimate,
+                                           std::optional<JobEstimate>& whole);
 
 // Computing in coordinates local to the lattice box (deformer_local_frame.cpp): the origin of a
 // lattice's local frame (0 for a box near the world origin); a mesh moved by `by`; the lattice as the
@@ -110,10 +125,14 @@ struct Deformer::Impl {
   Mesh localInput;
   Timings timings;
   std::unique_ptr<MethodRun> run;
-  // Smooth: the host-memory estimate checked against the limit (a streamed job's, stream_budget.h), and for
-  // a streamed job the whole job's (estimateSmoothJob), which result() checks before it holds the welded mesh.
+  // Smooth and accurate: the host-memory estimate checked against the limit (a streamed job's, stream_budget.h),
+  // and for a streamed job the whole job's, which result() checks before it holds the welded mesh.
   std::optional<JobEstimate> estimate, wholeEstimate;
 };
+
+// The input Error of the memory limit when `estimate` exceeds it, in the words of the Deformer's method
+// (smooth: checkHostFits's "the smooth job needs about", else checkJobFits's "the job needs about").
+void checkEstimateFits(const Deformer::Impl& impl, const JobEstimate& estimate, uint64_t memoryLimit, const char* limitName);
 
 // Sums dispatch times by label in first-seen order (GPU time; a negative time counts 0).
 std::vector<std::pair<std::string, double>> stepsOf(const std::vector<DispatchTiming>& dispatches);

@@ -61,13 +61,9 @@ class SmoothRun final : public MethodRun {
     sink.end();
   }
 
-  // The records' pre-images, downloaded once (fixed by the pre-compute). A one-shot run takes its result
-  // once: the records go from the device as soon as read, each chunk's output once welded (forEachChunk).
+  // The records' pre-images, downloaded once (fixed by the pre-compute; a one-shot session streams instead).
   const SubTrianglePreImages& preImages() const {
-    if (session_->options().once && taken_) throw Error(ErrorKind::Input, "the result was already taken (DeformOptions::once)");
-    taken_ = true;
     if (!records_) records_ = session_->preImages();
-    if (session_->options().once) session_->releaseRecords();
     return *records_;
   }
 
@@ -100,7 +96,6 @@ class SmoothRun final : public MethodRun {
     for (size_t ci = 0; ci < session_->chunks().size(); ++ci) {
       const DeformSession::Chunk& c = session_->chunks()[ci];
       weldChunk(weld, c, *records_, c.first);
-      if (session_->options().once) session_->releaseOutput(ci);
     }
   }
 
@@ -119,7 +114,6 @@ class SmoothRun final : public MethodRun {
       p.reserve(records_->size());
       for (size_t ci = 0; ci < session_->chunks().size(); ++ci) {
         append(session_->chunks()[ci], *records_, session_->chunks()[ci].first);
-        if (session_->options().once) session_->releaseOutput(ci);
       }
     }
     carryAttributes(p, input_);
@@ -143,7 +137,6 @@ class SmoothRun final : public MethodRun {
   template <class Real, class Add>
   void forEachBlock(const DeformSession::Chunk& c, Download<Real>& buffer, const Add& add) const {
     if (!c.count) return;
-    if (!c.output) throw Error(ErrorKind::Input, "the outputs were freed after one deformation (DeformOptions::once)");
     const size_t tessReals = 2 * size_t(tessVertexCount(session_->level())) * 4, patchBytes = tessReals * sizeof(Real);
     const size_t block = std::max<size_t>(1, kDownloadBytes / patchBytes / kWeldSlice) * kWeldSlice;   // whole weld slices
     Real* tess = buffer.room(std::min(block, c.count) * tessReals);
@@ -183,7 +176,6 @@ class SmoothRun final : public MethodRun {
   mutable Download<float> downloadF_;
   mutable Download<double> downloadD_;
   mutable std::optional<SubTrianglePreImages> records_;
-  mutable bool taken_ = false;   // a result was taken (DeformOptions::once allows one)
 };
 
 }  // namespace

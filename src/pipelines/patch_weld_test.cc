@@ -8,6 +8,7 @@
 #include <array>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <memory>
 #include <random>
@@ -17,6 +18,7 @@
 #include <sffd/sffd.h>
 
 #include "backends/backend_test_support.h"
+#include "kernels/clip/knot_box_clip.h"
 #include "model/mesh.h"
 #include "pipelines/deformer_internal.h"
 #include "pipelines/stream_budget.h"
@@ -343,13 +345,10 @@ TEST_P(PatchWeldOf, ForgettingPassedLocationsStreamsTheSameMesh) {
   EXPECT_THROW(weld.finish(), std::logic_error);
 }
 
-// The streamed job's memory estimate (stream_budget.h) bounds what the weld holds by its front: between
-// compactions twice the front at most (at least PatchWelder::kCompactAt, 1 here) and one slice. Its
-// triangles in a shuffled order make the front most of the mesh, and the bound follows.
-TEST(PatchWeld, HoldsNoMoreThanTheStreamEstimatesFront) {
-  const TwistedSphere t = twistedSphere(Method::Smooth);
+// What a streamed weld of t's patches holds at most, their parents renumbered by `rank` (the input's
+// triangles in a new order) and the patches sorted by them, against the front `shapeOf` that order.
+void expectFrontBounds(const TwistedSphere& t, const std::function<StreamShape(const Mesh&, const std::vector<uint32_t>&)>& shapeOf) {
   const Mesh& input = t.deformer->internal().input;
-  const double edgeLength = t.deformer->internal().resolved.edgeLength;
   std::vector<size_t> order(t.P.patchCount());
   for (size_t p = 0; p < order.size(); ++p) order[p] = p;
   const double sliceVertices = double(kWeldSlicePatches * size_t(tessVertexCount(t.P.level)));
@@ -370,7 +369,7 @@ TEST(PatchWeld, HoldsNoMoreThanTheStreamEstimatesFront) {
       append(sorted.parent, one.parent), append(sorted.parentWeld, one.parentWeld), append(sorted.lamParent, one.lamParent);
       append(sorted.position, one.position), append(sorted.normal, one.normal);
     }
-    const StreamShape shape = streamShape(mesh, edgeLength, t.P.level, 1000);
+    const StreamShape shape = shapeOf(mesh, rank);
     GatheringSink sink;
     PatchWelder weld(P.level, P.patchCount(), &sink);
     weld.forgetPassedLocations(mesh, 1);
@@ -382,6 +381,30 @@ TEST(PatchWeld, HoldsNoMoreThanTheStreamEstimatesFront) {
     EXPECT_LE(double(mostHeld), 2 * shape.frontLocations + sliceVertices) << (shuffled ? "shuffled" : "in order");
     EXPECT_GT(2 * double(mostHeld), shape.frontLocations) << "the bound is more than twice what the weld holds";
   }
+}
+
+// The streamed job's memory estimate (stream_budget.h) bounds what the weld holds by its front: between
+// compactions twice the front at most (at least PatchWelder::kCompactAt, 1 here) and one slice. Its
+// triangles in a shuffled order make the front most of the mesh, and the bound follows.
+TEST(PatchWeld, HoldsNoMoreThanTheStreamEstimatesFront) {
+  const TwistedSphere t = twistedSphere(Method::Smooth);
+  const double edgeLength = t.deformer->internal().resolved.edgeLength;
+  expectFrontBounds(t, [&](const Mesh& mesh, const std::vector<uint32_t>&) { return streamShape(mesh, edgeLength, t.P.level, 1000); });
+}
+
+// So does a one-shot accurate job's, from its knot-box sub-triangles (accurateStreamShape), their parents
+// renumbered as the patches' and sorted by them (in each parent in their order).
+TEST(PatchWeld, HoldsNoMoreThanTheAccurateEstimatesFront) {
+  const TwistedSphere t = twistedSphere(Method::Accurate);
+  const Mesh& input = t.deformer->internal().input;
+  const std::vector<SubTriangle> subs = clipAgainstKnotBoxes(input, t.deformer->internal().structure);
+  ASSERT_EQ(subs.size(), t.P.patchCount());
+  expectFrontBounds(t, [&](const Mesh& mesh, const std::vector<uint32_t>& rank) {
+    std::vector<SubTriangle> renumbered = subs;
+    for (SubTriangle& s : renumbered) s.parent = rank[s.parent];
+    std::stable_sort(renumbered.begin(), renumbered.end(), [](const SubTriangle& a, const SubTriangle& b) { return a.parent < b.parent; });
+    return accurateStreamShape(mesh, renumbered, t.P.level);
+  });
 }
 
 }  // namespace

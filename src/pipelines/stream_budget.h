@@ -1,13 +1,15 @@
 // The host memory of a one-shot smooth job with regular clipping (DeformSession::streamed: `sffd deform`
-// into a .ply or .stl). Such a job never holds all of its sub-triangles: estimateSmoothJob (job_budget.h),
-// which assumes it does, is far above what it needs (5.96 GiB for a run that peaks at 241 MB, docs/
-// PERFORMANCE.md "Scaling"). This estimate counts what stays alive, phase by phase.
+// into a .ply or .stl) and of a one-shot accurate job (AccurateRun with DeformOptions::once). Such a job
+// never holds all of its sub-triangles' output: estimateSmoothJob (job_budget.h), which assumes it does, is
+// far above what it needs (5.96 GiB for a run that peaks at 241 MB, docs/PERFORMANCE.md "Scaling"). This
+// estimate counts what stays alive, phase by phase.
 #pragma once
 #include <cstdint>
 
 #include <sffd/device.h>
 
 #include "core/job_budget.h"
+#include "kernels/accurate/accurate_patches.h"
 #include "model/mesh.h"
 #include "pipelines/deform_session.h"
 
@@ -29,6 +31,9 @@ struct StreamShape {
   double frontLocations = 0, frontVertices = 0;
 };
 StreamShape streamShape(const Mesh& mesh, double edgeLength, int level, uint64_t chunkParents);
+// The same of an accurate job's sub-triangles `subs` (in parent order) at `level`, exact where streamShape
+// bounds: the sub-triangles, and the front from where each patch's boundary lies on its parent.
+StreamShape accurateStreamShape(const Mesh& mesh, const std::vector<SubTriangle>& subs, int level);
 
 // Peak host bytes of the streamed job of `mesh` (its creases applied: the Deformer's copy), the largest of
 // three phases: the creases applied to that copy, the session's prepared mesh and topology made, and the
@@ -41,5 +46,23 @@ StreamShape streamShape(const Mesh& mesh, double edgeLength, int level, uint64_t
 // (estimateLatticeBytes) are the caller's to add.
 JobEstimate estimateStreamedSmoothJob(const Mesh& mesh, const DeformSessionOptions& options, const DeviceInfo& device,
                                       uint64_t otherMeshBytes);
+
+// A one-shot accurate run as AccurateRun makes it (deformer_accurate.cpp).
+struct AccurateStream {
+  const AccurateJob* job = nullptr;   // its sub-triangles and their corners, kept throughout
+  size_t realBytes = 8;               // of the kernel's reals
+  uint64_t chunkPatches = 1;          // sub-triangles a chunk at most (within kOnceChunkBytes)
+  uint64_t deviceBytes = 0;           // its buffers: the lattice's, the frame's, the scratch and one chunk's
+  uint64_t hostBytes = 0;             // what else it keeps on the host: the frame and its tables
+};
+
+// Peak host bytes of a one-shot accurate job of `mesh` (the run's): the larger of the clipping (its
+// sub-triangles grown: twice) and the stream (the job, the weld's per-weld-id slots, one chunk's
+// corners made for their upload, the download block, the weld's front and its slice, the writer's buffers,
+// and the device's buffers where they are host memory, else the staging of one chunk), with the program
+// and, on a graphics device, its driver. `otherMeshBytes` and outputVertices as for the smooth job's; the
+// lattice's bytes are the caller's to add.
+JobEstimate estimateStreamedAccurateJob(const Mesh& mesh, const AccurateStream& run, const DeviceInfo& device,
+                                        uint64_t otherMeshBytes);
 
 }  // namespace sffd

@@ -1,6 +1,7 @@
-// The host-memory estimate of a streamed smooth job (stream_budget.h): its sub-triangle bound holds for
-// every clipping, only a streamed job gets it, and a one-shot result() is still checked against the
-// whole job's. That it bounds the peak RSS: MemoryLimit.StreamedEstimateBoundsThePeak (tests/).
+// The host-memory estimate of a streamed smooth or one-shot accurate job (stream_budget.h): its
+// sub-triangle bound holds for every clipping, only a streamed job gets it, the accurate front counts where
+// the patches lie, and a one-shot result() is still checked against the whole job's. That it bounds the
+// peak RSS: MemoryLimit.StreamedEstimateBoundsThePeak, AccurateOneShotEstimateBoundsThePeak (tests/).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -89,21 +90,70 @@ TEST(StreamBudget, OnlyStreamedJobsGetTheStreamedEstimate) {
   EXPECT_EQ(S.estimate->hostBytes, own.hostBytes + estimateLatticeBytes(lattice));
   EXPECT_GE(S.estimate->outputVertices, 2040u * 10u);   // every patch vertex of 2,040 patches of level 3
 
+  // Accurate: its run's estimate (deformer_accurate.cpp), a kept Deformer's the whole job's, a one-shot one's
+  // from what stays alive (below the whole job's where the output is large: MemoryLimit.AccurateOneShot*),
+  // with the caller's mesh, the lattice and the device's buffers in host memory.
   DeformOptions accurate;
-  accurate.once = true;
   accurate.method = Method::Accurate;
-  EXPECT_FALSE(made(accurate)->internal().estimate);   // its own estimate, in its run (deformer_accurate.cpp)
+  const auto kept = made(accurate);
+  ASSERT_TRUE(kept->internal().estimate);
+  EXPECT_FALSE(kept->internal().wholeEstimate);
+  accurate.once = true;
+  const auto oneShot = made(accurate);
+  const Deformer::Impl& A = oneShot->internal();
+  ASSERT_TRUE(A.estimate && A.wholeEstimate);
+  EXPECT_EQ(A.wholeEstimate->hostBytes, kept->internal().estimate->hostBytes);
+  EXPECT_NE(A.estimate->hostBytes, A.wholeEstimate->hostBytes);
+  EXPECT_GT(A.estimate->hostBytes, meshHeldBytes(sphere) + estimateLatticeBytes(lattice) + A.estimate->deviceBytes);
+  EXPECT_EQ(A.estimate->outputVertices, oneShot->subTriangles() * 10u);   // every patch vertex of level 3
+}
+
+// The accurate front (accurateStreamShape) from where each patch's boundary lies: the corners and points on
+// the parents' edges held until their last parent, the rest while its parent is current. Each term counts:
+// a sub-triangle's corner on a parent corner, on a parent edge, its edge along a parent edge.
+TEST(StreamBudget, AccurateFrontCountsWhereThePatchBoundariesLie) {
+  Mesh m;
+  m.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}};
+  m.weldId = {0, 1, 2, 3};
+  m.triangles = {{0, 1, 2}, {1, 3, 2}};
+  auto sub = [](uint32_t parent, glm::dvec3 a, glm::dvec3 b, glm::dvec3 c) {
+    SubTriangle s;
+    s.parent = parent;
+    s.corners[0].lam = a, s.corners[1].lam = b, s.corners[2].lam = c;
+    return s;
+  };
+  const glm::dvec3 c0(1, 0, 0), c1(0, 1, 0), c2(0, 0, 1), mid01(0.5, 0.5, 0), mid12(0, 0.5, 0.5);
+  // Parent 0 split at the middle of its edge 0-1 (not shared) into two; parent 1 whole.
+  const std::vector<SubTriangle> subs = {sub(0, c0, mid01, c2), sub(0, mid01, c1, c2), sub(1, c0, c1, c2)};
+  for (int level : {1, 3}) {
+    const StreamShape s = accurateStreamShape(m, subs, level);
+    const double nv = tessVertexCount(level);
+    EXPECT_EQ(s.subTriangles, 3);
+    // The front is largest at parent 0: its corners (3 locations); on its edge 0-1 the level - 1 points of
+    // each half and the split point from each (2 level: counted twice, a bound), on its edges 1-2 and 2-0
+    // level - 1 each; its two patches' 2 nv points.
+    const double edgePoints = 2 * level + (level - 1) + (level - 1);
+    EXPECT_EQ(s.frontLocations, 3 + edgePoints + 2 * nv) << level;
+    // Vertices: corner 2 in both patches, corners 0 and 1 in one each.
+    EXPECT_EQ(s.frontVertices, 4 + edgePoints + 2 * nv) << level;
+  }
+  EXPECT_THROW(accurateStreamShape(m, {subs[2], subs[0]}, 1), std::logic_error);
 }
 
 // A limit between the streamed and the whole job's estimate: the one-shot Deformer is made and streams its
-// result, but result(), which holds the welded mesh, is refused before any work.
-TEST(StreamBudget, OneShotResultIsCheckedAgainstTheWholeJob) {
+// result, but result(), which holds the welded mesh, is refused before any work (smooth and accurate).
+class OneShotOf : public ::testing::TestWithParam<Method> {};
+INSTANTIATE_TEST_SUITE_P(Methods, OneShotOf, ::testing::Values(Method::Smooth, Method::Accurate),
+                         [](const ::testing::TestParamInfo<Method>& m) { return m.param == Method::Smooth ? "smooth" : "accurate"; });
+
+TEST_P(OneShotOf, ResultIsCheckedAgainstTheWholeJob) {
   Device device = cpuDevice();
   const Mesh torus = testMesh("torus.obj");
   const Lattice lattice = twisted(torus);
   DeformOptions o;
+  o.method = GetParam();
   o.once = true;
-  o.tess = 6;
+  o.tess = GetParam() == Method::Smooth ? 6 : 12;
   Deformer probe(device, torus, lattice, o);
   const uint64_t streamed = probe.internal().estimate->hostBytes, whole = probe.internal().wholeEstimate->hostBytes;
   ASSERT_LT(streamed, whole);
@@ -119,7 +169,9 @@ TEST(StreamBudget, OneShotResultIsCheckedAgainstTheWholeJob) {
     ADD_FAILURE() << "result() of a one-shot job was not checked against the whole job's estimate";
   } catch (const Error& err) {
     EXPECT_EQ(err.kind(), ErrorKind::Input);
-    EXPECT_NE(std::string(err.what()).find("the smooth job needs about"), std::string::npos) << err.what();
+    EXPECT_NE(std::string(err.what()).find(GetParam() == Method::Smooth ? "the smooth job needs about" : "the job needs about"),
+              std::string::npos)
+        << err.what();
   }
 }
 
