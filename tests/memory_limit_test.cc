@@ -56,6 +56,32 @@ double estimateIn(const std::string& err) {
   return v * std::pow(1024.0, double(u));
 }
 
+// A 40,000-triangle sphere and its lattice in `dir`, deformed on the CPU device by `sffd deform ... ARGS
+// -o dir/OUT EXTRA` under SFFD_MEMORY_LIMIT=limit.
+struct LimitedJob {
+  fs::path dir;
+  std::string job;
+  LimitedJob(const fs::path& d, const std::string& args) : dir(d) {
+    writeSphereObj(dir / "s.obj", 100, false);
+    const std::string mesh = (dir / "s.obj").string(), lattice = (dir / "l.json").string();
+    EXPECT_EQ(runSffd("lattice " + mesh + " -o " + lattice + " --preset twist:0.3 --quiet").status, 0);
+    job = "deform " + mesh + " -l " + lattice + " " + args + " --backend cpu --quiet -o ";
+  }
+  RunResult operator()(const std::string& out, const std::string& extra, double limit) const {
+    return runSffd(job + (dir / out).string() + " " + extra, "SFFD_MEMORY_LIMIT=" + std::to_string(uint64_t(limit)));
+  }
+};
+
+// A run that wrote `stats` succeeded and peaked within its host_memory_estimate.
+void expectPeakWithinEstimate(const RunResult& r, const fs::path& stats, const std::string& what) {
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json j = statsOf(stats);
+  ASSERT_TRUE(j["host_memory_estimate"].is_number()) << j.dump();
+  const double estimate = j["host_memory_estimate"].get<double>(), peak = 1024.0 * double(r.maxRssKiB);
+  EXPECT_GT(peak, 8e6) << "the peak RSS was not measured";
+  EXPECT_LE(peak, estimate) << what;
+}
+
 const char* kBigLattice = R"({"format":"sffd-lattice","version":1,"degree":[2,2,2],"counts":[256,256,256],
   "box":{"min":[-1,-1,-1],"max":[1,1,1]}})";
 
@@ -129,28 +155,19 @@ TEST(MemoryLimit, StreamedEstimateBoundsThePeak) {
       const std::string m = (dir / j.mesh).string();
       RunResult r = runSffd("deform " + m + ".obj -l " + m + ".json -o " + (dir / "o.ply").string() + " --binary --backend " + backend +
                             " --stats " + (dir / "stats.json").string() + " --quiet " + j.args);
-      ASSERT_EQ(r.status, 0) << r.err;
-      const double estimate = statsOf(dir / "stats.json")["host_memory_estimate"].get<double>(), peak = 1024.0 * double(r.maxRssKiB);
-      EXPECT_GT(peak, 8e6) << "the peak RSS was not measured";
-      EXPECT_LE(peak, estimate) << backend << " " << j.mesh << " " << j.args;
+      expectPeakWithinEstimate(r, dir / "stats.json", std::string(backend) + " " + j.mesh + " " + j.args);
     }
   }
   fs::remove_all(dir);
 }
 
 // A limit between the streamed and the whole job's estimate: the job into .ply runs under it and peaks below
-// it, into .obj (not streamed) and with knot-box clipping (not streamed) it is refused with the whole job's
-// estimate, and into .stl, whose writer keeps every output vertex, it is refused once the limit leaves no room
+// it, into .obj (not streamed) and with knot-box clipping (streamed, but estimated as the whole job) it is
+// refused with the whole job's estimate, and into .stl, whose writer keeps every output vertex, it is refused once the limit leaves no room
 // for them.
 TEST(MemoryLimit, StreamedJobRunsUnderALimitTheWholeJobsEstimateExceeds) {
   fs::path dir = tempDir("memory_limit_streamed_limit");
-  writeSphereObj(dir / "s.obj", 100, false);   // 40,000 triangles
-  const std::string mesh = (dir / "s.obj").string(), lattice = (dir / "l.json").string();
-  ASSERT_EQ(runSffd("lattice " + mesh + " -o " + lattice + " --preset twist:0.3 --quiet").status, 0);
-  const std::string job = "deform " + mesh + " -l " + lattice + " --backend cpu --tess 3 --quiet -o ";
-  auto limited = [&](const std::string& out, const std::string& extra, double limit) {
-    return runSffd(job + (dir / out).string() + " " + extra, "SFFD_MEMORY_LIMIT=" + std::to_string(uint64_t(limit)));
-  };
+  const LimitedJob limited(dir, "--tess 3");
   const double whole = estimateIn(limited("o.obj", "", 1 << 20).err), knotBox = estimateIn(limited("o.ply", "--clip knot-box", 1 << 20).err);
   const double streamed = estimateIn(limited("o.ply", "--binary", 1 << 20).err);
   EXPECT_EQ(knotBox, whole);
@@ -194,12 +211,7 @@ TEST(MemoryLimit, AccurateOneShotEstimateBoundsThePeak) {
         RunResult r = runSffd("deform " + m + ".obj -l " + m + ".json --method accurate -o " + (dir / "o.ply").string() +
                               " --binary --backend " + backend + " --stats " + (dir / "stats.json").string() +
                               " --quiet --tess " + std::to_string(level));
-        ASSERT_EQ(r.status, 0) << r.err;
-        const nlohmann::json stats = statsOf(dir / "stats.json");
-        ASSERT_TRUE(stats["host_memory_estimate"].is_number()) << stats.dump();
-        const double estimate = stats["host_memory_estimate"].get<double>(), peak = 1024.0 * double(r.maxRssKiB);
-        EXPECT_GT(peak, 8e6) << "the peak RSS was not measured";
-        EXPECT_LE(peak, estimate) << backend << " " << mesh << " --tess " << level;
+        expectPeakWithinEstimate(r, dir / "stats.json", std::string(backend) + " " + mesh + " --tess " + std::to_string(level));
       }
   }
   fs::remove_all(dir);
@@ -210,13 +222,7 @@ TEST(MemoryLimit, AccurateOneShotEstimateBoundsThePeak) {
 // estimate, and into .stl, whose writer keeps every output vertex, once the limit leaves no room for them.
 TEST(MemoryLimit, AccurateOneShotRunsUnderALimitTheWholeJobsEstimateExceeds) {
   fs::path dir = tempDir("memory_limit_accurate_limit");
-  writeSphereObj(dir / "s.obj", 100, false);   // 40,000 triangles
-  const std::string mesh = (dir / "s.obj").string(), lattice = (dir / "l.json").string();
-  ASSERT_EQ(runSffd("lattice " + mesh + " -o " + lattice + " --preset twist:0.3 --quiet").status, 0);
-  const std::string job = "deform " + mesh + " -l " + lattice + " --method accurate --backend cpu --tess 6 --quiet -o ";
-  auto limited = [&](const std::string& out, const std::string& extra, double limit) {
-    return runSffd(job + (dir / out).string() + " " + extra, "SFFD_MEMORY_LIMIT=" + std::to_string(uint64_t(limit)));
-  };
+  const LimitedJob limited(dir, "--method accurate --tess 6");
   const double whole = estimateIn(limited("o.obj", "", 1 << 20).err), streamed = estimateIn(limited("o.ply", "--binary", 1 << 20).err);
   ASSERT_GT(streamed, 0);
   ASSERT_GT(whole, 1.5 * streamed);
