@@ -72,6 +72,16 @@ struct LimitedJob {
   }
 };
 
+// Into .stl, whose writer keeps every output vertex (96 bytes each), a one-shot job is refused once the limit
+// leaves no room for them above its estimate: `streamed` plus 1 MiB, less than 40,000 patches of `vertices`.
+void expectStlRefused(const LimitedJob& limited, double streamed, int vertices, const std::string& refusal) {
+  RunResult stl = limited("o.stl", "--binary", streamed + (1 << 20));
+  EXPECT_EQ(stl.status, 2) << stl.err;
+  EXPECT_GE(estimateIn(stl.err), streamed + 40000.0 * vertices * 96 * 0.99) << stl.err;
+  EXPECT_NE(stl.err.find("sffd: error: " + refusal), std::string::npos) << stl.err;
+  EXPECT_FALSE(fs::exists(limited.dir / "o.stl"));
+}
+
 // A run that wrote `stats` succeeded and peaked within its host_memory_estimate.
 void expectPeakWithinEstimate(const RunResult& r, const fs::path& stats, const std::string& what) {
   ASSERT_EQ(r.status, 0) << r.err;
@@ -183,14 +193,9 @@ TEST(MemoryLimit, StreamedJobRunsUnderALimitTheWholeJobsEstimateExceeds) {
   RunResult ok = limited("o.ply", "--binary", limit);
   EXPECT_EQ(ok.status, 0) << ok.err;
   EXPECT_LT(1024.0 * double(ok.maxRssKiB), limit);
-  // STL: 40,000 patches of 10 vertices, 96 bytes each, more than the 1 MiB left above the estimate.
   ok = limited("o.ply", "--binary", streamed + (1 << 20));
   EXPECT_EQ(ok.status, 0) << ok.err;
-  RunResult stl = limited("o.stl", "--binary", streamed + (1 << 20));
-  EXPECT_EQ(stl.status, 2) << stl.err;
-  EXPECT_GE(estimateIn(stl.err), streamed + 40000.0 * 10 * 96 * 0.99) << stl.err;
-  EXPECT_NE(stl.err.find("sffd: error: the smooth job needs about "), std::string::npos) << stl.err;
-  EXPECT_FALSE(fs::exists(dir / "o.stl"));
+  expectStlRefused(limited, streamed, 10, "the smooth job needs about ");   // 10 vertices a patch at level 3
   fs::remove_all(dir);
 }
 
@@ -235,12 +240,7 @@ TEST(MemoryLimit, AccurateOneShotRunsUnderALimitTheWholeJobsEstimateExceeds) {
   RunResult ok = limited("o.ply", "--binary", limit);
   EXPECT_EQ(ok.status, 0) << ok.err;
   EXPECT_LT(1024.0 * double(ok.maxRssKiB), limit);
-  // STL: every patch vertex (28 a patch at level 6, over 40,000 patches) 96 bytes, more than 1 MiB.
-  RunResult stl = limited("o.stl", "--binary", streamed + (1 << 20));
-  EXPECT_EQ(stl.status, 2) << stl.err;
-  EXPECT_GE(estimateIn(stl.err), streamed + 40000.0 * 28 * 96 * 0.99) << stl.err;
-  EXPECT_NE(stl.err.find("sffd: error: the job needs about "), std::string::npos) << stl.err;
-  EXPECT_FALSE(fs::exists(dir / "o.stl"));
+  expectStlRefused(limited, streamed, 28, "the job needs about ");   // 28 vertices a patch at level 6
   fs::remove_all(dir);
 }
 
