@@ -9,7 +9,8 @@
 #   devices; conform --cases default live (vulkan, gl-egl, gles, cpu) and against DUMP_DIR; bench of the
 #   teapot (first process: cold; then warm, fast and strict); five whole `deform --binary` runs per
 #   backend; strict outputs of every backend cmp'ed with the CPU's (smooth, accurate; float, double);
-#   a 1,000,000-triangle mesh at level 3 per backend (wall, peak RSS); the gtest binaries.
+#   a 1,000,000-triangle mesh at level 3 per backend, smooth (both clippings) and accurate (wall, peak RSS);
+#   the gtest binaries.
 # STEPS="conform bench whole strict big tests" (the default) picks steps.
 set -uo pipefail
 cd "$(dirname "$0")/.."
@@ -98,17 +99,21 @@ done | tee "$OUT/strict_files.txt"
 }
 
 want big && {
-step "1,000,000 triangles at level 3"
+step "1,000,000 triangles at level 3: smooth, knot-box clipping, accurate"
 python3 tools/make_big_mesh.py --triangles 1000000 "$W/big.ply" > /dev/null
 "$S" lattice "$W/big.ply" -o "$W/big.json" --preset twist:0.3 --quiet
-for b in cpu vulkan gl; do
-  python3 - "$b" "$S" deform "$W/big.ply" -l "$W/big.json" --tess 3 --backend $b -o "$W/big-$b.ply" --binary \
-    --stats "$OUT/big_$b.json" --quiet <<'PY'
+# Smooth with either clipping and accurate, each streamed chunk by chunk into the file.
+for mode in smooth knot-box accurate; do
+  case $mode in smooth) args=;; knot-box) args="--clip knot-box";; accurate) args="--method accurate";; esac
+  for b in cpu vulkan gl; do
+    python3 - "$mode $b" "$S" deform "$W/big.ply" -l "$W/big.json" --tess 3 --backend $b -o "$W/big-$b.ply" --binary \
+      $args --stats "$OUT/big_${mode}_$b.json" --quiet <<'PY'
 import resource, subprocess, sys, time
 a = time.time(); rc = subprocess.run(sys.argv[2:], timeout=300).returncode
 print("%s: exit %d, wall %.1f s, peak RSS %.0f MiB" % (sys.argv[1], rc, time.time() - a,
       resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024))
 PY
+  done
 done | tee "$OUT/big.txt"
 rm -f "$W"/big*
 }
