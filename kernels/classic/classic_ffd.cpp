@@ -74,14 +74,19 @@ size_t classicChunkVertices(const DeviceLimits& lim, size_t n, size_t realBytes,
   return std::max<size_t>(1, chunk);
 }
 
+KernelUse classicKernel(const gpu::LatticeParams& lattice, KernelVariant variant) {
+  return {"classic_ffd", forLattice(variant, lattice)};
+}
+
 void dispatchClassicFfd(Backend& backend, const gpu::LatticeParams& lattice, KernelVariant variant, size_t count,
                         const ClassicBindings& b, size_t normalsAt) {
   gpu::ClassicParams params;
   params.lattice = lattice;
   params.range = {0, uint32_t(count), uint32_t(normalsAt), 0};
   Dispatch d;
-  d.kernel = "classic_ffd";
-  d.variant = forLattice(variant, lattice);
+  const KernelUse k = classicKernel(lattice, variant);
+  d.kernel = k.kernel;
+  d.variant = k.variant;
   d.params = &params;
   d.paramsSize = sizeof(params);
   d.buffers = {b.coeffs, b.frame, b.in, b.out};

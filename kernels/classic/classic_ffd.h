@@ -34,6 +34,8 @@ size_t classicChunkVertices(const DeviceLimits& limits, size_t vertices, size_t 
 struct ClassicBindings {
   BufferBinding coeffs, frame, in, out;
 };
+// The kernel variant dispatchClassicFfd runs (Backend::precompile).
+KernelUse classicKernel(const gpu::LatticeParams& lattice, KernelVariant variant);
 void dispatchClassicFfd(Backend& backend, const gpu::LatticeParams& lattice, KernelVariant variant, size_t count,
                         const ClassicBindings& bindings, size_t normalsAt);
 

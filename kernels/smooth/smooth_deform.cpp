@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
+#include <span>
 
 #include <sffd/error.h>
 #include "kernels/pn/pn_eval.h"
@@ -104,14 +105,36 @@ uint64_t deformOutSections(gpu::DeformParams& params, uint64_t count, int level,
   return split ? samples + (SFFD_SAMPLE_FIXED + uint64_t(fitPoints)) * count : samples;
 }
 
+namespace {
+// The deform kernel, or the split's four steps, with their timing labels.
+struct DeformStep {
+  const char* kernel;
+  const char* label;
+};
+constexpr DeformStep kWholeDeform[] = {{"deform_smooth", "deform"}};
+constexpr DeformStep kSplitDeform[] = {{"deform_step_sample", "deform.sample"},
+                                       {"deform_step_fit", "deform.fit"},
+                                       {"deform_step_adjust", "deform.adjust"},
+                                       {"deform_step_tessellate", "deform.tessellate"}};
+std::span<const DeformStep> deformSteps(bool split) {
+  return split ? std::span<const DeformStep>(kSplitDeform) : std::span<const DeformStep>(kWholeDeform);
+}
+}  // namespace
+
+std::vector<KernelUse> deformKernels(const gpu::DeformParams& params, KernelVariant variant, bool split) {
+  std::vector<KernelUse> uses;
+  for (const DeformStep& step : deformSteps(split)) uses.push_back({step.kernel, forLattice(variant, params)});
+  return uses;
+}
+
 void dispatchDeform(Backend& backend, const gpu::DeformParams& params, const DeformBuffers& b, size_t count,
                     KernelVariant variant, bool split) {
   const std::vector<BufferBinding> buffers = {{SFFD_BINDING_LATTICE_COEFFS, b.coeffs}, {SFFD_BINDING_LATTICE_FRAME, b.frame},
                                               {SFFD_BINDING_DEFORM_SUB_RECORDS, b.records}, {SFFD_BINDING_DEFORM_OUT, b.out}};
-  auto dispatch = [&](const char* kernel, const char* label) {
+  for (const DeformStep& step : deformSteps(split)) {
     Dispatch d;
-    d.kernel = kernel;
-    d.label = label;
+    d.kernel = step.kernel;
+    d.label = step.label;
     d.variant = forLattice(variant, params);
     d.params = &params;
     d.paramsSize = sizeof(params);
@@ -119,14 +142,6 @@ void dispatchDeform(Backend& backend, const gpu::DeformParams& params, const Def
     gridFor(count, backend.info().limits, d.groups);
     backend.dispatch(d);
     backend.barrier();
-  };
-  if (split) {
-    dispatch("deform_step_sample", "deform.sample");
-    dispatch("deform_step_fit", "deform.fit");
-    dispatch("deform_step_adjust", "deform.adjust");
-    dispatch("deform_step_tessellate", "deform.tessellate");
-  } else {
-    dispatch("deform_smooth", "deform");
   }
 }
 

@@ -48,6 +48,8 @@ struct DeformBuffers {
 // The output range of a chunk of `count` sub-triangles (layout.h, SFFD_BINDING_DEFORM_OUT): sets
 // params.sections.z (patches) and .w (samples, with `split`); returns the range's real4 elements.
 uint64_t deformOutSections(gpu::DeformParams& params, uint64_t count, int level, int fitPoints, bool split);
+// The kernel variants dispatchDeform runs for `params`, in order (Backend::precompile).
+std::vector<KernelUse> deformKernels(const gpu::DeformParams& params, KernelVariant variant, bool split);
 void dispatchDeform(Backend& backend, const gpu::DeformParams& params, const DeformBuffers& buffers, size_t count,
                     KernelVariant variant, bool split);
 

@@ -233,9 +233,8 @@ TEST_P(BackendContract, BufferRoundTripWithOffsets) {
 }
 
 // classic_ffd in its four variants on the identity lattice; f64 is refused with a device error where
-// the device has no double-precision shaders. One timing a dispatch, taken once.
-TEST_P(BackendContract, ClassicIdentityInEveryVariant) {
-  Backend& b = backend();
+// the device has no double-precision shaders. Returns how many ran.
+size_t runClassicVariants(Backend& b) {
   size_t dispatched = 0;
   for (bool f64 : {false, true})
     for (bool strict : {false, true}) {
@@ -257,9 +256,40 @@ TEST_P(BackendContract, ClassicIdentityInEveryVariant) {
       }
       ++dispatched;
     }
+  return dispatched;
+}
+
+// One timing a dispatch, taken once.
+TEST_P(BackendContract, ClassicIdentityInEveryVariant) {
+  Backend& b = backend();
+  const size_t dispatched = runClassicVariants(b);
   b.finish();
   EXPECT_EQ(b.takeTimings().size(), dispatched);
   EXPECT_TRUE(b.takeTimings().empty());
+}
+
+// precompile is a hint: variants built ahead (Vulkan: on other threads) give the same results, and
+// what cannot be built (an unknown kernel, f64 without the feature) fails at the dispatch that needs it.
+TEST_P(BackendContract, PrecompiledVariantsBehaveAsBuiltOnFirstUse) {
+  Backend& b = backend();
+  std::vector<KernelUse> uses = {{"no_such_kernel", {}}};
+  for (bool f64 : {false, true})
+    for (bool strict : {false, true}) uses.push_back({"classic_ffd", {strict, f64}});
+  b.precompile(uses);
+  b.precompile(uses);   // again, while they may still be building
+  runClassicVariants(b);
+  ClassicJob<float> job(b, 100, 100);
+  const gpu::ClassicParams p = job.params(0, 100);
+  Dispatch d = job.dispatchOf({}, p, job.vertIn, job.vertOut);
+  d.kernel = "no_such_kernel";
+  EXPECT_EQ(errorKindOf([&] { b.dispatch(d); }), ErrorKind::Internal);
+  b.finish();
+}
+
+// Builds never asked for, a failing one among them, end with the backend (the fixture's TearDown
+// checks that Vulkan's validation saw nothing left behind).
+TEST_P(BackendContract, UnclaimedPrecompiledBuildsEndWithTheBackend) {
+  backend().precompile({{"no_such_kernel", {}}, {"classic_ffd", {}}, {"classic_ffd", {true, true}}});
 }
 
 // Ranges in the middle of one larger buffer, at aligned offsets; bad dispatches are internal errors.

@@ -46,6 +46,12 @@ struct Dispatch {
   std::string_view label;                   // names the timing record; defaults to the kernel name
 };
 
+// A kernel variant a job is going to dispatch (Backend::precompile).
+struct KernelUse {
+  std::string_view kernel;   // name in the kernel registry
+  KernelVariant variant;
+};
+
 struct DispatchTiming {
   std::string label;
   double gpuMs = -1;   // from timestamp queries (the CPU backend: the dispatch's wall time); -1 when the device has none
@@ -62,8 +68,13 @@ class Backend {
   // Waits for all work that writes the buffer, then copies it out.
   virtual void download(BufferId buffer, uint64_t offset, void* data, uint64_t bytes) = 0;
 
-  // Records (or issues) one dispatch; compiles the kernel variant on first use.
+  // Records (or issues) one dispatch; compiles the kernel variant on first use, or waits for its
+  // build that precompile started.
   virtual void dispatch(const Dispatch& d) = 0;
+  // A hint, in the order of first use: starts building these variants where the backend can do so
+  // away from the calling thread (Vulkan: pipelines on other threads while the caller prepares its
+  // inputs and runs the earlier kernels). A build's error surfaces at the dispatch that needs it.
+  virtual void precompile(const std::vector<KernelUse>& kernels) { (void)kernels; }
   // Makes the writes of earlier dispatches visible to later dispatches and transfers.
   virtual void barrier() = 0;
   // Submits everything recorded and waits for it.

@@ -85,6 +85,8 @@ void DeformSession::prepare(const Mesh& input, const Lattice& lattice, const Sta
   int s = options.samples > 0 ? options.samples : lattice.degree[0] + lattice.degree[1] + lattice.degree[2];
   I.fit = makeFitTable(std::max(3, s));
   PackedLattice packed = packLattice(lattice);
+  // The kernels build on other threads (where the backend can) while the mesh is prepared.
+  backend.precompile(SessionKernels{backend, options}.uses(deformParamsFor(packed, f64, &I.fit.data)));
   // A copy only where the creases are still to be applied.
   Mesh withCreases;
   if (!input.normalsFromFile && !options.creasesApplied) {

@@ -199,6 +199,14 @@ struct SessionKernels {
     B.dispatch(d);
     B.barrier();
   }
+  // What the session dispatches, in order of first use (Backend::precompile): the knot-box
+  // clipping runs on the host.
+  std::vector<KernelUse> uses(const gpu::DeformParams& params) const {
+    std::vector<KernelUse> k = {{"pn_triangles", o.variant}};
+    if (!o.knotBoxClip) k.insert(k.end(), {{"clip_count", o.variant}, {"clip_write", o.variant}});
+    for (const KernelUse& d : deformKernels(params, o.variant, o.split)) k.push_back(d);
+    return k;
+  }
   // The clip kernels' parameters and bindings (a pre-compute chunk's inputs), for both passes.
   gpu::ClipParams clipParams(const ClipRanges& r, size_t first, size_t count) const {
     gpu::ClipParams params;

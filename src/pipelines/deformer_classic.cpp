@@ -20,6 +20,7 @@ class ClassicRun final : public MethodRun {
     const DeviceLimits& lim = B_.info().limits;
     const size_t realBytes = variant_.f64 ? 8 : 4;
     PackedLattice packed = packLattice(lattice);
+    B_.precompile({classicKernel(packed.params, variant_)});   // while the inputs are packed
     checkJobFits(estimateClassicJob(input, packed, realBytes, &lim), packed, realBytes, &lim, r.memoryLimit,
                  "DeformOptions::memoryLimit");
     params_ = packed.params;

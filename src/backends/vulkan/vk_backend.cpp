@@ -183,6 +183,10 @@ class VulkanBackend final : public Backend {
     std::memcpy(data, downloadStaging_.mapped, bytes);
   }
 
+  void precompile(const std::vector<KernelUse>& kernels) override {
+    for (const KernelUse& k : kernels) kernels_.precompile(k.kernel, k.variant);
+  }
+
   void dispatch(const Dispatch& d) override {
     VkPipeline pipeline = kernels_.pipeline(d.kernel, d.variant);   // throws before anything is recorded
     const DeviceLimits& limits = device_.info().limits;

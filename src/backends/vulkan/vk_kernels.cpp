@@ -1,5 +1,7 @@
 #include "backends/vulkan/vk_kernels.h"
 
+#include <system_error>
+
 #include <sffd/error.h>
 #include "core/kernel_registry.h"
 #include "kernels/common/shader_layout.h"
@@ -41,6 +43,13 @@ Kernels::~Kernels() { destroy(); }
 void Kernels::destroy() {
   const Api& api = device_.api();
   VkDevice dev = device_.handle();
+  for (auto& [key, building] : building_) {
+    try {
+      pipelines_.emplace(key, building.get());
+    } catch (...) {   // a build that failed and was never asked for
+    }
+  }
+  building_.clear();
   for (auto& [key, pipeline] : pipelines_) api.vkDestroyPipeline(dev, pipeline, nullptr);
   pipelines_.clear();
   if (cache_) api.vkDestroyPipelineCache(dev, cache_, nullptr);
@@ -51,21 +60,50 @@ void Kernels::destroy() {
   setLayout_ = VK_NULL_HANDLE;
 }
 
-VkPipeline Kernels::pipeline(std::string_view kernel, KernelVariant variant) {
+Kernels::Key Kernels::keyOf(std::string_view kernel, KernelVariant& variant) const {
   variant = forDevice(variant, device_.info());
-  const int v = variantIndex(variant);
-  auto key = std::make_pair(std::string(kernel), variantKey(variant));
-  if (auto it = pipelines_.find(key); it != pipelines_.end()) return it->second;
+  return {std::string(kernel), variantKey(variant)};
+}
 
+VkPipeline Kernels::pipeline(std::string_view kernel, KernelVariant variant) {
+  Key key = keyOf(kernel, variant);
+  if (auto it = pipelines_.find(key); it != pipelines_.end()) return it->second;
+  VkPipeline pipeline = VK_NULL_HANDLE;
+  if (auto it = building_.find(key); it != building_.end()) {
+    std::future<VkPipeline> f = std::move(it->second);
+    building_.erase(it);
+    pipeline = f.get();
+  } else {
+    pipeline = build(key.first, variant);
+  }
+  pipelines_.emplace(std::move(key), pipeline);
+  return pipeline;
+}
+
+void Kernels::precompile(std::string_view kernel, KernelVariant variant) {
+  Key key = keyOf(kernel, variant);
+  if (pipelines_.count(key) || building_.count(key)) return;
+  // vkCreateComputePipelines may be called from several threads at once (the cache synchronises
+  // itself); nothing else of this object is touched there.
+  std::future<VkPipeline> f;
+  try {
+    f = std::async(std::launch::async, [this, name = key.first, variant] { return build(name, variant); });
+  } catch (const std::system_error&) {   // no thread to be had: pipeline() builds it when it is needed
+    return;
+  }
+  building_.emplace(std::move(key), std::move(f));
+}
+
+VkPipeline Kernels::build(const std::string& kernel, KernelVariant variant) const {
+  const int v = variantIndex(variant);
   const EmbeddedKernel* k = findKernel(kernel);
-  if (!k) throw Error(ErrorKind::Internal, "unknown kernel '" + std::string(kernel) + "'");
+  if (!k) throw Error(ErrorKind::Internal, "unknown kernel '" + kernel + "'");
   if (variant.f64 && !device_.info().limits.float64)
     throw deviceError("The Vulkan device " + device_.info().name +
                       " has no 64-bit floating point in shaders (shaderFloat64); double precision needs another device.");
   const std::span<const uint32_t> spirv = spirvFor(*k, variant);
   if (spirv.empty())
-    throw Error(ErrorKind::Internal, "kernel '" + std::string(kernel) + "' has no SPIR-V for variant " + std::to_string(v));
-
+    throw Error(ErrorKind::Internal, "kernel '" + kernel + "' has no SPIR-V for variant " + std::to_string(v));
   const Api& api = device_.api();
   VkDevice dev = device_.handle();
   CompileTrace trace("vulkan", kernel, variant);
@@ -90,7 +128,6 @@ VkPipeline Kernels::pipeline(std::string_view kernel, KernelVariant variant) {
   VkResult r = api.vkCreateComputePipelines(dev, cache_, 1, &ci, nullptr, &pipeline);
   api.vkDestroyShaderModule(dev, module, nullptr);   // the pipeline keeps what it needs
   check(r, "vkCreateComputePipelines");
-  pipelines_.emplace(std::move(key), pipeline);
   return pipeline;
 }
 
