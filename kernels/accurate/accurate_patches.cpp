@@ -182,6 +182,7 @@ void accurateRun(Backend& backend, const AccurateJob& job, const PackedLattice& 
     return b;
   };
   BufferId bFrame = upload(frame), bCoeffs = upload(coeffs);
+  const gpu::AccurateParams params = accurateParamsFor(P, variant.f64, F);
   // The chunk range: positions, normals from element chunk * nv, corners from 2 * chunk * nv; the
   // scratch range: samples, control points from element chunk * m.
   const uint32_t normalsAt = uint32_t(chunk * nv), cornersAt = 2 * normalsAt, patchesAt = uint32_t(chunk * m);
@@ -197,7 +198,7 @@ void accurateRun(Backend& backend, const AccurateJob& job, const PackedLattice& 
     const size_t cw = 4 * SFFD_ACC_CORNER_STRIDE;
     for (size_t i = 0; i < cw * count; ++i) corners[i] = Real(job.corners[cw * first + i]);
     backend.upload(bChunk, cornersAt * r4, corners.data(), count * SFFD_ACC_CORNER_STRIDE * r4);
-    dispatchAccurateChunk(backend, P.params, variant, job, F, count,
+    dispatchAccurateChunk(backend, params, variant, job, count,
                           {{SFFD_BINDING_LATTICE_COEFFS, bCoeffs}, {SFFD_BINDING_LATTICE_FRAME, bFrame},
                            {SFFD_BINDING_ACC_CHUNK, bChunk}, {SFFD_BINDING_ACC_SCRATCH, bScratch},
                            normalsAt, cornersAt, patchesAt});
@@ -249,21 +250,36 @@ size_t accurateChunkPatches(const DeviceLimits& lim, const AccurateJob& job, siz
   return std::max<size_t>(1, std::min(chunk, std::max<size_t>(job.count(), 1)));
 }
 
-void dispatchAccurateChunk(Backend& backend, const gpu::LatticeParams& lattice, KernelVariant variant, const AccurateJob& job,
-                           const AccurateFrame& frame, size_t count, const AccurateBindings& bindings) {
+gpu::AccurateParams accurateParamsFor(const PackedLattice& lattice, bool f64, const AccurateFrame& frame) {
+  gpu::AccurateParams p{};
+  const uint32_t next = inlineLattice(lattice, f64, p.lattice, p.inline_lattice);
+  const size_t matrixReals = frame.basisAt - frame.matrixAt, basisReals = frame.reals.size() - frame.basisAt;
+  // Each table where it fits: A_n^{-1} (196 vec4 at n = 6) first, then the basis (462 at n = 6, level 10).
+  const uint32_t matrixAt = inlineReals(&frame.reals[frame.matrixAt], matrixReals, next, p.inline_lattice);
+  const uint32_t basisAt = inlineReals(&frame.reals[frame.basisAt], basisReals,
+                                       matrixAt ? uint32_t(matrixAt + (matrixReals + 3) / 4) : next, p.inline_lattice);
+  p.tables = {frame.matrixAt, frame.basisAt, matrixAt, basisAt};
+  return p;
+}
+
+KernelUse accurateKernel(const gpu::AccurateParams& params, KernelVariant variant) {
+  return {"accurate_patches", forLattice(variant, params)};
+}
+
+void dispatchAccurateChunk(Backend& backend, const gpu::AccurateParams& base, KernelVariant variant, const AccurateJob& job,
+                           size_t count, const AccurateBindings& bindings) {
   const uint32_t n = uint32_t(job.degree), m = uint32_t(triangleControlPoints(job.degree));
   const uint32_t nv = uint32_t(tessVertexCount(job.level));
   // Samples, then control points, then the tessellation: three dispatches, a barrier between each.
   for (uint32_t stage : {SFFD_ACC_STAGE_SAMPLES, SFFD_ACC_STAGE_PATCHES, SFFD_ACC_STAGE_TESSELLATE}) {
-    gpu::AccurateParams params;
-    params.lattice = lattice;
+    gpu::AccurateParams params = base;
     params.range = {0, uint32_t(count), stage, 0};
     params.shape = {n, m, uint32_t(job.level), nv};
     params.sections = {bindings.normalsAt, bindings.cornersAt, bindings.patchesAt, 0};
-    params.tables = {frame.matrixAt, frame.basisAt, 0, 0};
     Dispatch d;
-    d.kernel = "accurate_patches";
-    d.variant = forLattice(variant, lattice);
+    const KernelUse k = accurateKernel(base, variant);
+    d.kernel = k.kernel;
+    d.variant = k.variant;
     d.params = &params;
     d.paramsSize = sizeof(params);
     d.label = stage == SFFD_ACC_STAGE_SAMPLES ? "accurate_samples" : stage == SFFD_ACC_STAGE_PATCHES ? "accurate_patches" : "accurate_tessellate";

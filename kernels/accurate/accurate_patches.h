@@ -90,6 +90,10 @@ struct AccurateFrame {
   uint32_t matrixAt = 0, basisAt = 0;
 };
 AccurateFrame accurateFrame(const std::vector<double>& latticeFrame, int degree, int level);
+// The kernel's parameter block but for the chunk's range, shape and sections: the lattice and the
+// frame's tables, and in the float variants the lattice and the tables inline where they fit (layout.h,
+// AccurateParams; the same bits either way).
+gpu::AccurateParams accurateParamsFor(const PackedLattice& lattice, bool f64, const AccurateFrame& frame);
 // Sub-triangles one chunk may hold on the device with reals of `realBytes`; `maxChunk` caps it when not 0.
 size_t accurateChunkPatches(const DeviceLimits& limits, const AccurateJob& job, size_t realBytes, size_t maxChunk);
 // The three dispatches (samples, control points, tessellation) over `count` sub-triangles, each
@@ -100,8 +104,11 @@ struct AccurateBindings {
   BufferBinding coeffs, frame, chunk, scratch;
   uint32_t normalsAt = 0, cornersAt = 0, patchesAt = 0;
 };
-void dispatchAccurateChunk(Backend& backend, const gpu::LatticeParams& lattice, KernelVariant variant, const AccurateJob& job,
-                           const AccurateFrame& frame, size_t count, const AccurateBindings& bindings);
+// The kernel variant dispatchAccurateChunk runs (Backend::precompile).
+KernelUse accurateKernel(const gpu::AccurateParams& params, KernelVariant variant);
+// `params`: accurateParamsFor's block.
+void dispatchAccurateChunk(Backend& backend, const gpu::AccurateParams& params, KernelVariant variant, const AccurateJob& job,
+                           size_t count, const AccurateBindings& bindings);
 
 // Per patch its parent, per tessellation vertex its pre-image barycentrics in the parent
 // (sum_i lambda_i lam_i), its position and normal.

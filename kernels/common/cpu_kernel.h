@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <type_traits>
 
 #include <sffd/error.h>
 #include "core/backend.h"
@@ -72,6 +73,22 @@ LatticeEvaluator<Real> boundLattice(const CpuKernelArgs& a, const gpu::LatticePa
   if (!coeffs)
     coeffs = a.array<const Real>(SFFD_BINDING_LATTICE_COEFFS, 4ull * boxes[0] * boxes[1] * boxes[2] * L.boxes.w).data();
   return LatticeEvaluator<Real>(L, frame, coeffs);
+}
+
+// The reals from vec4 `first` of a parameter block's inline_lattice (layout.h, DeformParams and
+// AccurateParams) where the host put them there (`present`, float variants only), else nullptr.
+template <class Real>
+const Real* blockReals(const gpu::Vec4 (&block)[SFFD_INLINE_LATTICE_VEC4], bool present, uint32_t first) {
+  if constexpr (std::is_same_v<Real, float>) return present && first < SFFD_INLINE_LATTICE_VEC4 ? &block[first].x : nullptr;
+  return nullptr;
+}
+
+// The lattice of a parameter block that may carry it (break_offset.w), as lattice_eval.glsl reads it.
+template <class Real>
+LatticeEvaluator<Real> boundLattice(const CpuKernelArgs& a, const gpu::LatticeParams& L,
+                                    const gpu::Vec4 (&block)[SFFD_INLINE_LATTICE_VEC4]) {
+  const bool inlined = L.break_offset.w != 0;
+  return boundLattice<Real>(a, L, blockReals<Real>(block, inlined, 0), blockReals<Real>(block, inlined, L.break_offset.w));
 }
 
 }  // namespace sffd

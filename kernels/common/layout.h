@@ -75,10 +75,11 @@
 #define SFFD_SPEC_ASSUMPTIONS 0
 #define SFFD_ASSUME_DEGREE2 1u             // degree 2 on every axis
 #define SFFD_ASSUME_GENERAL_DEGREE 2u      // any other degrees
-#define SFFD_ASSUME_LATTICE_IN_PARAMS 4u   // DeformParams.inline_lattice holds the lattice
+#define SFFD_ASSUME_LATTICE_IN_PARAMS 4u   // the parameter block's inline_lattice holds the lattice
 #define SFFD_ASSUME_LATTICE_IN_STORAGE 8u  // the lattice storage buffers hold it
-#define SFFD_ASSUME_FIT_IN_PARAMS 16u      // DeformParams.inline_lattice holds the fit table
-#define SFFD_ASSUME_FIT_IN_STORAGE 32u     // the lattice frame range holds it
+#define SFFD_ASSUME_FIT_IN_PARAMS 16u      // inline_lattice holds all the kernel's constant tables (DeformParams:
+                                           // the fit table; AccurateParams: A_n^{-1} and the tessellation basis)
+#define SFFD_ASSUME_FIT_IN_STORAGE 32u     // the lattice frame range holds all of them
 #define SFFD_ASSUME_ROLLED_LOOPS 64u       // keep the loops bounded by sffdRolled() rolled (prelude.glsl)
 #define SFFD_ASSUME_LOOSE_DIVISION 128u    // strict kernels: the driver's a / b and sqrt may miss the correctly
                                            // rounded result, so round them (correctly_rounded.h)
@@ -87,7 +88,8 @@
 SFFD_STRUCT_BEGIN(LatticeParams)
   SFFD_UVEC4 degree;         // xyz: degree per axis (1..SFFD_MAX_DEGREE); w: outside_mode
   SFFD_UVEC4 boxes;          // xyz: knot boxes per axis; w: coefficients per box
-  SFFD_UVEC4 break_offset;   // xyz: first break of each axis in the frame buffer
+  SFFD_UVEC4 break_offset;   // xyz: first break of each axis in the frame buffer; w: where the parameter
+                             // block's inline_lattice holds the coefficients (0: not there; DeformParams)
 SFFD_STRUCT_END(LatticeParams)
 
 // ---- kernel classic_ffd: one thread per vertex, deforms the position and normal ----
@@ -245,7 +247,9 @@ SFFD_STRUCT_BEGIN(AccurateParams)
   SFFD_UVEC4 range;      // x: first sub-triangle of this chunk (relative to the bound ranges), y: sub-triangle count, z: stage
   SFFD_UVEC4 shape;      // x: patch degree n, y: control points m = (n+1)(n+2)/2, z: tessellation level L, w: vertices (L+1)(L+2)/2
   SFFD_UVEC4 sections;   // x: first normal, y: first corner (elements of the chunk range); z: first control point (scratch)
-  SFFD_UVEC4 tables;     // x: first real of A_n^{-1}, y: first real of the tessellation basis (lattice frame range)
+  SFFD_UVEC4 tables;     // x: first real of A_n^{-1}, y: first real of the tessellation basis (lattice frame range);
+                         // z, w: their first vec4 in inline_lattice (0: that one is read from the frame range)
+  SFFD_VEC4 inline_lattice[SFFD_INLINE_LATTICE_VEC4];   // as DeformParams's: the lattice, then the tables that fit
 SFFD_STRUCT_END(AccurateParams)
 // ---- end of accurate_patches ----
 

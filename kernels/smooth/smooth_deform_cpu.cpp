@@ -38,15 +38,10 @@ struct DeformTwin {
 
   // float variants: the lattice and the fit table from the parameter block where the host put them
   // there (layout.h, DeformParams), as lattice_eval.glsl and fitAt() read them.
-  static const Real* inlineReals(const gpu::DeformParams& p, bool present, uint32_t vec4) {
-    if constexpr (std::is_same_v<Real, float>) return present ? &p.inline_lattice[vec4].x : nullptr;
-    return nullptr;
-  }
   DeformTwin(const CpuKernelArgs& a, uint64_t n)
       : p(a.paramsAs<gpu::DeformParams>()),
-        L(boundLattice<Real>(a, p.lattice, inlineReals(p, p.lattice.break_offset.w != 0, 0),
-                             inlineReals(p, p.lattice.break_offset.w != 0, p.lattice.break_offset.w))),
-        fit(inlineReals(p, p.sections.x != 0, p.sections.x)),
+        L(boundLattice<Real>(a, p.lattice, p.inline_lattice)),
+        fit(blockReals<Real>(p.inline_lattice, p.sections.x != 0, p.sections.x)),
         records(a.array<const Real>(SFFD_BINDING_DEFORM_SUB_RECORDS, 4 * SFFD_SUB_STRIDE * n).data()),
         fitPoints(int(p.range.z)),
         level(int(p.range.w)) {

@@ -80,6 +80,35 @@ TEST_P(AccurateConformance, AgreesWithCpuTwinInEveryVariant) {
   EXPECT_EQ(vk::validationMessageCount(), 0u);
 }
 
+// Float variants read the lattice and the two tables from the parameter block where they fit
+// (accurateParamsFor), else from the storage buffers: each placement against the double reference, with
+// fast float's tolerances (a table or lattice read from a wrong place is far outside them).
+TEST_P(AccurateConformance, InlineAndStorageLatticeAndTablesAgreeWithDouble) {
+  SFFD_OPEN_OR_SKIP(b, GetParam());
+  Mesh mesh = readMesh(kData + "/sphere.obj");
+  struct Case {
+    const char* what;
+    std::array<int, 3> controlPoints;
+    int level;
+    bool latticeInline, matrixInline, basisInline;
+  };
+  for (const Case& c : {Case{"all inline", {5, 5, 5}, 3, true, true, true}, Case{"basis in storage", {5, 5, 5}, 10, true, true, false},
+                        Case{"tables in storage", {5, 5, 6}, 3, true, false, false},
+                        Case{"all in storage", {13, 13, 13}, 3, false, false, false}}) {
+    Lattice L = latticeFor(mesh, c.controlPoints, {2, 2, 2}, 0.05, OutsideMode::Extrapolate, 0.01);
+    PackedLattice P = packLattice(L);
+    AccurateJob job = makeAccurateJob(mesh, L, clipAgainstKnotBoxes(mesh, L), c.level);
+    const gpu::AccurateParams params = accurateParamsFor(P, false, accurateFrame(P.frame, job.degree, job.level));
+    ASSERT_EQ(params.lattice.break_offset.w != 0, c.latticeInline) << c.what;
+    ASSERT_EQ(params.tables.z != 0, c.matrixInline) << c.what;
+    ASSERT_EQ(params.tables.w != 0, c.basisInline) << c.what;
+    EXPECT_EQ(accurateParamsFor(P, true, accurateFrame(P.frame, job.degree, job.level)).lattice.break_offset.w, 0u) << "never in double";
+    expectBuffers(accurateFfd(*b.backend, job, P, {false, false}), accurateFfd(sffd::testing::cpuBackend(), job, P, {false, true}),
+                  true, {false, 64, 1e-5}, c.what, CompareTolerance{false, 64, 1e-4});
+  }
+  EXPECT_EQ(vk::validationMessageCount(), 0u);
+}
+
 TEST_P(AccurateConformance, LargestPatchDegree) {
   SFFD_OPEN_OR_SKIP(b, GetParam());
   Mesh mesh = readMesh(kData + "/cube2.obj");

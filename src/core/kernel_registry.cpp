@@ -50,11 +50,25 @@ KernelVariant forLattice(KernelVariant v, const gpu::LatticeParams& lattice) {
   return v;
 }
 
-KernelVariant forLattice(KernelVariant v, const gpu::DeformParams& params) {
-  v = forLattice(v, params.lattice);
-  v.assumptions |= params.lattice.break_offset.w ? SFFD_ASSUME_LATTICE_IN_PARAMS : SFFD_ASSUME_LATTICE_IN_STORAGE;
-  v.assumptions |= params.sections.x ? SFFD_ASSUME_FIT_IN_PARAMS : SFFD_ASSUME_FIT_IN_STORAGE;
+namespace {
+// A kernel whose parameter block may hold the lattice and its constant tables (all of them or none:
+// the tables' assumption; some: none, each table's place read at run time).
+KernelVariant forInlineLattice(KernelVariant v, const gpu::LatticeParams& lattice, std::initializer_list<uint32_t> tablesAt) {
+  v = forLattice(v, lattice);
+  v.assumptions |= lattice.break_offset.w ? SFFD_ASSUME_LATTICE_IN_PARAMS : SFFD_ASSUME_LATTICE_IN_STORAGE;
+  const size_t inlined = size_t(std::count_if(tablesAt.begin(), tablesAt.end(), [](uint32_t at) { return at != 0; }));
+  if (inlined == tablesAt.size()) v.assumptions |= SFFD_ASSUME_FIT_IN_PARAMS;
+  else if (inlined == 0) v.assumptions |= SFFD_ASSUME_FIT_IN_STORAGE;
   return v;
+}
+}  // namespace
+
+KernelVariant forLattice(KernelVariant v, const gpu::DeformParams& params) {
+  return forInlineLattice(v, params.lattice, {params.sections.x});
+}
+
+KernelVariant forLattice(KernelVariant v, const gpu::AccurateParams& params) {
+  return forInlineLattice(v, params.lattice, {params.tables.z, params.tables.w});
 }
 
 KernelVariant forDevice(KernelVariant v, const DeviceInfo& device) {

@@ -41,10 +41,11 @@ inline uint64_t variantKey(KernelVariant v) { return uint64_t(variantIndex(v)) +
 // "strict f32", "fast f64 assuming 0x5", ...: for messages and traces.
 std::string variantName(KernelVariant v);
 // The variant a lattice-evaluating kernel is dispatched with: assuming the lattice's degrees
-// (SFFD_ASSUME_DEGREE2 or _GENERAL_DEGREE) and, given the deform kernels' parameter block, where the
-// lattice and the fit table are read from.
+// (SFFD_ASSUME_DEGREE2 or _GENERAL_DEGREE) and, given the deform or accurate kernels' parameter block,
+// where the lattice and the kernel's constant tables are read from.
 KernelVariant forLattice(KernelVariant v, const gpu::LatticeParams& lattice);
 KernelVariant forLattice(KernelVariant v, const gpu::DeformParams& params);
+KernelVariant forLattice(KernelVariant v, const gpu::AccurateParams& params);
 // The variant a backend compiles for `device`: with SFFD_ASSUME_ROLLED_LOOPS on llvmpipe and lavapipe of
 // Mesa 23 and later (prelude.glsl sffdRolled; measured on 22.3, which is left without, and 25.0); strict
 // variants with SFFD_ASSUME_LOOSE_DIVISION on every driver but llvmpipe and lavapipe, whose a / b and sqrt

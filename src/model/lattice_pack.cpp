@@ -29,25 +29,39 @@ PackedLattice packLattice(const Lattice& L) {
   return P;
 }
 
+namespace {
+void putReals(const double* reals, size_t count, size_t firstReal, gpu::Vec4 (&block)[SFFD_INLINE_LATTICE_VEC4]) {
+  for (size_t i = 0; i < count; ++i) {
+    gpu::Vec4& q = block[(firstReal + i) / 4];
+    const size_t c = (firstReal + i) % 4;
+    (c == 0 ? q.x : c == 1 ? q.y : c == 2 ? q.z : q.w) = float(reals[i]);
+  }
+}
+}  // namespace
+
+uint32_t inlineLattice(const PackedLattice& lattice, bool f64, gpu::LatticeParams& params,
+                       gpu::Vec4 (&block)[SFFD_INLINE_LATTICE_VEC4]) {
+  params = lattice.params;
+  params.break_offset.w = 0;
+  const size_t frameVec4 = (lattice.frame.size() + 3) / 4, coeffVec4 = lattice.coeffs.size() / 4;
+  if (f64 || frameVec4 == 0 || frameVec4 + coeffVec4 > SFFD_INLINE_LATTICE_VEC4) return 0;
+  putReals(lattice.frame.data(), lattice.frame.size(), 0, block);
+  putReals(lattice.coeffs.data(), lattice.coeffs.size(), 4 * frameVec4, block);
+  params.break_offset.w = uint32_t(frameVec4);
+  return uint32_t(frameVec4 + coeffVec4);
+}
+
+uint32_t inlineReals(const double* reals, size_t count, uint32_t first, gpu::Vec4 (&block)[SFFD_INLINE_LATTICE_VEC4]) {
+  if (first == 0 || count == 0 || first + (count + 3) / 4 > SFFD_INLINE_LATTICE_VEC4) return 0;
+  putReals(reals, count, 4 * size_t(first), block);
+  return first;
+}
+
 gpu::DeformParams deformParamsFor(const PackedLattice& lattice, bool f64, const std::vector<double>* fit) {
   gpu::DeformParams d{};
-  d.lattice = lattice.params;
-  d.lattice.break_offset.w = 0;
   d.sections.y = uint32_t(lattice.frame.size());   // the fit table after the frame (deformFrameRange)
-  const size_t frameVec4 = (lattice.frame.size() + 3) / 4, coeffVec4 = lattice.coeffs.size() / 4;
-  if (f64 || frameVec4 == 0 || frameVec4 + coeffVec4 > SFFD_INLINE_LATTICE_VEC4) return d;
-  auto put = [&](size_t i, double v) {
-    gpu::Vec4& q = d.inline_lattice[i / 4];
-    (i % 4 == 0 ? q.x : i % 4 == 1 ? q.y : i % 4 == 2 ? q.z : q.w) = float(v);
-  };
-  for (size_t i = 0; i < lattice.frame.size(); ++i) put(i, lattice.frame[i]);
-  for (size_t i = 0; i < lattice.coeffs.size(); ++i) put(4 * frameVec4 + i, lattice.coeffs[i]);
-  d.lattice.break_offset.w = uint32_t(frameVec4);
-  const size_t fitFirst = frameVec4 + coeffVec4;
-  if (fit && !fit->empty() && fitFirst + (fit->size() + 3) / 4 <= SFFD_INLINE_LATTICE_VEC4) {
-    for (size_t i = 0; i < fit->size(); ++i) put(4 * fitFirst + i, (*fit)[i]);
-    d.sections.x = uint32_t(fitFirst);
-  }
+  const uint32_t fitFirst = inlineLattice(lattice, f64, d.lattice, d.inline_lattice);
+  if (fit) d.sections.x = inlineReals(fit->data(), fit->size(), fitFirst, d.inline_lattice);
   return d;
 }
 

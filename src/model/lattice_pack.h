@@ -17,6 +17,16 @@ struct PackedLattice {
 
 PackedLattice packLattice(const Lattice& lattice);
 
+// A parameter block's inline_lattice (layout.h, DeformParams and AccurateParams): in the float variants
+// the lattice's frame reals, four to a vec4, then its coefficients, where they fit; `params` is the
+// block's lattice part, its break_offset.w set to the coefficients' first vec4 (0: they are not there,
+// the kernels read the lattice storage buffers). Returns the first vec4 after them (0: not inline).
+uint32_t inlineLattice(const PackedLattice& lattice, bool f64, gpu::LatticeParams& params,
+                       gpu::Vec4 (&block)[SFFD_INLINE_LATTICE_VEC4]);
+// Appends `count` reals at vec4 `first` of an inline_lattice where they fit: returns where they begin
+// (`first`), 0 where they do not fit or `first` is 0 (the lattice is not there either).
+uint32_t inlineReals(const double* reals, size_t count, uint32_t first, gpu::Vec4 (&block)[SFFD_INLINE_LATTICE_VEC4]);
+
 // The deform kernels' parameter block for a lattice: its LatticeParams, and in the float variants
 // the lattice itself inline when it fits (layout.h, DeformParams), else break_offset.w = 0 and the
 // kernels read the lattice storage buffers.

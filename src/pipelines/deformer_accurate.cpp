@@ -29,6 +29,7 @@ class AccurateRun final : public MethodRun {
               std::optional<JobEstimate>& whole)
       : B_(backend), input_(input), timings_(t), variant_(r.variant), once_(r.once) {
     const auto t0 = std::chrono::steady_clock::now();
+    PackedLattice packed = packLattice(lattice);
     progress("clip", 0);
     job_ = makeAccurateJob(input, lattice, clipAgainstKnotBoxes(input, lattice), r.tess);
     t.clipMs = msSince(t0);
@@ -36,8 +37,9 @@ class AccurateRun final : public MethodRun {
 
     const DeviceLimits& lim = B_.info().limits;
     const size_t realBytes = variant_.f64 ? 8 : 4;
-    PackedLattice packed = packLattice(lattice);
     frame_ = accurateFrame(packed.frame, job_.degree, job_.level);   // the frame, then the patch tables
+    params_ = accurateParamsFor(packed, variant_.f64, frame_);
+    B_.precompile({accurateKernel(params_, variant_)});
     const size_t ns = job_.count(), nv = size_t(tessVertexCount(job_.level)), m = size_t(triangleControlPoints(job_.degree));
     size_t chunk = accurateChunkPatches(lim, job_, realBytes, r.maxChunkElements);
     // One-shot: chunks of at most kOnceChunkBytes, so that the one chunk alive at a time stays small also
@@ -72,7 +74,6 @@ class AccurateRun final : public MethodRun {
     }
     checkJobFits(*estimate, packed, realBytes, &lim, r.memoryLimit, "DeformOptions::memoryLimit");
 
-    params_ = packed.params;
     frameBuffer_ = uploadReals(owned_, frame_.reals, variant_.f64);
     coeffs_ = uploadReals(owned_, packed.coeffs, variant_.f64);
     if (ns) scratch_ = makeBuffer(owned_, scratchBytes);
@@ -91,6 +92,7 @@ class AccurateRun final : public MethodRun {
     PackedLattice packed = packLattice(lattice);
     std::vector<unsigned char> coeffs = realBytes(packed.coeffs, variant_.f64);
     B_.upload(coeffs_, 0, coeffs.data(), coeffs.size());
+    params_ = accurateParamsFor(packed, variant_.f64, frame_);   // the coefficients may be inline
     if (once_) return;   // the kernels run chunk by chunk as the result is taken (forEachChunk)
     for (size_t i = 0; i < chunks_.size(); ++i) {
       runChunk(chunks_[i]);
@@ -227,7 +229,7 @@ class AccurateRun final : public MethodRun {
     AccurateBindings b{{SFFD_BINDING_LATTICE_COEFFS, coeffs_}, {SFFD_BINDING_LATTICE_FRAME, frameBuffer_},
                        {SFFD_BINDING_ACC_CHUNK, c.out}, {SFFD_BINDING_ACC_SCRATCH, scratch_},
                        normalsAt, 2 * normalsAt, patchesAt_};
-    dispatchAccurateChunk(B_, params_, variant_, job_, frame_, c.count, b);
+    dispatchAccurateChunk(B_, params_, variant_, job_, c.count, b);
   }
   Backend& B_;
   mutable OwnedBuffers owned_{B_};   // first: destroyed last, after everything that names its buffers
@@ -235,7 +237,7 @@ class AccurateRun final : public MethodRun {
   Timings& timings_;    // Deformer::Impl::timings: a one-shot run's kernels run when its result is taken
   KernelVariant variant_;
   AccurateJob job_;
-  gpu::LatticeParams params_;
+  gpu::AccurateParams params_;   // the lattice's and tables' part (accurateParamsFor)
   AccurateFrame frame_;
   BufferId frameBuffer_ = 0, coeffs_ = 0, scratch_ = 0;
   uint32_t patchesAt_ = 0;   // the first control point in scratch_, after the samples
