@@ -4,8 +4,10 @@
 //  stage 0, a thread per (sub-triangle, sample l): S_l = R(x(l/n)), the lattice volume at the principal
 //     lattice points l/n of the flat sub-triangle (every sample finds its own knot box; the sub-triangle
 //     lies in one, so R o x is a polynomial of total degree n = nu+nv+nw);
-//  stage 1, a thread per (sub-triangle, control point k): the exact triangular Bezier patch
-//     P = A_n^{-1} S (A_n^{-1} computed on the host in double, once per n, uploaded as a storage buffer);
+//  stage 1, a thread per sub-triangle: the exact triangular Bezier patch P = A_n^{-1} S (A_n^{-1}
+//     computed on the host in double, once per n, in the parameter block where it fits): the lanes read
+//     the same entry of A_n^{-1} at a time, a scalar read, where a thread per control point made every
+//     read of it a gather (lavapipe 22.3 gathers lane by lane);
 //  stage 2, a thread per (sub-triangle, tessellation vertex) at level L (src/pipelines/patch_output.h
 //     layout): interior vertices B^n(lambda)·P; boundary vertices R(x(lambda)) directly, the value the
 //     patch interpolates exactly there, computed from bits that both sub-triangles of a shared edge
@@ -16,9 +18,9 @@
 //     that knot-box clipping makes loses all float precision. It keeps the parent's orientation (also
 //     where det J < 0) and jumps across sub-triangle edges, which is why accurate FFD shades
 //     unsmoothly (METHOD.md 2.2, last paragraph).
-// Why not one thread per sub-triangle: llvmpipe and lavapipe end an invocation after 65535 loop
+// Why not one thread per sub-triangle throughout: llvmpipe and lavapipe end an invocation after 65535 loop
 // iterations in all (gallivm's LP_MAX_TGSI_LOOP_ITERATIONS, shared by every loop of the shader), which a
-// whole patch at --tess 38 already exceeds; here an invocation runs at most a few hundred.
+// whole patch at --tess 38 already exceeds; stage 1's m^2 is 18,496 at the largest degree (n = 15).
 // The C++ twin is kernels/accurate/accurate_patches_cpu.cpp: the same operations in the same order.
 #extension GL_GOOGLE_include_directive : require
 #include "../common/prelude.glsl"
@@ -75,7 +77,7 @@ void main() {
   uint t = sffdThreadIndex();
   uint n = params.shape.x, m = params.shape.y, L = params.shape.z, nv = params.shape.w;
   uint stage = params.range.z;
-  uint per = stage == SFFD_ACC_STAGE_TESSELLATE ? nv : m;
+  uint per = SFFD_ACC_THREADS_PER_SUB(stage, m, nv);
   uint local = t / per;
   if (local >= params.range.y) return;
   uint e = t - local * per;
@@ -93,12 +95,14 @@ void main() {
   }
 
   if (stage == SFFD_ACC_STAGE_PATCHES) {
-    P real3 cp = real3(0);
-    for (uint l = 0u; l < m; ++l) {
-      P real3 v = cp + accSamples(s * m + l).xyz * accMatrix(l * m + e);
-      cp = v;
+    for (uint k = 0u; k < m; ++k) {
+      P real3 cp = real3(0);
+      for (uint l = 0u; l < m; ++l) {
+        P real3 v = cp + accSamples(s * m + l).xyz * accMatrix(l * m + k);
+        cp = v;
+      }
+      accPatches(s * m + k) = real4(cp, 0);
     }
-    accPatches(s * m + e) = real4(cp, 0);
     return;
   }
 

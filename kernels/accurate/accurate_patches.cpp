@@ -284,7 +284,7 @@ void dispatchAccurateChunk(Backend& backend, const gpu::AccurateParams& base, Ke
     d.paramsSize = sizeof(params);
     d.label = stage == SFFD_ACC_STAGE_SAMPLES ? "accurate_samples" : stage == SFFD_ACC_STAGE_PATCHES ? "accurate_patches" : "accurate_tessellate";
     d.buffers = {bindings.coeffs, bindings.frame, bindings.chunk, bindings.scratch};
-    gridFor(uint64_t(count) * (stage == SFFD_ACC_STAGE_TESSELLATE ? nv : m), backend.info().limits, d.groups);
+    gridFor(uint64_t(count) * SFFD_ACC_THREADS_PER_SUB(stage, m, nv), backend.info().limits, d.groups);
     backend.dispatch(d);
     backend.barrier();
   }

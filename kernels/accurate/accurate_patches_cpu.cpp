@@ -36,7 +36,7 @@ void accurateThreads(const CpuKernelArgs& a, uint64_t first, uint64_t last) {
   const uint32_t n = p.shape.x, m = p.shape.y, L = p.shape.z, nv = p.shape.w, stage = p.range.z;
   a.check(m <= SFFD_ACC_MAX_CP && m == uint32_t(triangleControlPoints(int(n))) && nv == uint32_t(tessVertexCount(int(L))),
           "accurate: patch shape out of range");
-  const uint64_t subs = uint64_t(p.range.x) + p.range.y, per = stage == SFFD_ACC_STAGE_TESSELLATE ? nv : m;
+  const uint64_t subs = uint64_t(p.range.x) + p.range.y, per = SFFD_ACC_THREADS_PER_SUB(stage, m, nv);
   // The sections of the chunk and scratch ranges and the tables in the frame range (layout.h).
   const uint64_t normalsAt = 4 * uint64_t(p.sections.x), cornersAt = 4 * uint64_t(p.sections.y),
                  patchesAt = 4 * uint64_t(p.sections.z);
@@ -68,10 +68,12 @@ void accurateThreads(const CpuKernelArgs& a, uint64_t first, uint64_t last) {
     const Real* samples = scratch;
     Real* patches = scratch + patchesAt;
     for (uint64_t t = first; t < end; ++t) {
-      const uint32_t local = uint32_t(t / per), e = uint32_t(t - uint64_t(local) * per), s = p.range.x + local;
-      RVec3<Real> cp{};
-      for (uint32_t l = 0; l < m; ++l) cp = cp + get(&samples[4 * (size_t(s) * m + l)]) * matrix[size_t(l) * m + e];
-      put(&patches[4 * (size_t(s) * m + e)], cp);
+      const uint32_t s = p.range.x + uint32_t(t);   // a thread per sub-triangle
+      for (uint32_t k = 0; k < m; ++k) {
+        RVec3<Real> cp{};
+        for (uint32_t l = 0; l < m; ++l) cp = cp + get(&samples[4 * (size_t(s) * m + l)]) * matrix[size_t(l) * m + k];
+        put(&patches[4 * (size_t(s) * m + k)], cp);
+      }
     }
   } else if (stage == SFFD_ACC_STAGE_TESSELLATE) {
     LatticeEvaluator<Real> eval = boundLattice<Real>(a, p.lattice, p.inline_lattice);

@@ -221,13 +221,17 @@ SFFD_STRUCT_END(PnParams)
 // Three dispatches a chunk of knot-box sub-triangles (range.z selects the stage), so that no invocation
 // runs more than a few hundred loop iterations (llvmpipe ends every invocation after 65535 in all):
 //   stage 0, a thread per (sub-triangle, sample l): S_l = R(x(l/n)) at the principal lattice points;
-//   stage 1, a thread per (sub-triangle, control point k): P_k = sum_l A_n^{-1}[k][l] S_l (l ascending);
+//   stage 1, a thread per sub-triangle: P_k = sum_l A_n^{-1}[k][l] S_l (k, then l ascending; every lane
+//     reads the same entry of A_n^{-1} at a time);
 //   stage 2, a thread per (sub-triangle, tessellation vertex): position and normal (patch_output.h layout).
 #define SFFD_ACC_MAX_DEGREE 15           // 3 * SFFD_MAX_DEGREE
 #define SFFD_ACC_MAX_CP 136              // (n+1)(n+2)/2 for n = SFFD_ACC_MAX_DEGREE
 #define SFFD_ACC_STAGE_SAMPLES 0u
 #define SFFD_ACC_STAGE_PATCHES 1u
 #define SFFD_ACC_STAGE_TESSELLATE 2u
+// Threads a sub-triangle of a stage's dispatch (m control points, nv tessellation vertices).
+#define SFFD_ACC_THREADS_PER_SUB(stage, m, nv) \
+  ((stage) == SFFD_ACC_STAGE_TESSELLATE ? (nv) : (stage) == SFFD_ACC_STAGE_PATCHES ? 1u : (m))
 // Four storage blocks in all (the OpenGL ES 3.1 minimum): the lattice's two, and two of sections.
 // The lattice frame range also holds, from the reals AccurateParams.tables names, the constant tables:
 //   A_n^{-1} transposed, entry (sample l, control point k) at l*m + k;
