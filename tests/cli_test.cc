@@ -125,6 +125,24 @@ TEST(Cli, LatticeThenDeformWritesStats) {
   EXPECT_LE(phases, j["timings_ms"]["total"].get<double>() + 1e-6);
 }
 
+// Accurate FFD's stats add its three dispatches' times, which make up its deform stage.
+TEST(Cli, AccurateStatsGiveTheKernelsSteps) {
+  fs::path dir = tempDir("accurate_steps");
+  const std::string stats = (dir / "s.json").string();
+  RunResult r = runSffd("deform " + kData + "/sphere.obj -l " + kData + "/lattices/sphere_twist.npy --method accurate --tess 3 -o " +
+                        (dir / "a.ply").string() + " --backend cpu --stats " + stats + " --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::ifstream sf(stats);
+  const nlohmann::json t = nlohmann::json::parse(sf)["timings_ms"];
+  double steps = 0;
+  for (const char* k : {"accurate_samples", "accurate_patches", "accurate_tessellate"}) {
+    ASSERT_TRUE(t.contains(k)) << k;
+    EXPECT_GE(t[k].get<double>(), 0) << k;
+    steps += t[k].get<double>();
+  }
+  EXPECT_NEAR(steps, t["deform"].get<double>(), 1e-6 + 1e-9 * steps);
+}
+
 // The CPU reference and every backend this machine must have (SFFD_REQUIRE_BACKENDS), each line
 // naming its backend and then its device.
 TEST(Cli, DevicesListsEveryRequiredBackend) {

@@ -113,10 +113,11 @@ int run(const ParsedArgs& args) {
     // Smooth and accurate: the host-memory estimate checked against SFFD_MEMORY_LIMIT (bytes); classic: null.
     const std::optional<JobEstimate>& estimate = run.deformer.internal().estimate;
     j["host_memory_estimate"] = estimate ? nlohmann::ordered_json(estimate->hostBytes) : nlohmann::ordered_json();
-    // --split: the deform steps (deform.sample, ...), which the fused kernel does not have.
-    if (args.has("--split"))
-      for (const auto& [step, ms] : t.steps)
-        if (step.find('.') != std::string::npos) j["timings_ms"][step] = ms;
+    // The deform stage's steps where it has several: --split (deform.sample, ...), which the fused kernel
+    // does not have, and accurate's three dispatches (accurate_samples, _patches, _tessellate).
+    for (const auto& [step, ms] : t.steps)
+      if ((args.has("--split") && step.find('.') != std::string::npos) || step.rfind("accurate_", 0) == 0)
+        j["timings_ms"][step] = ms;
     std::string text = j.dump(1) + "\n";
     writeFileAtomically(args.get("--stats"), [&](std::ostream& o) { o << text; });
   }
