@@ -184,7 +184,7 @@ class VulkanBackend final : public Backend {
   }
 
   void precompile(const std::vector<KernelUse>& kernels) override {
-    for (const KernelUse& k : kernels) kernels_.precompile(k.kernel, k.variant);
+    kernels_.precompile(kernels);
   }
 
   void dispatch(const Dispatch& d) override {

@@ -1,6 +1,9 @@
 #include "backends/vulkan/vk_kernels.h"
 
+#include <algorithm>
+#include <optional>
 #include <system_error>
+#include <thread>
 
 #include <sffd/error.h>
 #include "core/kernel_registry.h"
@@ -43,10 +46,16 @@ Kernels::~Kernels() { destroy(); }
 void Kernels::destroy() {
   const Api& api = device_.api();
   VkDevice dev = device_.handle();
+  {
+    std::lock_guard<std::mutex> lock(queueMutex_);
+    queue_.clear();   // their futures report broken promises, caught below
+  }
+  for (std::future<void>& w : workers_) w.wait();
+  workers_.clear();
   for (auto& [key, building] : building_) {
     try {
       pipelines_.emplace(key, building.get());
-    } catch (...) {   // a build that failed and was never asked for
+    } catch (...) {   // a build that failed, or was never made, and was never asked for
     }
   }
   building_.clear();
@@ -72,6 +81,7 @@ VkPipeline Kernels::pipeline(std::string_view kernel, KernelVariant variant) {
   if (auto it = building_.find(key); it != building_.end()) {
     std::future<VkPipeline> f = std::move(it->second);
     building_.erase(it);
+    buildIfQueued(key);
     pipeline = f.get();
   } else {
     pipeline = build(key.first, variant);
@@ -80,18 +90,64 @@ VkPipeline Kernels::pipeline(std::string_view kernel, KernelVariant variant) {
   return pipeline;
 }
 
-void Kernels::precompile(std::string_view kernel, KernelVariant variant) {
-  Key key = keyOf(kernel, variant);
-  if (pipelines_.count(key) || building_.count(key)) return;
-  // vkCreateComputePipelines may be called from several threads at once (the cache synchronises
-  // itself); nothing else of this object is touched there.
-  std::future<VkPipeline> f;
-  try {
-    f = std::async(std::launch::async, [this, name = key.first, variant] { return build(name, variant); });
-  } catch (const std::system_error&) {   // no thread to be had: pipeline() builds it when it is needed
-    return;
+void Kernels::precompile(const std::vector<KernelUse>& kernels) {
+  size_t queued = 0;
+  {
+    std::lock_guard<std::mutex> lock(queueMutex_);
+    for (const KernelUse& use : kernels) {
+      KernelVariant variant = use.variant;
+      Key key = keyOf(use.kernel, variant);
+      if (pipelines_.count(key) || building_.count(key)) continue;
+      QueuedBuild b{key.first, variant, {}};
+      building_.emplace(std::move(key), b.done.get_future());
+      queue_.push_back(std::move(b));
+      ++queued;
+    }
   }
-  building_.emplace(std::move(key), std::move(f));
+  // vkCreateComputePipelines may be called from several threads at once (the cache synchronises
+  // itself); the workers touch nothing else of this object but the queue.
+  const size_t cores = std::max(1u, std::thread::hardware_concurrency());
+  for (size_t i = 0; i < std::min(queued, cores); ++i) {
+    try {
+      workers_.push_back(std::async(std::launch::async, [this] { buildQueued(); }));
+    } catch (const std::system_error&) {   // no thread to be had: the workers started, or the caller, build them
+      break;
+    }
+  }
+}
+
+void Kernels::buildIfQueued(const Key& key) {
+  std::optional<QueuedBuild> mine;
+  {
+    std::lock_guard<std::mutex> lock(queueMutex_);
+    auto it = std::find_if(queue_.begin(), queue_.end(),
+                           [&](const QueuedBuild& b) { return b.kernel == key.first && variantKey(b.variant) == key.second; });
+    if (it == queue_.end()) return;
+    mine = std::move(*it);
+    queue_.erase(it);
+  }
+  try {
+    mine->done.set_value(build(mine->kernel, mine->variant));
+  } catch (...) {
+    mine->done.set_exception(std::current_exception());
+  }
+}
+
+void Kernels::buildQueued() {
+  for (;;) {
+    QueuedBuild b;
+    {
+      std::lock_guard<std::mutex> lock(queueMutex_);
+      if (queue_.empty()) return;
+      b = std::move(queue_.front());
+      queue_.pop_front();
+    }
+    try {
+      b.done.set_value(build(b.kernel, b.variant));
+    } catch (...) {
+      b.done.set_exception(std::current_exception());
+    }
+  }
 }
 
 VkPipeline Kernels::build(const std::string& kernel, KernelVariant variant) const {

@@ -2,11 +2,15 @@
 // (binding 0: the parameter block as a uniform buffer; 1..SFFD_MAX_STORAGE_BINDINGS: storage
 // buffers, see kernels/common/layout.h), so one pipeline layout serves all of them. A pipeline is
 // built from the SPIR-V embedded at build time, on first use of a (kernel, variant) pair or ahead of
-// it on a thread of its own (precompile): creating one costs lavapipe tens of milliseconds of
-// SPIR-V to NIR translation and optimisation, which other cores can do while the caller works.
+// it (precompile): creating one costs lavapipe tens of milliseconds of SPIR-V to NIR translation and
+// optimisation, which other cores can do while the caller works. Builds ahead are taken in the order
+// they were asked for by one worker a core, so that the first kernel a job dispatches is ready first.
 #pragma once
+#include <deque>
 #include <future>
 #include <map>
+#include <mutex>
+#include <vector>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -29,21 +33,33 @@ class Kernels {
   // without shaderFloat64.
   // Waits for the pipeline's build where precompile started one (and rethrows its error).
   VkPipeline pipeline(std::string_view kernel, KernelVariant variant);
-  // Starts building the pipeline on another thread unless it is built or being built.
-  void precompile(std::string_view kernel, KernelVariant variant);
+  // Queues the pipelines for building on other threads, in this order, unless built or queued already.
+  void precompile(const std::vector<KernelUse>& kernels);
 
  private:
   using Key = std::pair<std::string, uint64_t>;
   Key keyOf(std::string_view kernel, KernelVariant& variant) const;
   VkPipeline build(const std::string& kernel, KernelVariant variant) const;
+  void buildQueued();   // a worker: builds queued pipelines until none is left
+  // A build no worker has taken yet (or none could start) is made by the caller, now.
+  void buildIfQueued(const Key& key);
   void destroy();
+
+  struct QueuedBuild {
+    std::string kernel;
+    KernelVariant variant;
+    std::promise<VkPipeline> done;
+  };
 
   Device& device_;
   VkDescriptorSetLayout setLayout_ = VK_NULL_HANDLE;
   VkPipelineLayout pipelineLayout_ = VK_NULL_HANDLE;
   VkPipelineCache cache_ = VK_NULL_HANDLE;   // in memory only: Mesa and vendor drivers keep their own disk caches
   std::map<Key, VkPipeline> pipelines_;
-  std::map<Key, std::future<VkPipeline>> building_;   // precompiled, not yet asked for
+  std::map<Key, std::future<VkPipeline>> building_;   // queued or built ahead, not yet asked for
+  std::mutex queueMutex_;
+  std::deque<QueuedBuild> queue_;                        // not yet taken by a worker
+  std::vector<std::future<void>> workers_;
 };
 
 }  // namespace sffd::vk
