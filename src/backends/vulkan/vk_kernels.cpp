@@ -1,6 +1,7 @@
 #include "backends/vulkan/vk_kernels.h"
 
 #include <algorithm>
+#include <chrono>
 #include <optional>
 #include <system_error>
 #include <thread>
@@ -107,6 +108,7 @@ void Kernels::precompile(const std::vector<KernelUse>& kernels) {
   // vkCreateComputePipelines may be called from several threads at once (the cache synchronises
   // itself); the workers touch nothing else of this object but the queue.
   const size_t cores = std::max(1u, std::thread::hardware_concurrency());
+  std::erase_if(workers_, [](const std::future<void>& w) { return w.wait_for(std::chrono::seconds(0)) == std::future_status::ready; });
   for (size_t i = 0; i < std::min(queued, cores); ++i) {
     try {
       workers_.push_back(std::async(std::launch::async, [this] { buildQueued(); }));
