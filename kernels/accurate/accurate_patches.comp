@@ -38,22 +38,9 @@ layout(std430, SFFD_SET binding = SFFD_BINDING_ACC_SCRATCH) buffer AccScratch { 
 #define accPositions(i) accChunk[i]
 #define accSamples(i) accScratch[i]
 #define accPatches(i) accScratch[params.sections.z + (i)]
-
-// Real i of a constant table: from the parameter block where the host put it there (inlineAt, a vec4
-// index, 0: not there), else from the lattice frame range (frameAt, a real index).
-#if !SFFD_F64
-real accTable(uint inlineAt, uint frameAt, uint i) {
-  real v;
-  bool inParams = sffdAssumes(SFFD_ASSUME_FIT_IN_PARAMS) || (!sffdAssumes(SFFD_ASSUME_FIT_IN_STORAGE) && inlineAt != 0u);
-  if (inParams) v = params.inline_lattice[inlineAt + (i >> 2u)][i & 3u];
-  else v = latticeFrame[frameAt + i];
-  return v;
-}
-#else
-real accTable(uint inlineAt, uint frameAt, uint i) { return latticeFrame[frameAt + i]; }
-#endif
-#define accMatrix(i) accTable(params.tables.z, params.tables.x, i)
-#define accTessBasis(i) accTable(params.tables.w, params.tables.y, i)
+// The two constant tables, from the parameter block where each fits (layout.h, AccurateParams.tables).
+#define accMatrix(i) latticeTableAt(params.tables.z, params.tables.x, i)
+#define accTessBasis(i) latticeTableAt(params.tables.w, params.tables.y, i)
 
 // The point (i, j, k) / d of the flat triangle (c0, c1, c2). Always precise (also in the fast
 // variant): on a shared edge one weight is 0 and the sum of the other two terms is the same bits from

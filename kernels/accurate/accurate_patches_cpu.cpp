@@ -44,13 +44,6 @@ void accurateThreads(const CpuKernelArgs& a, uint64_t first, uint64_t last) {
   Real* scratch = a.array<Real>(SFFD_BINDING_ACC_SCRATCH, std::max(4 * m * subs, patchesAt + 4 * m * subs)).data();
   const Real* corners = chunk + cornersAt;
   const uint64_t end = std::min<uint64_t>(last, per * p.range.y);
-  // The two tables from the parameter block where the host put them there (float variants), else after
-  // the frame in the frame range, as accurate_patches.comp reads them.
-  auto table = [&](uint32_t inlineAt, uint32_t frameAt, uint64_t reals) {
-    a.check(!inlineAt || inlineAt + (reals + 3) / 4 <= SFFD_INLINE_LATTICE_VEC4, "accurate: an inline table overruns the parameter block");
-    if (const Real* r = blockReals<Real>(p.inline_lattice, inlineAt != 0, inlineAt)) return r;
-    return a.array<const Real>(SFFD_BINDING_LATTICE_FRAME, uint64_t(frameAt) + reals).data() + frameAt;
-  };
   if (stage == SFFD_ACC_STAGE_SAMPLES) {
     LatticeEvaluator<Real> eval = boundLattice<Real>(a, p.lattice, p.inline_lattice);
     Real* samples = scratch;
@@ -64,7 +57,7 @@ void accurateThreads(const CpuKernelArgs& a, uint64_t first, uint64_t last) {
       put(&samples[4 * (size_t(s) * m + e)], keep ? x : S.value);
     }
   } else if (stage == SFFD_ACC_STAGE_PATCHES) {
-    const Real* matrix = table(p.tables.z, p.tables.x, uint64_t(m) * m);
+    const Real* matrix = tableReals<Real>(a, p.inline_lattice, p.tables.z, p.tables.x, uint64_t(m) * m);
     const Real* samples = scratch;
     Real* patches = scratch + patchesAt;
     for (uint64_t t = first; t < end; ++t) {
@@ -77,7 +70,7 @@ void accurateThreads(const CpuKernelArgs& a, uint64_t first, uint64_t last) {
     }
   } else if (stage == SFFD_ACC_STAGE_TESSELLATE) {
     LatticeEvaluator<Real> eval = boundLattice<Real>(a, p.lattice, p.inline_lattice);
-    const Real* basis = table(p.tables.w, p.tables.y, uint64_t(nv) * m);
+    const Real* basis = tableReals<Real>(a, p.inline_lattice, p.tables.w, p.tables.y, uint64_t(nv) * m);
     const Real* patches = scratch + patchesAt;
     Real* positions = chunk;
     Real* normals = chunk + normalsAt;

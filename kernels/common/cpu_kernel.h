@@ -83,6 +83,16 @@ const Real* blockReals(const gpu::Vec4 (&block)[SFFD_INLINE_LATTICE_VEC4], bool 
   return nullptr;
 }
 
+// `reals` reals of a kernel's constant table, as latticeTableAt() reads them: from vec4 `inlineAt` of the
+// parameter block (0: not there; float variants only), else from real `frameAt` of the lattice frame range.
+template <class Real>
+const Real* tableReals(const CpuKernelArgs& a, const gpu::Vec4 (&block)[SFFD_INLINE_LATTICE_VEC4], uint32_t inlineAt,
+                       uint32_t frameAt, uint64_t reals) {
+  a.check(!inlineAt || inlineAt + (reals + 3) / 4 <= SFFD_INLINE_LATTICE_VEC4, "an inline table overruns the parameter block");
+  if (const Real* r = blockReals<Real>(block, inlineAt != 0, inlineAt)) return r;
+  return a.array<const Real>(SFFD_BINDING_LATTICE_FRAME, uint64_t(frameAt) + reals).data() + frameAt;
+}
+
 // The lattice of a parameter block that may carry it (break_offset.w), as lattice_eval.glsl reads it.
 template <class Real>
 LatticeEvaluator<Real> boundLattice(const CpuKernelArgs& a, const gpu::LatticeParams& L,

@@ -28,9 +28,20 @@ real3 latticeCoeffAt(uint c) {
   else v = latticeCoeffs[c].xyz;
   return v;
 }
+// Real i of a kernel's constant table (smooth: the fit table; accurate: A_n^{-1}, the tessellation
+// basis): from vec4 inlineAt of the parameter block where the host put it there (0: not there), else
+// from real frameAt of the lattice frame range.
+real latticeTableAt(uint inlineAt, uint frameAt, uint i) {
+  real v;
+  bool inParams = sffdAssumes(SFFD_ASSUME_FIT_IN_PARAMS) || (!sffdAssumes(SFFD_ASSUME_FIT_IN_STORAGE) && inlineAt != 0u);
+  if (inParams) v = params.inline_lattice[inlineAt + (i >> 2u)][i & 3u];
+  else v = latticeFrame[frameAt + i];
+  return v;
+}
 #else
 real latticeFrameAt(uint i) { return latticeFrame[i]; }
 real3 latticeCoeffAt(uint c) { return latticeCoeffs[c].xyz; }
+real latticeTableAt(uint inlineAt, uint frameAt, uint i) { return latticeFrame[frameAt + i]; }
 #endif
 
 // Value and derivative of the B-spline volume at a lattice parameter, plus whether it is inside the box.

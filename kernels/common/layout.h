@@ -89,7 +89,8 @@ SFFD_STRUCT_BEGIN(LatticeParams)
   SFFD_UVEC4 degree;         // xyz: degree per axis (1..SFFD_MAX_DEGREE); w: outside_mode
   SFFD_UVEC4 boxes;          // xyz: knot boxes per axis; w: coefficients per box
   SFFD_UVEC4 break_offset;   // xyz: first break of each axis in the frame buffer; w: where the parameter
-                             // block's inline_lattice holds the coefficients (0: not there; DeformParams)
+                             // block's inline_lattice holds the coefficients (0: not there; DeformParams,
+                             // AccurateParams)
 SFFD_STRUCT_END(LatticeParams)
 
 // ---- kernel classic_ffd: one thread per vertex, deforms the position and normal ----
@@ -195,14 +196,15 @@ SFFD_STRUCT_END(ClipParams)
 // the interior sample normals.
 #define SFFD_SAMPLE_FIXED 27u
 
-// The deform kernels' parameter block also carries the lattice itself (float variants, when it fits):
+// The deform (and accurate) kernels' parameter block also carries the lattice itself (float variants,
+// when it fits):
 // on llvmpipe/lavapipe a uniform-buffer read is a vector load or gather, while every storage-buffer
 // read is a loop over the SIMD lanes, which made lattice evaluation several times slower. 16 KiB in
 // all, the smallest uniform block every GL 4.3 and Vulkan device accepts. lattice.break_offset.w is
 // then the first vec4 of the Bezier coefficients in inline_lattice (the frame reals come first, four
 // to a vec4); 0 means the kernel reads the lattice storage buffers instead (f64, or too large).
 // The fit table follows the lattice there when it fits too (sections.x: its first vec4, 0: read
-// it from the lattice frame range).
+// it from the lattice frame range; lattice_eval.glsl's latticeTableAt).
 #define SFFD_INLINE_LATTICE_VEC4 1015
 SFFD_STRUCT_BEGIN(DeformParams)
   SFFD_STRUCT_MEMBER(LatticeParams, lattice)
@@ -219,7 +221,7 @@ SFFD_STRUCT_END(PnParams)
 
 // ---- kernel accurate_patches (accurate FFD, METHOD.md 2; owner: accurate FFD) ----
 // Three dispatches a chunk of knot-box sub-triangles (range.z selects the stage), so that no invocation
-// runs more than a few hundred loop iterations (llvmpipe ends every invocation after 65535 in all):
+// runs more than m^2 loop iterations (18,496 at n = 15; llvmpipe ends every invocation after 65535 in all):
 //   stage 0, a thread per (sub-triangle, sample l): S_l = R(x(l/n)) at the principal lattice points;
 //   stage 1, a thread per sub-triangle: P_k = sum_l A_n^{-1}[k][l] S_l (k, then l ascending; every lane
 //     reads the same entry of A_n^{-1} at a time);

@@ -16,17 +16,7 @@ layout(std140, SFFD_SET binding = SFFD_BINDING_PARAMS) uniform DeformBlock { Def
 #include "../pn/pn_eval.glsl"
 // Fit-table reads: from the parameter block when the host put the table there (layout.h), as the
 // lattice; else from the lattice frame range, after the frame.
-#if !SFFD_F64
-real fitAt(uint i) {
-  real v;
-  bool inParams = sffdAssumes(SFFD_ASSUME_FIT_IN_PARAMS) || (!sffdAssumes(SFFD_ASSUME_FIT_IN_STORAGE) && params.sections.x != 0u);
-  if (inParams) v = params.inline_lattice[params.sections.x + (i >> 2u)][i & 3u];
-  else v = latticeFrame[params.sections.y + i];
-  return v;
-}
-#else
-real fitAt(uint i) { return latticeFrame[params.sections.y + i]; }
-#endif
+real fitAt(uint i) { return latticeTableAt(params.sections.x, params.sections.y, i); }
 layout(std430, SFFD_SET binding = SFFD_BINDING_DEFORM_SUB_RECORDS) readonly buffer SubRecords { real4 subRecords[]; };
 // The crease slot bits of sub-triangle st (layout.h: an integer-valued real).
 uint smoothCreaseBits(uint st) { return uint(subRecords[SFFD_SUB_STRIDE * st + SFFD_SUB_CREASE_BITS].w); }

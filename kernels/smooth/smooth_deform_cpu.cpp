@@ -37,16 +37,15 @@ struct DeformTwin {
   int fitPoints, level;
 
   // float variants: the lattice and the fit table from the parameter block where the host put them
-  // there (layout.h, DeformParams), as lattice_eval.glsl and fitAt() read them.
+  // there (layout.h, DeformParams), else the lattice bindings and the frame range after the frame, as
+  // lattice_eval.glsl and fitAt() read them.
   DeformTwin(const CpuKernelArgs& a, uint64_t n)
       : p(a.paramsAs<gpu::DeformParams>()),
         L(boundLattice<Real>(a, p.lattice, p.inline_lattice)),
-        fit(blockReals<Real>(p.inline_lattice, p.sections.x != 0, p.sections.x)),
+        fit(tableReals<Real>(a, p.inline_lattice, p.sections.x, p.sections.y, uint64_t(SFFD_FIT_STRIDE) * p.range.z)),
         records(a.array<const Real>(SFFD_BINDING_DEFORM_SUB_RECORDS, 4 * SFFD_SUB_STRIDE * n).data()),
         fitPoints(int(p.range.z)),
         level(int(p.range.w)) {
-    // Else after the lattice frame, from the real sections.y (layout.h).
-    if (!fit) fit = a.array<const Real>(SFFD_BINDING_LATTICE_FRAME, uint64_t(p.sections.y) + uint64_t(SFFD_FIT_STRIDE) * p.range.z).data() + p.sections.y;
     a.check(p.range.z <= SFFD_MAX_FIT_POINTS && p.range.w >= 1, "deform: fitting points or tessellation level out of range");
   }
 

@@ -5,6 +5,7 @@
 
 #include <cstdlib>
 #include <random>
+#include <set>
 #include <sstream>
 #include <tuple>
 
@@ -248,13 +249,21 @@ class ForwardingBackend final : public Backend {
   void dispatch(const Dispatch& d) override {
     Dispatch plain = d;
     assumed |= d.variant.assumptions;
+    dispatched.insert(useOf(d.kernel, d.variant));
     plain.variant.assumptions = 0;
     to_.dispatch(plain);
+  }
+  void precompile(const std::vector<KernelUse>& kernels) override {
+    for (const KernelUse& k : kernels) precompiled.insert(useOf(k.kernel, k.variant));
   }
   void barrier() override { to_.barrier(); }
   void finish() override { to_.finish(); }
   std::vector<DispatchTiming> takeTimings() override { return to_.takeTimings(); }
   uint32_t assumed = 0;   // the assumptions the session asked for, taken away
+  // The kernel variants asked for ahead and those dispatched (name, strict, f64, assumptions).
+  using Use = std::tuple<std::string, bool, bool, uint32_t>;
+  static Use useOf(std::string_view kernel, KernelVariant v) { return {std::string(kernel), v.strict, v.f64, v.assumptions}; }
+  std::set<Use> precompiled, dispatched;
 
  private:
   Backend& to_;
@@ -284,6 +293,30 @@ TEST_P(DeformSessionTest, KernelsWithoutLatticeAssumptionsGiveTheSameBits) {
     EXPECT_EQ(n.patches, a.patches);
   }
   EXPECT_EQ(vk::validationMessageCount(), 0u);
+}
+
+// A session asks ahead (Backend::precompile) for exactly the kernel variants it dispatches: regular and
+// knot-box clipping, fused and split deform, kept and one-shot (streamed). The same on every backend:
+// on the CPU device, which takes no time to compile the variants without assumptions.
+TEST(DeformSessionKernels, PrecompilesWhatItDispatches) {
+  Mesh m = readMesh(std::string(SFFD_TEST_DATA) + "/sphere.obj");
+  Lattice L = latticeFor(m, 1, 0.1);
+  for (auto [knotBox, split, once] : {std::tuple{false, false, false}, std::tuple{true, false, false},
+                                      std::tuple{false, true, false}, std::tuple{false, false, true}, std::tuple{true, true, true}}) {
+    SCOPED_TRACE(std::string(knotBox ? "knot-box" : "regular") + (split ? ", split" : "") + (once ? ", one-shot" : ""));
+    ForwardingBackend recorded(sffd::testing::cpuBackend());
+    DeformSessionOptions o;
+    o.edgeLength = 0.3;
+    o.level = 2;
+    o.knotBoxClip = knotBox;
+    o.split = split;
+    o.once = once;
+    DeformSession s(recorded, m, L, o);
+    s.deform(L);
+    if (once) s.streamChunks([](const DeformSession::Chunk&, const SubTrianglePreImages&) {});
+    EXPECT_FALSE(recorded.dispatched.empty());
+    EXPECT_EQ(recorded.precompiled, recorded.dispatched);
+  }
 }
 
 // A device whose storage binding cannot hold the job's vertices and one triangle's pre-compute inputs:
