@@ -16,12 +16,13 @@ set(SFFD_KERNELS
 # SFFD_SPIRV_OPTIMIZED: lavapipe translates and optimizes each pipeline's SPIR-V in every process (its
 # disk cache keeps only machine code), and deform_smooth's inlined SSA form with its assumptions folded
 # is translated in 30-50 ms, not 100-260 (docs/PERFORMANCE.md, "SPIR-V made for the usual dispatch").
-# The other kernels gain nothing there, and clip_write's code on lavapipe 22.3 runs 5 % more
-# instructions optimized, so they stay as glslang writes them. `--simplify-instructions` is left out
+# clip_write's in 26 ms, not 35, for 6 % more instructions when it runs on lavapipe 22.3 (0.1 ms of a
+# clip that runs once a mesh, against the translation every process pays: "The whole run, again").
+# The other kernels gain nothing there, so they stay as glslang writes them. `--simplify-instructions` is left out
 # because it reassociates float constants where no NoContraction forbids it: the fast kernels would no
 # longer give the CPU twin's bits on lavapipe. The rest changes no arithmetic (constant folding is IEEE;
 # strict kernels stay bit-identical).
-set(SFFD_SPIRV_OPTIMIZED deform_smooth)
+set(SFFD_SPIRV_OPTIMIZED deform_smooth clip_write)
 find_program(SFFD_SPIRV_OPT spirv-opt REQUIRED)
 set(SFFD_SPIRV_OPT_PASSES
     --wrap-opkill --eliminate-dead-branches --merge-return --inline-entry-points-exhaustive
