@@ -1,7 +1,9 @@
 // MeshFileWriter (<sffd/mesh.h>): writeMesh's file from a mesh handed over in pieces. PLY's header names
 // the vertex and face counts, known only at the end: vertices and faces go to two scratch files beside the
 // output, copied after the header into the output's temporary file at end(). STL's facets go straight to
-// the output (binary: the triangle count written over its placeholder at the end).
+// the output (binary: the triangle count written over its placeholder at the end). Both are formatted and
+// written on a thread of their own (PieceQueue) while the caller makes the next pieces; each piece is
+// checked on the caller's, so that a bad vertex stops the stream at the add() that gave it.
 #include <algorithm>
 #include <fstream>
 
@@ -9,6 +11,7 @@
 
 #include "io/atomic_file.h"
 #include "io/mesh_write_records.h"
+#include "io/piece_queue.h"
 
 namespace sffd {
 namespace {
@@ -50,6 +53,9 @@ struct MeshFileWriter::Impl {
   size_t vertices = 0, triangles = 0;
   std::unique_ptr<AtomicFile> out, vertexSpill, faceSpill;
   std::string vbuf, fbuf;
+  // Streamed modes: the thread that runs write(); everything above it touches from choose() to end().
+  // Last, so that it stops before the rest goes.
+  std::unique_ptr<PieceQueue> writer;
 
   // The fields of the file, fixed by the first piece that has vertices (an empty mesh has none).
   void choose(const Mesh& piece) {
@@ -66,6 +72,7 @@ struct MeshFileWriter::Impl {
       out = std::make_unique<AtomicFile>(path, options.binary);
       out->stream() << meshio::stlHeader(options.binary, 0);   // binary: the count set at the end
     }
+    writer = std::make_unique<PieceQueue>([this](const Mesh& piece) { write(piece); });
   }
 
   void check(const Mesh& piece, size_t first) {
@@ -96,6 +103,14 @@ struct MeshFileWriter::Impl {
   }
 
   void add(const Mesh& piece) {
+    if (writer) writer->push(piece);
+    else write(piece);
+    vertices += piece.positions.size();
+    triangles += piece.triangles.size();
+  }
+
+  // The piece into the file (streamed modes: on the writer's thread) or the gathered mesh.
+  void write(const Mesh& piece) {
     const int digits = options.significantDigits;
     const size_t n = piece.positions.size();
     switch (mode) {
@@ -118,12 +133,11 @@ struct MeshFileWriter::Impl {
         if (vbuf.size() >= kFlushBytes) flushTo(vbuf, out->stream());
         break;
     }
-    vertices += n;
-    triangles += piece.triangles.size();
   }
 
   void end() {
     if (mode == Mode::Gather) return writeMesh(path, held, options);
+    writer->drain();
     if (mode == Mode::Ply) {
       flushTo(vbuf, vertexSpill->stream());
       flushTo(fbuf, faceSpill->stream());
