@@ -99,7 +99,8 @@ void Kernels::precompile(const std::vector<KernelUse>& kernels) {
       KernelVariant variant = use.variant;
       Key key = keyOf(use.kernel, variant);
       if (pipelines_.count(key) || building_.count(key)) continue;
-      QueuedBuild b{key.first, variant, {}};
+      const EmbeddedKernel* k = findKernel(use.kernel);
+      QueuedBuild b{key.first, variant, k ? spirvFor(*k, variant).size() : 0, {}};
       building_.emplace(std::move(key), b.done.get_future());
       queue_.push_back(std::move(b));
       ++queued;
@@ -111,7 +112,7 @@ void Kernels::precompile(const std::vector<KernelUse>& kernels) {
   std::erase_if(workers_, [](const std::future<void>& w) { return w.wait_for(std::chrono::seconds(0)) == std::future_status::ready; });
   for (size_t i = 0; i < std::min(queued, cores); ++i) {
     try {
-      workers_.push_back(std::async(std::launch::async, [this] { buildQueued(); }));
+      workers_.push_back(std::async(std::launch::async, [this, inOrder = i == 0] { buildQueued(inOrder); }));
     } catch (const std::system_error&) {   // no thread to be had: the workers started, or the caller, build them
       break;
     }
@@ -135,14 +136,17 @@ void Kernels::buildIfQueued(const Key& key) {
   }
 }
 
-void Kernels::buildQueued() {
+void Kernels::buildQueued(bool inOrder) {
   for (;;) {
     QueuedBuild b;
     {
       std::lock_guard<std::mutex> lock(queueMutex_);
       if (queue_.empty()) return;
-      b = std::move(queue_.front());
-      queue_.pop_front();
+      auto next = inOrder ? queue_.begin()
+                          : std::max_element(queue_.begin(), queue_.end(),
+                                             [](const QueuedBuild& x, const QueuedBuild& y) { return x.spirvWords < y.spirvWords; });
+      b = std::move(*next);
+      queue_.erase(next);
     }
     try {
       b.done.set_value(build(b.kernel, b.variant));

@@ -3,8 +3,10 @@
 // buffers, see kernels/common/layout.h), so one pipeline layout serves all of them. A pipeline is
 // built from the SPIR-V embedded at build time, on first use of a (kernel, variant) pair or ahead of
 // it (precompile): creating one costs lavapipe tens of milliseconds of SPIR-V to NIR translation and
-// optimisation, which other cores can do while the caller works. Builds ahead are taken in the order
-// they were asked for by one worker a core, so that the first kernel a job dispatches is ready first.
+// optimisation, which other cores can do while the caller works. Builds ahead are taken by one worker a
+// core: the first in the order they were asked for, so that the first kernel a job dispatches is ready
+// first, the others the largest module left, whose translation is the longest (the last kernel of a job
+// is the largest, and waiting for it to be started last made it the run's long pole).
 #pragma once
 #include <deque>
 #include <future>
@@ -40,7 +42,8 @@ class Kernels {
   using Key = std::pair<std::string, uint64_t>;
   Key keyOf(std::string_view kernel, KernelVariant& variant) const;
   VkPipeline build(const std::string& kernel, KernelVariant variant) const;
-  void buildQueued();   // a worker: builds queued pipelines until none is left
+  // A worker: builds queued pipelines until none is left, in order or the largest module first.
+  void buildQueued(bool inOrder);
   // A build no worker has taken yet (or none could start) is made by the caller, now.
   void buildIfQueued(const Key& key);
   void destroy();
@@ -48,6 +51,7 @@ class Kernels {
   struct QueuedBuild {
     std::string kernel;
     KernelVariant variant;
+    size_t spirvWords = 0;   // what the translation's time grows with
     std::promise<VkPipeline> done;
   };
 
