@@ -105,7 +105,9 @@ struct Key3Hash {
 
 // A hash map from 3-word keys to a slot, by open addressing with linear probing (one flat table: no
 // allocation a key, as the node-based std::unordered_map makes). The all-zero key marks an empty slot;
-// Locations never makes it. A returned slot stays valid until the next of().
+// Locations never makes it. A returned slot stays valid until the next of(). A rehash (growth, remap)
+// builds the new table in the storage the last one left: a streamed weld rehashes every compaction,
+// and fresh storage each time cost more in page faults and the kernel's zeroing than the weld itself.
 class Key3Map {
  public:
   explicit Key3Map(size_t expected) : expected_(expected) {}
@@ -126,11 +128,9 @@ class Key3Map {
     for (const Slot& s : slots_) kept += !same(s.key, kEmpty) && to[s.value] != none;
     size_t n = 16;
     while (n < 4 * kept) n *= 2;
-    std::vector<Slot> old;
-    resizeHuge(old, n);
-    old.swap(slots_);
+    emptyTable(n);
     used_ = kept;
-    for (const Slot& s : old)
+    for (const Slot& s : spare_)
       if (!same(s.key, kEmpty) && to[s.value] != none) *find(s.key) = {s.key, to[s.value]};
   }
 
@@ -146,17 +146,24 @@ class Key3Map {
       if (same(slots_[i].key, key) || same(slots_[i].key, kEmpty)) return &slots_[i];
   }
   void grow() {
-    std::vector<Slot> old;
-    resizeHuge(old, slots_.size() * 2);
-    old.swap(slots_);
-    for (const Slot& s : old)
+    emptyTable(slots_.size() * 2);
+    for (const Slot& s : spare_)
       if (!same(s.key, kEmpty)) *find(s.key) = s;
+  }
+  // slots_ becomes n empty slots in the spare storage, spare_ the table it was.
+  void emptyTable(size_t n) {
+    if (spare_.capacity() < n) {
+      freeStorage(spare_);
+      reserveHuge(spare_, n);
+    }
+    spare_.assign(n, Slot{});
+    spare_.swap(slots_);
   }
   // std::array's == calls memcmp here, a call for each probe.
   static bool same(const std::array<uint64_t, 3>& a, const std::array<uint64_t, 3>& b) {
     return ((a[0] ^ b[0]) | (a[1] ^ b[1]) | (a[2] ^ b[2])) == 0;
   }
-  std::vector<Slot> slots_;
+  std::vector<Slot> slots_, spare_;
   size_t expected_, used_ = 0;
 };
 
