@@ -135,7 +135,9 @@ class MeshSink {
 // joined after its header at end(). Other formats, and .ply with colours (whose header depends on the last
 // vertex's alpha), are gathered and written at end(). The file appears at end(), whole; a writer destroyed
 // before (an exception) leaves nothing. Throws as writeMesh does: an input Error for a format it cannot write
-// or a non-finite vertex, which stops the stream.
+// or a non-finite vertex (from the add() that gives it), which stops the stream. A streamed file is formatted
+// and written on a thread of the writer's own while the caller makes the next pieces, so a failed write (a
+// full disk) is thrown by a later add() or by end().
 class MeshFileWriter final : public MeshSink {
  public:
   explicit MeshFileWriter(const std::string& path, const MeshWriteOptions& options = {});
