@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "io/piece_queue.h"
 #include "kernels/clip/split_pattern_table.h"
 #include "pipelines/deform_session_internal.h"
 #include "pipelines/deformer_internal.h"
@@ -72,7 +73,8 @@ class WeldFront {
 
 // The welded result's side of a stream of `s.subTriangles` patches at `level`: a weld slice (pre-images,
 // positions, normals, carried values) and the piece it makes, the writer's two buffers (1 MiB and a piece
-// as text, grown: twice), none larger than the job's whole output; and the weld (PatchWelder::
+// as text, grown: twice), none larger than the job's whole output, and its queue's copies of pieces
+// (PieceQueue: those waiting, the one written, the one being copied, a spare); and the weld (PatchWelder::
 // forgetPassedLocations): between compactions up to twice the front (at least kCompactAt) and a slice's;
 // per location its record, until and number (grown: twice) and up to 8 hash slots (grown twice, the old
 // table beside the new); per vertex its normal, carried values, location, next and number (grown: twice).
@@ -83,9 +85,10 @@ double weldBytes(const Mesh& mesh, int level, const StreamShape& s) {
   const double slicePatches = kWeldSlicePatches, patchVertices = s.subTriangles * nv;
   const double slice = slicePatches * (nv * (72 + 2 * carried + 60) + tris * 20);
   const double writer = std::min(4 * (kMiB + slicePatches * (nv * 400 + tris * 40)), 2 * s.subTriangles * (nv * 400 + tris * 40));
+  const double queued = double(PieceQueue::kWaiting + 3) * slicePatches * (nv * (48 + carried) + tris * 12);
   const double locations = std::min(patchVertices, std::max(double(PatchWelder::kCompactAt), 2 * s.frontLocations) + slicePatches * nv);
   const double vertices = std::min(patchVertices, locations + s.frontVertices);
-  return slice + writer + locations * (2 * 40 + 8 * 32 + 4) + vertices * (2 * (36 + carried) + 4);
+  return slice + writer + queued + locations * (2 * 40 + 8 * 32 + 4) + vertices * (2 * (36 + carried) + 4);
 }
 
 }  // namespace
