@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <csignal>
 #include <cstdlib>
 #include <cstring>
 #include <fcntl.h>
@@ -77,7 +78,10 @@ class Robust : public ::testing::Test {
   // printed as "sffd: vulkan ..." lines and fail the checks below.
   // leakCheck: a sanitizer build checks leaks too (runs that fail before any driver is loaded; Mesa's
   // drivers leak at exit, scripts/test.sh).
-  Result runSffd(const std::vector<std::string>& args, const std::vector<std::string>& env = {}, bool leakCheck = false) {
+  // fileSizeLimit: the largest file the run may write (RLIMIT_FSIZE, SIGXFSZ ignored): a larger write fails
+  // as on a full disk.
+  Result runSffd(const std::vector<std::string>& args, const std::vector<std::string>& env = {}, bool leakCheck = false,
+                 rlim_t fileSizeLimit = RLIM_INFINITY) {
     fs::path o = dir_ / "stdout", e = dir_ / "stderr";
     const bool validate = validationLayerHere();   // before the fork: it runs sffd itself
     pid_t pid = ::fork();
@@ -90,6 +94,11 @@ class Robust : public ::testing::Test {
       if (const char* asan = std::getenv("ASAN_OPTIONS"); asan && leakCheck)
         ::setenv("ASAN_OPTIONS", (std::string(asan) + ":detect_leaks=1").c_str(), 1);
       for (const std::string& kv : env) ::putenv(const_cast<char*>(kv.c_str()));
+      if (fileSizeLimit != RLIM_INFINITY) {
+        ::signal(SIGXFSZ, SIG_IGN);   // ignored across exec: the write fails with EFBIG instead
+        const struct rlimit limit {fileSizeLimit, fileSizeLimit};
+        ::setrlimit(RLIMIT_FSIZE, &limit);
+      }
       std::vector<char*> argv{const_cast<char*>(kSffd.c_str())};
       for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
       argv.push_back(nullptr);
@@ -422,6 +431,28 @@ TEST_F(Robust, JobAboveTheMemoryLimitIsRefused) {
   expectNothingWritten("bad limit");
   r = runSffd({"deform", mesh, "-l", lattice, "--method", "classic", "-o", out("o.obj"), "--quiet"}, {"SFFD_MEMORY_LIMIT=1G"});
   EXPECT_EQ(r.status, 0) << r.err;
+}
+
+// A write that fails half way (a full disk; here a file size limit of 256 KiB) stops a streamed job at the
+// next piece, whose file is formatted and written on a thread of its own (MeshFileWriter): one error line,
+// exit status 2, neither the output nor a temporary file left; so does a gathered format.
+TEST_F(Robust, AFailedWriteStopsTheJobAndLeavesNothing) {
+  const std::string mesh = (fs::path(SFFD_SOURCE_DIR) / "tests/data/teapot_8x8.obj").string(), lattice = (dir_ / "l.json").string();
+  ASSERT_EQ(runSffd({"lattice", mesh, "-o", lattice, "--preset", "twist:0.3", "--quiet"}).status, 0);
+  for (const char* backend : {"cpu", "vulkan"}) {
+    if (!sffd::test::hasDevice(backend)) continue;
+    for (const char* name : {"o.ply", "o.stl", "o.obj"})
+      for (const bool binary : {true, false}) {
+        if (binary && std::string(name) == "o.obj") continue;
+        std::vector<std::string> args = {"deform", mesh, "-l", lattice, "--backend", backend, "-o", out(name)};
+        if (binary) args.push_back("--binary");
+        const std::string context = std::string(backend) + " " + name + (binary ? " binary" : "");
+        const Result r = runSffd(args, {}, false, 256 * 1024);
+        expectInputError(r, out(name) + ": cannot write: ", context);
+        expectNoReports(r, context);
+        expectNothingWritten(context);
+      }
+  }
 }
 
 // ---------------------------------------------------------------------------------------------------

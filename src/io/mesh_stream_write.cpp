@@ -20,9 +20,12 @@ enum class Mode { Gather, Ply, Stl };
 
 constexpr size_t kFlushBytes = 1 << 20;
 
-void flushTo(std::string& buf, std::ostream& os) {
+// A failed write (a full disk) stops the stream at once rather than at end(): the job producing the
+// pieces stops at its next add().
+void flushTo(std::string& buf, std::ostream& os, const std::string& path) {
   os.write(buf.data(), std::streamsize(buf.size()));
   buf.clear();
+  if (!os) throw inputError(path, 0, "cannot write: write failed (disk full?)");
 }
 
 // Appends the file at `from` (a flushed scratch file) to `to`, a block at a time.
@@ -123,14 +126,14 @@ struct MeshFileWriter::Impl {
       case Mode::Ply:
         for (size_t v = 0; v < n; ++v) meshio::appendPlyVertex(vbuf, piece, v, digits, has, options.binary);
         for (const auto& t : piece.triangles) meshio::appendPlyFace(fbuf, t, options.binary);
-        if (vbuf.size() >= kFlushBytes) flushTo(vbuf, vertexSpill->stream());
-        if (fbuf.size() >= kFlushBytes) flushTo(fbuf, faceSpill->stream());
+        if (vbuf.size() >= kFlushBytes) flushTo(vbuf, vertexSpill->stream(), path);
+        if (fbuf.size() >= kFlushBytes) flushTo(fbuf, faceSpill->stream(), path);
         break;
       case Mode::Stl:
         append(held.positions, piece.positions);
         append(held.normals, piece.normals);
         for (const auto& t : piece.triangles) meshio::appendStlFacet(vbuf, held, t, has.normals, digits, options.binary);
-        if (vbuf.size() >= kFlushBytes) flushTo(vbuf, out->stream());
+        if (vbuf.size() >= kFlushBytes) flushTo(vbuf, out->stream(), path);
         break;
     }
   }
@@ -139,8 +142,8 @@ struct MeshFileWriter::Impl {
     if (mode == Mode::Gather) return writeMesh(path, held, options);
     writer->drain();
     if (mode == Mode::Ply) {
-      flushTo(vbuf, vertexSpill->stream());
-      flushTo(fbuf, faceSpill->stream());
+      flushTo(vbuf, vertexSpill->stream(), path);
+      flushTo(fbuf, faceSpill->stream(), path);
       for (AtomicFile* f : {vertexSpill.get(), faceSpill.get()})
         if (!f->stream().flush()) throw inputError(path, 0, "cannot write: write failed (disk full?)");
       out = std::make_unique<AtomicFile>(path, options.binary);
@@ -151,7 +154,7 @@ struct MeshFileWriter::Impl {
       faceSpill.reset();
     } else {
       if (options.binary && triangles > 0xFFFFFFFFull) throw Error(ErrorKind::Input, "binary STL holds at most 2^32 - 1 triangles");
-      flushTo(vbuf, out->stream());
+      flushTo(vbuf, out->stream(), path);
       out->stream() << meshio::stlFooter(options.binary);
       if (options.binary) {
         const std::string header = meshio::stlHeader(true, triangles);
