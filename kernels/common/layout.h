@@ -14,6 +14,10 @@
 
 // Work-group size of every 1-D kernel.
 #define SFFD_LOCAL_SIZE 64
+// The smallest squared length a vector has to have for snormalize to divide it by its length (prelude.glsl,
+// rvec.h): the smallest normal float, in every precision (a float literal in both languages). Shorter ones
+// (zero: a collinear triangle between opposite corner normals) are left as they are, not made NaN.
+#define SFFD_MIN_DIRECTION_LENGTH2 1.17549435e-38f
 // Largest work-group count per dimension guaranteed by the API (and the limit on llvmpipe/lavapipe).
 #define SFFD_MAX_GROUPS_X 65535
 

@@ -114,6 +114,10 @@ uvec3 withComponent(uvec3 v, uint i, uint x) { return uvec3(i == 0u ? x : v.x, i
 // Component i of v, likewise without a variable index.
 real componentOf(real3 v, uint i) { return i == 0u ? v.x : (i == 1u ? v.y : v.z); }
 
+// Whether a vector of squared length len2 has a direction to normalize to (layout.h); snormalize returns
+// one without as it is, a zero normal rather than a NaN that no writer accepts.
+bool sffdHasDirection(real len2) { return len2 >= real(SFFD_MIN_DIRECTION_LENGTH2); }
+
 // Included once for both uses below (the kernels' sources are inlined with each file once).
 #include "correctly_rounded.h"
 #if SFFD_STRICT
@@ -140,7 +144,9 @@ real3 scross(real3 a, real3 b) {
   return r;
 }
 real3 snormalize(real3 v) {
-  P real len = ssqrt(sdot(v, v));
+  P real len2 = sdot(v, v);
+  if (!sffdHasDirection(len2)) return v;
+  P real len = ssqrt(len2);
   P real3 r = sdiv(v, len);
   return r;
 }
@@ -154,14 +160,14 @@ real3 sdiv(real3 v, real s) { return real3(sdiv(v.x, s), sdiv(v.y, s), sdiv(v.z,
 real ssqrt(real x) { return x > real(0) && !isinf(x) ? sffdRefinedRoot(x, sqrt(x)) : sqrt(x); }
 real sdot(real3 a, real3 b) { return dot(a, b); }
 real3 scross(real3 a, real3 b) { return cross(a, b); }
-real3 snormalize(real3 v) { return sdiv(v, ssqrt(dot(v, v))); }
+real3 snormalize(real3 v) { return sffdHasDirection(dot(v, v)) ? sdiv(v, ssqrt(dot(v, v))) : v; }
 #else
 real sdiv(real a, real b) { return a / b; }
 real3 sdiv(real3 v, real s) { return v / s; }
 real ssqrt(real x) { return sqrt(x); }
 real sdot(real3 a, real3 b) { return dot(a, b); }
 real3 scross(real3 a, real3 b) { return cross(a, b); }
-real3 snormalize(real3 v) { return normalize(v); }
+real3 snormalize(real3 v) { return sffdHasDirection(dot(v, v)) ? normalize(v) : v; }
 #endif
 
 #endif

@@ -6,6 +6,8 @@
 
 #include <glm/glm.hpp>
 
+#include "kernels/common/shader_layout.h"
+
 namespace sffd {
 
 template <class Real>
@@ -34,8 +36,14 @@ template <class Real> Real sdot(RVec3<Real> a, RVec3<Real> b) {
 template <class Real> RVec3<Real> scross(RVec3<Real> a, RVec3<Real> b) {
   return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
+// Whether a vector of squared length len2 has a direction to normalize to (layout.h, prelude.glsl's
+// sffdHasDirection).
+template <class Real> bool hasDirection(Real len2) { return len2 >= Real(SFFD_MIN_DIRECTION_LENGTH2); }
+// The unit vector of v, or v itself where it has none (hasDirection), as the kernels' snormalize.
 template <class Real> RVec3<Real> snormalize(RVec3<Real> v) {
-  Real len = std::sqrt(sdot(v, v));
+  const Real len2 = sdot(v, v);
+  if (!hasDirection(len2)) return v;
+  Real len = std::sqrt(len2);
   return {v.x / len, v.y / len, v.z / len};
 }
 

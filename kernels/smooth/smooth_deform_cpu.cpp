@@ -168,9 +168,11 @@ void tessellate(const RVec3<Real> cp[10], const RVec3<Real> ncp[10], int Lv, Rea
   const int nv = (Lv + 1) * (Lv + 2) / 2;
   V P[10], N[10];
   for (int q = 0; q < 10; ++q) P[q] = V{cp[q].x, cp[q].y, cp[q].z, 0}, N[q] = V{ncp[q].x, ncp[q].y, ncp[q].z, 0};
-  // snormalize: sqrt of ((x x + y y) + z z), then each lane divided by it.
+  // snormalize: sqrt of ((x x + y y) + z z), then each lane divided by it (left as it is without a direction).
   auto normalized = [](V& n) {
-    const Real len = std::sqrt((n[0] * n[0] + n[1] * n[1]) + n[2] * n[2]);
+    const Real len2 = (n[0] * n[0] + n[1] * n[1]) + n[2] * n[2];
+    if (!hasDirection(len2)) return;
+    const Real len = std::sqrt(len2);
     n = n / V{len, len, len, len};
   };
   auto put = [](Real* o, V& v) {
