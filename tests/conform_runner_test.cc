@@ -167,7 +167,7 @@ fs::path twoCases(const fs::path& dir) {
   return dir / "two.cases";
 }
 
-TEST(ConformRunner, InjectedCrashAndHangAreResultsAndTheRunGoesOn) {
+TEST(ConformRunner, InjectedCrashHangAndLongCompileAreResultsAndTheRunGoesOn) {
   fs::path dir = tempDir("conform_faults");
   const std::string args = "conform --cases " + twoCases(dir).string() + " --backends vulkan,cpu --timeout 2 --json " +
                            (dir / "r.json").string();
@@ -184,6 +184,17 @@ TEST(ConformRunner, InjectedCrashAndHangAreResultsAndTheRunGoesOn) {
   r = runSffd(args, "SFFD_CONFORM_FAULT=hang:vulkan:first");
   EXPECT_EQ(r.status, 1) << r.out << r.err;
   EXPECT_TRUE(has(r.err, "vulkan first: Timeout: no progress for 2 s")) << r.err;
+  EXPECT_TRUE(has(r.out, "second/classic.normals vulkan vs cpu: max_abs=0")) << r.out;
+
+  // A kernel compile longer than --timeout is progress (NVIDIA's GL compiles the strict double clip_write
+  // for 75 s): the child says so while it lasts ...
+  r = runSffd(args, "SFFD_CONFORM_FAULT=slow-compile:cpu:first");
+  EXPECT_EQ(r.status, 0) << r.out << r.err;
+  EXPECT_TRUE(has(r.out, "first/classic.positions vulkan vs cpu: max_abs=0 max_ulp=0 mismatched=0/")) << r.out;
+  // ... for at most ten timeouts.
+  r = runSffd(args, "SFFD_CONFORM_FAULT=stuck-compile:cpu:first");
+  EXPECT_EQ(r.status, 1) << r.out << r.err;
+  EXPECT_TRUE(has(r.err, "cpu first: Timeout: a kernel compile ran past 20 s (10 times --timeout)")) << r.err;
   EXPECT_TRUE(has(r.out, "second/classic.normals vulkan vs cpu: max_abs=0")) << r.out;
 
   // The crash listed in a baseline is an expected failure (exit 0); a listed test that passes is not.

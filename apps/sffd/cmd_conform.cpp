@@ -204,7 +204,7 @@ CommandSpec conformCommand() {
       {"--device", "SUBSTRING", "on each backend, the first device whose name contains SUBSTRING"},
       {"--cases", "default|FILE", "run a case set: the default one (every kernel) or a case file"},
       {"--require", "LIST", "backends that must open (exit 3 otherwise); others that cannot are skipped"},
-      {"--timeout", "SECONDS", "a backend child without progress for this long is killed: Timeout (default 60)"},
+      {"--timeout", "SECONDS", "a backend child without progress for this long is killed: Timeout (default 60; a kernel compile is progress for up to 10 times this)"},
       {"--junit", "FILE", "write JUnit XML: one testcase per case, buffer and pair of backends"},
       {"--json", "FILE", "write the backends, cases and results as JSON"},
       {"--baseline", "FILE", "expected failures, TEST,STATUS lines (deqp-runner's failures.csv)"},

@@ -1,23 +1,30 @@
 // sffd conform: each backend runs in a forked child process, so that a driver that crashes or hangs
 // ends one case, not the run. The parent opens no device itself; the child reports on a pipe (one
-// line an event) and writes each case's buffers to files. Test hook (docs/CONFORMANCE.md):
-// SFFD_CONFORM_FAULT=crash|hang:BACKEND[:CASE] makes that child crash or hang at that case.
+// line an event) and writes each case's buffers to files. While a kernel compiles, the child says "busy"
+// every second, so that a driver's long compile is not taken for a hang, up to kCompileTimeouts times the
+// case timeout (docs/CONFORMANCE.md "Timeouts"). Test hook (docs/CONFORMANCE.md):
+// SFFD_CONFORM_FAULT=crash|hang|slow-compile|stuck-compile:BACKEND[:CASE] makes that child crash, hang, or
+// compile for 3 case timeouts or for ever at that case.
 #include <poll.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
+#include <condition_variable>
 #include <cstdlib>
 #include <cerrno>
 #include <cstring>
+#include <mutex>
 #include <optional>
 #include <fstream>
+#include <thread>
 
 #include <nlohmann/json.hpp>
 #include <sffd/error.h>
 
 #include "apps/sffd/conform.h"
+#include "core/kernel_registry.h"
 
 namespace sffd::cli::conform {
 
@@ -61,7 +68,14 @@ CaseOutput readCaseOutput(const fs::path& dir) {
 
 namespace {
 
+// A kernel compile counts as progress for at most this many case timeouts (10 min by default).
+constexpr double kCompileTimeouts = 10;
+
+// The child's lines come from its main thread and its heartbeat: one write each, one at a time.
+std::mutex gSayMutex;
+
 void say(int fd, const std::string& line) {
+  std::lock_guard<std::mutex> lock(gSayMutex);
   std::string l = line;
   for (char& c : l)
     if (c == '\n') c = ' ';
@@ -73,8 +87,9 @@ void say(int fd, const std::string& line) {
   }
 }
 
-// The test hook: "crash:vulkan" or "hang:gl-egl:CASE".
-void injectFault(const std::string& backend, const std::string& caseName) {
+// The test hook: "crash:vulkan", "hang:gl-egl:CASE", "slow-compile:cpu:CASE" (a compile of 3 case
+// timeouts, which is progress) or "stuck-compile:cpu" (one that never ends).
+void injectFault(const std::string& backend, const std::string& caseName, double timeoutSeconds) {
   const char* v = std::getenv("SFFD_CONFORM_FAULT");
   if (!v) return;
   std::string s = v, kind = s.substr(0, s.find(':')), rest = s.find(':') == std::string::npos ? "" : s.substr(s.find(':') + 1);
@@ -83,11 +98,47 @@ void injectFault(const std::string& backend, const std::string& caseName) {
   if (kind == "crash") ::raise(SIGSEGV);
   if (kind == "hang")
     for (;;) ::pause();
+  if (kind == "slow-compile" || kind == "stuck-compile") {
+    CompileScope compiling(backend, "injected", {});
+    if (kind == "stuck-compile")
+      for (;;) ::pause();
+    std::this_thread::sleep_for(std::chrono::duration<double>(3 * timeoutSeconds));
+  }
 }
+
+// Says "busy" every second (or every fifth of the case timeout, if shorter) while a kernel compile is
+// in flight and younger than kCompileTimeouts case timeouts: a driver compiling is making progress.
+class Heartbeat {
+ public:
+  Heartbeat(int fd, double timeoutSeconds)
+      : thread_([this, fd, timeoutSeconds] {
+          const auto period = std::chrono::duration<double>(std::min(1.0, timeoutSeconds / 5));
+          std::unique_lock<std::mutex> lock(mutex_);
+          while (!cv_.wait_for(lock, period, [this] { return stop_; })) {
+            const double compiling = oldestCompileInFlightSeconds();
+            if (compiling >= 0 && compiling < kCompileTimeouts * timeoutSeconds) say(fd, "busy");
+          }
+        }) {}
+  ~Heartbeat() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stop_ = true;
+    }
+    cv_.notify_one();
+    thread_.join();
+  }
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  bool stop_ = false;
+  std::thread thread_;   // last: starts once the members it reads exist
+};
 
 // The child: opens the device, then runs cases[first..] and reports each on `fd`.
 void childMain(const std::string& name, const std::vector<Case>& cases, size_t first, const fs::path& dir,
                const RunnerOptions& options, int fd) {
+  Heartbeat heartbeat(fd, options.timeoutSeconds);
   std::optional<Device> device;
   try {
     DeviceRequest req;
@@ -101,7 +152,7 @@ void childMain(const std::string& name, const std::vector<Case>& cases, size_t f
   say(fd, "open " + deviceJson(device->label(), device->info()));
   for (size_t i = first; i < cases.size(); ++i) {
     say(fd, "start " + std::to_string(i));
-    injectFault(name, cases[i].name);
+    injectFault(name, cases[i].name, options.timeoutSeconds);
     try {
       writeCaseOutput(dir / cases[i].name, runCase(*device, cases[i]));
       say(fd, "done " + std::to_string(i));
@@ -154,7 +205,7 @@ BackendRun runBackend(const std::string& name, const std::vector<Case>& cases, c
     }
     ::close(fds[1]);
     long current = -1;   // the case the child is in
-    bool timedOut = false, backendSkipped = false;
+    bool timedOut = false, backendSkipped = false, compiling = false;   // compiling: the last line was "busy"
     auto deadline = Clock::now() + std::chrono::duration<double>(options.timeoutSeconds);
     std::string pending;
     for (;;) {
@@ -174,7 +225,9 @@ BackendRun runBackend(const std::string& name, const std::vector<Case>& cases, c
         const std::string line = pending.substr(0, eol), word = line.substr(0, line.find(' '));
         const std::string rest = line.find(' ') == std::string::npos ? "" : line.substr(line.find(' ') + 1);
         deadline = Clock::now() + std::chrono::duration<double>(options.timeoutSeconds);
-        if (word == "open") {
+        compiling = word == "busy";
+        if (word == "busy") {
+        } else if (word == "open") {
           json j = json::parse(rest);
           run.opened = true;
           run.label = j.value("backend", name);
@@ -204,8 +257,12 @@ BackendRun runBackend(const std::string& name, const std::vector<Case>& cases, c
     const bool clean = !timedOut && WIFEXITED(status) && WEXITSTATUS(status) == 0;
     if (clean && next >= cases.size()) break;
     const Status s = timedOut ? Status::Timeout : Status::Crash;
-    char t[64];
-    std::snprintf(t, sizeof t, "no progress for %g s", options.timeoutSeconds);
+    char t[128];
+    if (compiling)
+      std::snprintf(t, sizeof t, "a kernel compile ran past %g s (%g times --timeout)",
+                    kCompileTimeouts * options.timeoutSeconds, kCompileTimeouts);
+    else
+      std::snprintf(t, sizeof t, "no progress for %g s", options.timeoutSeconds);
     const std::string why = timedOut ? std::string(t) : signalText(status);
     if (current < 0) {   // died opening the device or between cases: nothing more can be trusted
       for (size_t i = next; i < cases.size(); ++i) run.cases[i] = {s, why + (run.opened ? "" : " while opening the device")};

@@ -21,6 +21,15 @@
 #ifndef SFFD_CR_PRECISE
 #define SFFD_CR_PRECISE SFFD_PRECISE
 #endif
+// 0, in a form no shader compiler can fold (gl_NumWorkGroups.z is at most 65535), so that the stepping
+// loops below stay loops: each iteration is one exact check of some sixty integer operations, a kernel
+// divides in dozens of places, and unrolled (two checks an iteration, four iterations) they were most of
+// what NVIDIA's compilers spent minutes on (docs/CONFORMANCE.md "Strict kernels").
+#ifndef SFFD_CR_OPAQUE_ZERO
+#define SFFD_CR_OPAQUE_ZERO (gl_NumWorkGroups.z >> 16u)
+#endif
+// The most iterations of a stepping loop: one check, then one a step, four steps either way.
+#define SFFD_CR_CHECKS 6
 
 // Whether m * 2^d > M for a significand m (< 2^24) and a 64-bit M (hi, lo) >= 2^47.
 SFFD_CR_INLINE bool sffdShiftedAbove(uint m, int d, uint hi, uint lo) {
@@ -57,10 +66,21 @@ SFFD_CR_INLINE float sffdRoundedQuotient(float a, float b, float q) {
   int ea = sffdExponent(ua), eb = sffdExponent(ub), eq = sffdExponent(uq);
   if (ea == 0 || ea == 255 || eb == 0 || eb == 255 || eq < 2 || eq > 253) return q;
   uint m = uq & 0x7fffffffu;
-  for (int i = 0; i < 4; ++i) {
-    if (sffdQuotientAbove(ua, ub, m)) m += 1u;
-    else if (!sffdQuotientAbove(ua, ub, m - 1u)) m -= 1u;
-    else break;
+  // Up while the exact quotient lies above m's upper midpoint; if it never did, down while it lies
+  // below m's lower one (the upper midpoint of m - 1). One check an iteration.
+  int dir = 0;
+  for (uint i = 0u; i < uint(SFFD_CR_CHECKS) + SFFD_CR_OPAQUE_ZERO; ++i) {
+    bool above = sffdQuotientAbove(ua, ub, dir < 0 ? m - 1u : m);
+    if (dir >= 0 && above) {
+      m += 1u;
+      dir = 1;
+    } else if (dir == 0) {
+      dir = -1;
+    } else if (dir < 0 && !above) {
+      m -= 1u;
+    } else {
+      break;
+    }
   }
   return uintBitsToFloat(((ua ^ ub) & 0x80000000u) | m);
 }
@@ -71,10 +91,19 @@ SFFD_CR_INLINE float sffdRoundedRoot(float x, float s) {
   int es = sffdExponent(us);
   if (ux >= 0x7f800000u || ux < 0x00800000u || us >= 0x80000000u || es < 2 || es > 253) return s;
   uint m = us;
-  for (int i = 0; i < 4; ++i) {
-    if (sffdRootAbove(ux, m)) m += 1u;
-    else if (!sffdRootAbove(ux, m - 1u)) m -= 1u;
-    else break;
+  int dir = 0;   // as in sffdRoundedQuotient
+  for (uint i = 0u; i < uint(SFFD_CR_CHECKS) + SFFD_CR_OPAQUE_ZERO; ++i) {
+    bool above = sffdRootAbove(ux, dir < 0 ? m - 1u : m);
+    if (dir >= 0 && above) {
+      m += 1u;
+      dir = 1;
+    } else if (dir == 0) {
+      dir = -1;
+    } else if (dir < 0 && !above) {
+      m -= 1u;
+    } else {
+      break;
+    }
   }
   return uintBitsToFloat(m);
 }
@@ -171,15 +200,33 @@ SFFD_CR_INLINE double sffdRoundedQuotient(double a, double b, double q) {
   uvec2 ua = unpackDouble2x32(a), ub = unpackDouble2x32(b);
   int ea = sffdExponent64(ua), eb = sffdExponent64(ub);
   if (ea == 0 || ea == 2047 || eb == 0 || eb == 2047) return q;
-  q = sffdRefinedQuotient(a, b, q);
+  // sffdRefinedQuotient's Newton steps with one division, not two: each step multiplies q's error by
+  // 1 - b / b', b' the driver's b, as small as q's first error. For |b| >= 2^1022, whose reciprocal
+  // would be subnormal, by way of b 2^-64 (exact).
+  SFFD_CR_PRECISE double scale = eb >= 2045 ? 5.421010862427522e-20 : 1.0;   // 2^-64
+  SFFD_CR_PRECISE double rb = 1.0 / (b * scale);
+  for (int i = 0; i < 2; ++i) {
+    SFFD_CR_PRECISE double r = a - q * b;
+    SFFD_CR_PRECISE double n = q + (r * rb) * scale;
+    q = n;
+  }
   uvec2 uq = unpackDouble2x32(q);
   int eq = sffdExponent64(uq);
   if (eq < 2 || eq > 2045) return q;
   uvec2 m = uvec2(uq.x, uq.y & 0x7fffffffu);
-  for (int i = 0; i < 4; ++i) {
-    if (sffdQuotientAbove64(ua, ub, m)) m = sffdNext64(m);
-    else if (!sffdQuotientAbove64(ua, ub, sffdPrev64(m))) m = sffdPrev64(m);
-    else break;
+  int dir = 0;   // as for float
+  for (uint i = 0u; i < uint(SFFD_CR_CHECKS) + SFFD_CR_OPAQUE_ZERO; ++i) {
+    bool above = sffdQuotientAbove64(ua, ub, dir < 0 ? sffdPrev64(m) : m);
+    if (dir >= 0 && above) {
+      m = sffdNext64(m);
+      dir = 1;
+    } else if (dir == 0) {
+      dir = -1;
+    } else if (dir < 0 && !above) {
+      m = sffdPrev64(m);
+    } else {
+      break;
+    }
   }
   return packDouble2x32(uvec2(m.x, ((ua.y ^ ub.y) & 0x80000000u) | m.y));
 }
@@ -187,15 +234,29 @@ SFFD_CR_INLINE double sffdRoundedQuotient(double a, double b, double q) {
 SFFD_CR_INLINE double sffdRoundedRoot(double x, double s) {
   uvec2 ux = unpackDouble2x32(x);
   if (ux.y >= 0x7ff00000u || ux.y < 0x00100000u || !(s > 0.0)) return s;
-  s = sffdRefinedRoot(x, s);
+  SFFD_CR_PRECISE double h = 0.5 / s;   // sffdRefinedRoot's steps with one division, as above
+  for (int i = 0; i < 2; ++i) {
+    SFFD_CR_PRECISE double r = x - s * s;
+    SFFD_CR_PRECISE double n = s + r * h;
+    s = n;
+  }
   uvec2 us = unpackDouble2x32(s);
   int es = sffdExponent64(us);
   if (us.y >= 0x80000000u || es < 2 || es > 2045) return s;
   uvec2 m = us;
-  for (int i = 0; i < 4; ++i) {
-    if (sffdRootAbove64(ux, m)) m = sffdNext64(m);
-    else if (!sffdRootAbove64(ux, sffdPrev64(m))) m = sffdPrev64(m);
-    else break;
+  int dir = 0;   // as for float
+  for (uint i = 0u; i < uint(SFFD_CR_CHECKS) + SFFD_CR_OPAQUE_ZERO; ++i) {
+    bool above = sffdRootAbove64(ux, dir < 0 ? sffdPrev64(m) : m);
+    if (dir >= 0 && above) {
+      m = sffdNext64(m);
+      dir = 1;
+    } else if (dir == 0) {
+      dir = -1;
+    } else if (dir < 0 && !above) {
+      m = sffdPrev64(m);
+    } else {
+      break;
+    }
   }
   return packDouble2x32(m);
 }

@@ -74,6 +74,28 @@ TEST(CorrectlyRounded, DoublesFromFloatPrecision) {
   }
 }
 
+// The same over the whole double range, a third of the divisors 2^1022 or more (their reciprocals are
+// subnormal, which the strict Newton steps avoid): a float-precision error, in double's own range.
+TEST(CorrectlyRounded, DoublesFromFloatPrecisionOverTheWholeRange) {
+  std::mt19937_64 rng(1022);
+  std::uniform_real_distribution<double> mant(1, 2), error(-1, 1);
+  std::uniform_int_distribution<int> expo(-1020, 1023), high(1022, 1023), pick(0, 2);
+  int checked = 0;
+  for (int i = 0; i < 100000; ++i) {
+    double a = std::ldexp(mant(rng), expo(rng)), b = std::ldexp(mant(rng), pick(rng) == 0 ? high(rng) : expo(rng));
+    if (rng() & 1) b = -b;
+    const double q = a / b;
+    // Quotients near the ends of the range are returned as the driver gave them.
+    if (!(std::abs(q) >= 0x1p-1020 && std::abs(q) <= 0x1p1020)) continue;
+    const double approx = q * (1 + 0x1p-23 * error(rng));
+    ASSERT_EQ(bits(sffdRoundedQuotient(a, b, approx)), bits(q)) << a << " / " << b << " from " << approx;
+    const double x = std::abs(a);
+    ASSERT_EQ(bits(sffdRoundedRoot(x, std::sqrt(x) * (1 + 0x1p-23 * error(rng)))), bits(std::sqrt(x))) << "sqrt " << x;
+    ++checked;
+  }
+  EXPECT_GT(checked, 50000);
+}
+
 // Exact results at binade edges, approached from below (the neighbour below has half the ulp).
 TEST(CorrectlyRounded, ExactPowersOfTwoFromBelow) {
   for (float p : {0.25f, 1.0f, 2.0f, 1024.0f}) {

@@ -26,7 +26,9 @@ inline uint uaddCarry(uint a, uint b, uint& carry) {
 }
 #define SFFD_CR_INLINE inline
 #define SFFD_CR_PRECISE   // the project builds with -ffp-contract=off
+#define SFFD_CR_OPAQUE_ZERO 0u
 #include "correctly_rounded.h"
 #undef SFFD_CR_INLINE
 #undef SFFD_CR_PRECISE
+#undef SFFD_CR_OPAQUE_ZERO
 }  // namespace sffd::kernels::rounded

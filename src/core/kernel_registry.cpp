@@ -119,16 +119,35 @@ void traceFirstDispatch(std::string_view label, double deviceMs) {
   std::fprintf(stderr, "sffd: first dispatch %.*s: %.1f ms\n", int(label.size()), label.data(), deviceMs);
 }
 
-CompileTrace::CompileTrace(std::string_view backend, std::string_view kernel, KernelVariant variant) {
-  if (!compileTraceOn()) return;
-  what_ = std::string(backend) + " " + std::string(kernel) + " " + variantName(variant);
-  start_ = std::chrono::steady_clock::now();
+namespace {
+// The start times of the CompileScopes alive (a few at once: one per precompile worker).
+std::mutex gCompilesMutex;
+std::multiset<std::chrono::steady_clock::time_point> gCompiles;
+}  // namespace
+
+CompileScope::CompileScope(std::string_view backend, std::string_view kernel, KernelVariant variant)
+    : start_(std::chrono::steady_clock::now()) {
+  {
+    std::lock_guard<std::mutex> lock(gCompilesMutex);
+    gCompiles.insert(start_);
+  }
+  if (compileTraceOn()) what_ = std::string(backend) + " " + std::string(kernel) + " " + variantName(variant);
 }
 
-CompileTrace::~CompileTrace() {
+CompileScope::~CompileScope() {
+  {
+    std::lock_guard<std::mutex> lock(gCompilesMutex);
+    gCompiles.erase(gCompiles.find(start_));
+  }
   if (what_.empty()) return;
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start_).count();
   std::fprintf(stderr, "sffd: compile %s: %.1f ms\n", what_.c_str(), ms);
+}
+
+double oldestCompileInFlightSeconds() {
+  std::lock_guard<std::mutex> lock(gCompilesMutex);
+  if (gCompiles.empty()) return -1;
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - *gCompiles.begin()).count();
 }
 
 }  // namespace sffd

@@ -64,20 +64,26 @@ bool compileTraceOn();
 // `sffd: first dispatch LABEL: MS ms`: on llvmpipe and lavapipe it includes the code generation.
 void traceFirstDispatch(std::string_view label, double deviceMs);
 
-// With SFFD_TRACE_COMPILE=1 in the environment, a backend's creation of one kernel variant (Vulkan
-// pipeline, GL program) prints one line `sffd: compile BACKEND KERNEL VARIANT: MS ms` to stderr when this
-// goes out of scope: which variants a run compiles and what creating each costs. llvmpipe and lavapipe
-// generate the machine code later, at the first dispatch (docs/PERFORMANCE.md "Cold start").
-class CompileTrace {
+// The creation of one kernel variant by a backend (Vulkan pipeline, GL program), from construction to
+// destruction. With SFFD_TRACE_COMPILE=1 in the environment it prints one line `sffd: compile BACKEND
+// KERNEL VARIANT: MS ms` to stderr at the end: which variants a run compiles and what creating each costs
+// (llvmpipe and lavapipe generate the machine code later, at the first dispatch: docs/PERFORMANCE.md "Cold
+// start"). Always, it counts as a compile in flight (oldestCompileInFlightSeconds), so that a watchdog can
+// tell a driver that is compiling from one that is hung: NVIDIA's GL compiler takes 75 s over the strict
+// double clip_write (docs/CONFORMANCE.md "Timeouts").
+class CompileScope {
  public:
-  CompileTrace(std::string_view backend, std::string_view kernel, KernelVariant variant);
-  ~CompileTrace();
-  CompileTrace(const CompileTrace&) = delete;
-  CompileTrace& operator=(const CompileTrace&) = delete;
+  CompileScope(std::string_view backend, std::string_view kernel, KernelVariant variant);
+  ~CompileScope();
+  CompileScope(const CompileScope&) = delete;
+  CompileScope& operator=(const CompileScope&) = delete;
 
  private:
   std::string what_;   // empty: tracing is off
   std::chrono::steady_clock::time_point start_;
 };
+
+// How long the oldest CompileScope alive in this process has been; a negative number when none is.
+double oldestCompileInFlightSeconds();
 
 }  // namespace sffd

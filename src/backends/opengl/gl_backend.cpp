@@ -464,7 +464,7 @@ class GlBackend final : public Backend {
     if (variant.f64 && !info_.limits.float64)
       throw deviceError(info_.api + ": the device has no float64 for " + what);
 
-    CompileTrace trace(info_.api, kernel.name, variant);
+    CompileScope compiling(info_.api, kernel.name, variant);
     std::string src = glslForVariant(kernel, variant, es_);
     fitVersion(src, ctx_->glVersion());
     GLuint shader = glCreateShader(GL_COMPUTE_SHADER);

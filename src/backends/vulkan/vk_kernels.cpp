@@ -168,7 +168,7 @@ VkPipeline Kernels::build(const std::string& kernel, KernelVariant variant) cons
     throw Error(ErrorKind::Internal, "kernel '" + kernel + "' has no SPIR-V for variant " + std::to_string(v));
   const Api& api = device_.api();
   VkDevice dev = device_.handle();
-  CompileTrace trace("vulkan", kernel, variant);
+  CompileScope compiling("vulkan", kernel, variant);
   auto mi = vkStruct<VkShaderModuleCreateInfo>(VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO);
   mi.codeSize = spirv.size_bytes();
   mi.pCode = spirv.data();
