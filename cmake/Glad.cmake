@@ -7,7 +7,7 @@ add_custom_command(
   OUTPUT ${SFFD_GLAD_DIR}/src/gl.c ${SFFD_GLAD_DIR}/include/glad/gl.h
          ${SFFD_GLAD_DIR}/src/gles2.c ${SFFD_GLAD_DIR}/include/glad/gles2.h
   COMMAND ${GLAD_EXECUTABLE} --quiet --reproducible --api gl:core=4.5,gles2=3.1
-          --extensions GL_ARB_gl_spirv,GL_ARB_spirv_extensions,GL_KHR_debug,GL_EXT_disjoint_timer_query
+          --extensions GL_ARB_gl_spirv,GL_ARB_spirv_extensions,GL_KHR_debug,GL_EXT_disjoint_timer_query,GL_KHR_parallel_shader_compile,GL_ARB_parallel_shader_compile
           --out-path ${SFFD_GLAD_DIR} c
   COMMAND ${CMAKE_COMMAND} -DHEADER=${SFFD_GLAD_DIR}/include/glad/gl.h -DGUARD=GLAD_GL_H_
           -P ${PROJECT_SOURCE_DIR}/cmake/GladPrefix.cmake

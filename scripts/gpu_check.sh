@@ -86,7 +86,7 @@ for method in smooth accurate; do
   for p in float double; do
     for b in cpu vulkan gl gles; do
       [ $b = gles ] && [ $p = double ] && continue
-      timeout 120 "$S" deform "$T" -l "$L" "${A[@]}" --method $method --strict --precision $p --backend $b \
+      timeout 400 "$S" deform "$T" -l "$L" "${A[@]}" --method $method --strict --precision $p --backend $b \
         -o "$W/$method-$p-$b.ply" --binary --quiet || echo "$method $p $b: exit $?"
     done
     for b in vulkan gl gles; do

@@ -268,7 +268,8 @@ TEST_P(BackendContract, ClassicIdentityInEveryVariant) {
   EXPECT_TRUE(b.takeTimings().empty());
 }
 
-// precompile is a hint: variants built ahead (Vulkan: on other threads) give the same results, and
+// precompile is a hint: variants built ahead (Vulkan: on other threads; GL: on the driver's compiler
+// threads, KHR_parallel_shader_compile) give the same results, and
 // what cannot be built (an unknown kernel, f64 without the feature) fails at the dispatch that needs it.
 TEST_P(BackendContract, PrecompiledVariantsBehaveAsBuiltOnFirstUse) {
   Backend& b = backend();

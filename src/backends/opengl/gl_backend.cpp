@@ -15,6 +15,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <map>
+#include <memory>
 #include <unordered_map>
 #include <utility>
 
@@ -71,6 +72,13 @@ struct Program {
   ProgramResources resources;
 };
 
+// A program whose compile and link are issued and not yet checked: with KHR_parallel_shader_compile
+// the driver works on it on its own threads until the first dispatch asks for its status.
+struct ProgramBuild {
+  GLuint shader = 0, program = 0;
+  std::unique_ptr<CompileScope> compiling;
+};
+
 // What a linked compute program uses, as GL reports it.
 ProgramResources queryResources(GLuint prog) {
   ProgramResources r;
@@ -120,6 +128,15 @@ class GlBackend final : public Backend {
     ctx_->activate();
     es_ = ctx_->es();
     heldToEsMinimum_ = es_ && !deviceLimits;
+    // As many compiler threads as the driver likes (NVIDIA's, Mesa's radeonsi and iris use them); an
+    // adopted context keeps the count its application set (the hint is the context's state).
+    parallelCompile_ = !es_ && (GLAD_GL_KHR_parallel_shader_compile || GLAD_GL_ARB_parallel_shader_compile);
+    if (parallelCompile_ && !ctx_->adopted()) {
+      if (GLAD_GL_KHR_parallel_shader_compile)
+        glMaxShaderCompilerThreadsKHR(0xffffffffu);
+      else
+        glMaxShaderCompilerThreadsARB(0xffffffffu);
+    }
     GLint major = 0, minor = 0, profile = 0;
     glGetIntegerv(GL_MAJOR_VERSION, &major);
     glGetIntegerv(GL_MINOR_VERSION, &minor);
@@ -187,6 +204,10 @@ class GlBackend final : public Backend {
       ctx_->activate();
       glFinish();
       for (auto& [key, p] : programs_) glDeleteProgram(p.name);
+      for (auto& [key, b] : builds_) {
+        glDeleteShader(b.shader);
+        glDeleteProgram(b.program);
+      }
       for (auto& [id, b] : buffers_) glDeleteBuffers(1, &b.name);
       for (const Pending& p : pending_)
         if (p.begin) {
@@ -280,6 +301,20 @@ class GlBackend final : public Backend {
       glGetBufferSubData(GL_COPY_READ_BUFFER, static_cast<GLintptr>(offset), static_cast<GLsizeiptr>(bytes), data);
     }
     checkGl("download");
+  }
+
+  // Issues the compile and link of each variant where the driver compiles on threads of its own
+  // (KHR_parallel_shader_compile); their status is asked for at the first dispatch. Without it a compile
+  // blocks the caller, so each is compiled at its first use as before. NVIDIA's GL otherwise compiles a
+  // job's kernels one after the other: 148 s for strict double (PERFORMANCE.md "On a GPU", run 4).
+  void precompile(const std::vector<KernelUse>& kernels) override {
+    if (!parallelCompile_) return;
+    ctx_->activate();
+    for (const KernelUse& use : kernels) {
+      const EmbeddedKernel* kernel = findKernel(use.kernel);
+      // What cannot be built fails at its dispatch, as the interface says.
+      if (kernel && (!use.variant.f64 || info_.limits.float64)) startBuild(*kernel, use.variant);
+    }
   }
 
   void dispatch(const Dispatch& d) override {
@@ -455,40 +490,63 @@ class GlBackend final : public Backend {
     return q;
   }
 
+  using ProgramKey = std::pair<const EmbeddedKernel*, uint64_t>;
+
   const Program& program(const EmbeddedKernel& kernel, KernelVariant variant) {
     variant = forDevice(variant, info_);
-    auto key = std::make_pair(&kernel, variantKey(variant));
+    const ProgramKey key(&kernel, variantKey(variant));
     auto it = programs_.find(key);
     if (it != programs_.end()) return it->second;
-    std::string what = std::string(kernel.name) + " (" + variantName(variant) + ")";
-    if (variant.f64 && !info_.limits.float64)
-      throw deviceError(info_.api + ": the device has no float64 for " + what);
+    startBuild(kernel, variant);
+    auto b = builds_.find(key);
+    ProgramBuild build = std::move(b->second);
+    builds_.erase(b);
+    return programs_.emplace(key, finishBuild(kernel, variant, std::move(build))).first->second;
+  }
 
-    CompileScope compiling(info_.api, kernel.name, variant);
+  // Issues the compile and link of a variant (forDevice's) not built or building yet.
+  void startBuild(const EmbeddedKernel& kernel, KernelVariant variant) {
+    variant = forDevice(variant, info_);
+    const ProgramKey key(&kernel, variantKey(variant));
+    if (programs_.count(key) || builds_.count(key)) return;
+    if (variant.f64 && !info_.limits.float64)
+      throw deviceError(info_.api + ": the device has no float64 for " + std::string(kernel.name) + " (" +
+                        variantName(variant) + ")");
+    ProgramBuild b;
+    b.compiling = std::make_unique<CompileScope>(info_.api, kernel.name, variant);
     std::string src = glslForVariant(kernel, variant, es_);
     fitVersion(src, ctx_->glVersion());
-    GLuint shader = glCreateShader(GL_COMPUTE_SHADER);
+    b.shader = glCreateShader(GL_COMPUTE_SHADER);
     const char* text = src.c_str();
-    glShaderSource(shader, 1, &text, nullptr);
-    glCompileShader(shader);
+    glShaderSource(b.shader, 1, &text, nullptr);
+    glCompileShader(b.shader);
+    b.program = glCreateProgram();
+    glAttachShader(b.program, b.shader);
+    glLinkProgram(b.program);
+    builds_.emplace(key, std::move(b));
+  }
+
+  // Waits for a build's compile and link (the status queries block until the driver is done).
+  Program finishBuild(const EmbeddedKernel& kernel, KernelVariant variant, ProgramBuild b) {
+    std::string what = std::string(kernel.name) + " (" + variantName(variant) + ")";
     GLint ok = 0;
-    glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+    glGetShaderiv(b.shader, GL_COMPILE_STATUS, &ok);
     if (!ok) {
-      std::string log = shaderLog(shader, false);
-      glDeleteShader(shader);
+      std::string log = shaderLog(b.shader, false);
+      glDeleteShader(b.shader);
+      glDeleteProgram(b.program);
       throw Error(ErrorKind::Internal, "gl: compiling kernel " + what + " failed:\n" + log);
     }
-    GLuint prog = glCreateProgram();
-    glAttachShader(prog, shader);
-    glLinkProgram(prog);
-    glDetachShader(prog, shader);
-    glDeleteShader(shader);
-    glGetProgramiv(prog, GL_LINK_STATUS, &ok);
+    glGetProgramiv(b.program, GL_LINK_STATUS, &ok);
+    glDetachShader(b.program, b.shader);
+    glDeleteShader(b.shader);
+    const GLuint prog = b.program;
     if (!ok) {
       std::string log = shaderLog(prog, true);
       glDeleteProgram(prog);
       throw Error(ErrorKind::Internal, "gl: linking kernel " + what + " failed:\n" + log);
     }
+    b.compiling.reset();
     Program p;
     p.name = prog;
     p.resources = queryResources(prog);
@@ -508,7 +566,7 @@ class GlBackend final : public Backend {
       if (binding == SFFD_BINDING_PARAMS) p.paramsBlockSize = size;
     }
     checkGl(("building kernel " + what).c_str());
-    return programs_.emplace(key, p).first->second;
+    return p;
   }
 
   static std::string shaderLog(GLuint object, bool isProgram) {
@@ -530,7 +588,9 @@ class GlBackend final : public Backend {
   DeviceInfo info_;
   std::unordered_map<BufferId, Buf> buffers_;
   BufferId nextId_ = 1;
-  std::map<std::pair<const EmbeddedKernel*, uint64_t>, Program> programs_;
+  std::map<ProgramKey, Program> programs_;
+  std::map<ProgramKey, ProgramBuild> builds_;   // issued by precompile, not yet asked for
+  bool parallelCompile_ = false;                // the driver compiles on its own threads
   GLuint ubo_ = 0;
   uint64_t uboSize_ = 0, uboHead_ = 0, uboAlign_ = 256, maxParams_ = 16384;
   std::vector<Pending> pending_;
