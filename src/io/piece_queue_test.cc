@@ -1,9 +1,14 @@
 // PieceQueue (piece_queue.h): pieces written in order on its thread, copies independent of the caller's
-// piece, a write's error reported by the next push() or drain(), and a queue dropped before it drains.
+// piece, a write's error reported by the next push() or drain(), a queue dropped before it drains, and
+// one that gets no thread.
 #include <gtest/gtest.h>
+
+#include <sys/resource.h>
 
 #include <atomic>
 #include <chrono>
+#include <cstdio>
+#include <cstdlib>
 #include <stdexcept>
 #include <thread>
 
@@ -104,6 +109,48 @@ TEST(PieceQueue, DroppedBeforeDrainingWritesNoMore) {
   EXPECT_LE(written.load(), 1u);
   PieceQueue empty([](const Mesh&) {});
   EXPECT_NO_THROW(empty.drain());
+}
+
+// Without a thread to be had (here: no address space for its stack), the pieces are written on the
+// caller's thread, in order, and a write's error comes out of that push(). In a child process: the
+// limit would hold the whole test program.
+// The child's part: 0 when the queue, without a thread, wrote as it should.
+int writeWithoutAThread() {
+  long pages = 0;
+  FILE* statm = std::fopen("/proc/self/statm", "r");
+  if (!statm || std::fscanf(statm, "%ld", &pages) != 1) return 3;
+  std::fclose(statm);
+  // 2 MiB above what the process maps: a thread's stack (8 MiB by default) does not fit.
+  const rlim_t limit = rlim_t(pages) * 4096 + (2u << 20);
+  const rlimit rl{limit, limit};
+  if (setrlimit(RLIMIT_AS, &rl) != 0) return 4;
+  std::vector<size_t> ids;
+  bool elsewhere = false;
+  const std::thread::id caller = std::this_thread::get_id();
+  PieceQueue q([&](const Mesh& m) {
+    if (m.positions[0].x == 7) throw std::runtime_error("disk full");
+    ids.push_back(size_t(m.positions[0].x));
+    elsewhere = elsewhere || std::this_thread::get_id() != caller;
+  });
+  if (q.threaded()) return 5;
+  for (size_t i = 0; i < 7; ++i) q.push(pieceOf(i, 3));
+  bool thrown = false;
+  try {
+    q.push(pieceOf(7, 3));
+  } catch (const std::runtime_error&) {
+    thrown = true;
+  }
+  q.drain();
+  return thrown && !elsewhere && ids == std::vector<size_t>{0, 1, 2, 3, 4, 5, 6} ? 0 : 6;
+}
+
+TEST(PieceQueue, WithoutAThreadWritesOnTheCallers) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "AddressSanitizer's shadow memory does not live under an address-space limit";
+#endif
+  // A fresh process: a forked one could take a stack glibc kept from the other tests' threads.
+  ::testing::FLAGS_gtest_death_test_style = "threadsafe";
+  EXPECT_EXIT(std::_Exit(writeWithoutAThread()), ::testing::ExitedWithCode(0), "");
 }
 
 }  // namespace
