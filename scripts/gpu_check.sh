@@ -6,12 +6,14 @@
 # DUMP_DIR: a `sffd conform --cases default --dump` made elsewhere (the CI's Mesa 22.3), checked bit for
 # bit. SFFD_REFERENCE_DATA as for model_set.sh (the teapot t.bpt); TESTS=DIR also runs the gtest binaries
 # of DIR (a build's tests/) and summarises them. Each step is bounded by a timeout; in order:
-#   devices; conform --cases default live (vulkan, gl-egl, gles, cpu) and against DUMP_DIR; bench of the
-#   teapot (first process: cold; then warm, fast and strict); five whole `deform --binary` runs per
+#   devices; the kernels' compile times with an empty driver cache (SFFD_TRACE_COMPILE, fast float,
+#   strict float and strict double, Vulkan and GL); conform --cases default live (vulkan, gl-egl, gles,
+#   cpu) and against DUMP_DIR; bench of the teapot (first process with an empty driver cache: cold; then
+#   warm, fast and strict); five whole `deform --binary` runs per
 #   backend; strict outputs of every backend cmp'ed with the CPU's (smooth, accurate; float, double);
 #   a 1,000,000-triangle mesh at level 3 per backend, smooth (both clippings) and accurate (wall, peak RSS);
 #   the gtest binaries.
-# STEPS="conform bench whole strict big tests" (the default) picks steps.
+# STEPS="compile conform bench whole strict big tests" (the default) picks steps.
 set -uo pipefail
 cd "$(dirname "$0")/.."
 [ $# -ge 1 ] || { echo "usage: scripts/gpu_check.sh OUT_DIR [DUMP_DIR]" >&2; exit 2; }
@@ -25,7 +27,7 @@ W=$(mktemp -d)
 trap 'rm -rf "$W"' EXIT
 export SFFD_DEVICE_TIMEOUT=${SFFD_DEVICE_TIMEOUT:-120}
 t0=$(date +%s)
-STEPS=" ${STEPS:-conform bench whole strict big tests} "
+STEPS=" ${STEPS:-compile conform bench whole strict big tests} "
 want() { [[ $STEPS == *" $1 "* ]]; }
 step() { echo "== [$(( $(date +%s) - t0 )) s] $*"; }
 medians() {  # JSON files of `sffd bench --json`: one line per run
@@ -43,6 +45,24 @@ step devices
 { command -v nvidia-smi > /dev/null && nvidia-smi --query-gpu=name,driver_version --format=csv,noheader; "$S" devices; } | tee "$OUT/devices.txt"
 "$S" devices --json > "$OUT/devices.json"
 
+# NVIDIA's drivers keep compiled shaders under __GL_SHADER_DISK_CACHE_PATH (GL and Vulkan alike): a new
+# folder is an empty cache.
+emptyCache() { mktemp -d "$W/cache.XXXX"; }
+
+if want compile; then
+step "compiles with an empty driver cache (strict double: minutes on NVIDIA's GL before 2026-11-27)"
+for b in vulkan gl; do
+  for m in fast strict strict-double; do
+    case $m in fast) flag=();; strict) flag=(--strict);; strict-double) flag=(--strict --precision double);; esac
+    a=$(date +%s%N)
+    SFFD_TRACE_COMPILE=1 __GL_SHADER_DISK_CACHE_PATH=$(emptyCache) timeout 400 "$S" deform "$T" -l "$L" "${A[@]}" \
+      --backend $b "${flag[@]}" -o "$W/c.ply" --binary --quiet > "$W/trace" 2>&1
+    rc=$?
+    echo "$b $m: exit $rc, $(( ($(date +%s%N) - a) / 1000000 )) ms; $(grep -o 'compile [a-z]* [a-z_]*[^:]*: [0-9.]* ms' "$W/trace" | sed 's/^compile [a-z]* //' | paste -sd';')"
+  done
+done | tee "$OUT/compile.txt"
+fi
+
 if want conform; then
 step "conform --cases default"
 timeout 300 "$S" conform --cases default --backends vulkan,gl-egl,gles,cpu --require vulkan,gl-egl \
@@ -58,8 +78,9 @@ fi
 fi
 
 if want bench; then
-step "bench (the first process finds the driver's shader cache as the machine left it)"
-timeout 200 "$S" bench "$T" -l "$L" "${A[@]}" --backends vulkan,gl --repeat 20 --json > "$OUT/bench_first.json" 2> "$W/err" || tail -3 "$W/err"
+step "bench (the first process with an empty driver cache)"
+__GL_SHADER_DISK_CACHE_PATH=$(emptyCache) timeout 200 "$S" bench "$T" -l "$L" "${A[@]}" --backends vulkan,gl --repeat 20 \
+  --json > "$OUT/bench_first.json" 2> "$W/err" || tail -3 "$W/err"
 for m in fast strict; do
   flag=(); [ $m = strict ] && flag=(--strict)
   timeout 200 "$S" bench "$T" -l "$L" "${A[@]}" --backends vulkan,gl,cpu --repeat 50 "${flag[@]}" --json > "$OUT/bench_$m.json" 2> "$W/err" || tail -3 "$W/err"
