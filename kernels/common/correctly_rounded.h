@@ -31,6 +31,15 @@
 // The most iterations of a stepping loop: one check, then one a step, four steps either way.
 #define SFFD_CR_CHECKS 6
 
+// A stepping loop's state: 0 at first, 1 stepped up, -1 looking down, -2 stepped down, 2 done. Up while
+// the exact value lies above m's upper midpoint; if it never did, down while it lies below m's lower
+// one (the upper midpoint of m - 1). `above`: whether it lies above the midpoint probed, m's upper one
+// in states 0 and 1, its lower one in -1 and -2.
+SFFD_CR_INLINE int sffdStepState(int state, bool above) {
+  if (state >= 0) return above ? 1 : (state == 0 ? -1 : 2);
+  return above ? 2 : -2;
+}
+
 // Whether m * 2^d > M for a significand m (< 2^24) and a 64-bit M (hi, lo) >= 2^47.
 SFFD_CR_INLINE bool sffdShiftedAbove(uint m, int d, uint hi, uint lo) {
   if (d < 0) return false;
@@ -66,21 +75,10 @@ SFFD_CR_INLINE float sffdRoundedQuotient(float a, float b, float q) {
   int ea = sffdExponent(ua), eb = sffdExponent(ub), eq = sffdExponent(uq);
   if (ea == 0 || ea == 255 || eb == 0 || eb == 255 || eq < 2 || eq > 253) return q;
   uint m = uq & 0x7fffffffu;
-  // Up while the exact quotient lies above m's upper midpoint; if it never did, down while it lies
-  // below m's lower one (the upper midpoint of m - 1). One check an iteration.
-  int dir = 0;
-  for (uint i = 0u; i < uint(SFFD_CR_CHECKS) + SFFD_CR_OPAQUE_ZERO; ++i) {
-    bool above = sffdQuotientAbove(ua, ub, dir < 0 ? m - 1u : m);
-    if (dir >= 0 && above) {
-      m += 1u;
-      dir = 1;
-    } else if (dir == 0) {
-      dir = -1;
-    } else if (dir < 0 && !above) {
-      m -= 1u;
-    } else {
-      break;
-    }
+  for (int i = 0, state = 0; i < SFFD_CR_CHECKS + int(SFFD_CR_OPAQUE_ZERO); ++i) {
+    state = sffdStepState(state, sffdQuotientAbove(ua, ub, state < 0 ? m - 1u : m));
+    if (state == 2) break;
+    m = state == 1 ? m + 1u : (state == -2 ? m - 1u : m);
   }
   return uintBitsToFloat(((ua ^ ub) & 0x80000000u) | m);
 }
@@ -91,19 +89,10 @@ SFFD_CR_INLINE float sffdRoundedRoot(float x, float s) {
   int es = sffdExponent(us);
   if (ux >= 0x7f800000u || ux < 0x00800000u || us >= 0x80000000u || es < 2 || es > 253) return s;
   uint m = us;
-  int dir = 0;   // as in sffdRoundedQuotient
-  for (uint i = 0u; i < uint(SFFD_CR_CHECKS) + SFFD_CR_OPAQUE_ZERO; ++i) {
-    bool above = sffdRootAbove(ux, dir < 0 ? m - 1u : m);
-    if (dir >= 0 && above) {
-      m += 1u;
-      dir = 1;
-    } else if (dir == 0) {
-      dir = -1;
-    } else if (dir < 0 && !above) {
-      m -= 1u;
-    } else {
-      break;
-    }
+  for (int i = 0, state = 0; i < SFFD_CR_CHECKS + int(SFFD_CR_OPAQUE_ZERO); ++i) {
+    state = sffdStepState(state, sffdRootAbove(ux, state < 0 ? m - 1u : m));
+    if (state == 2) break;
+    m = state == 1 ? m + 1u : (state == -2 ? m - 1u : m);
   }
   return uintBitsToFloat(m);
 }
@@ -214,19 +203,10 @@ SFFD_CR_INLINE double sffdRoundedQuotient(double a, double b, double q) {
   int eq = sffdExponent64(uq);
   if (eq < 2 || eq > 2045) return q;
   uvec2 m = uvec2(uq.x, uq.y & 0x7fffffffu);
-  int dir = 0;   // as for float
-  for (uint i = 0u; i < uint(SFFD_CR_CHECKS) + SFFD_CR_OPAQUE_ZERO; ++i) {
-    bool above = sffdQuotientAbove64(ua, ub, dir < 0 ? sffdPrev64(m) : m);
-    if (dir >= 0 && above) {
-      m = sffdNext64(m);
-      dir = 1;
-    } else if (dir == 0) {
-      dir = -1;
-    } else if (dir < 0 && !above) {
-      m = sffdPrev64(m);
-    } else {
-      break;
-    }
+  for (int i = 0, state = 0; i < SFFD_CR_CHECKS + int(SFFD_CR_OPAQUE_ZERO); ++i) {
+    state = sffdStepState(state, sffdQuotientAbove64(ua, ub, state < 0 ? sffdPrev64(m) : m));
+    if (state == 2) break;
+    m = state == 1 ? sffdNext64(m) : (state == -2 ? sffdPrev64(m) : m);
   }
   return packDouble2x32(uvec2(m.x, ((ua.y ^ ub.y) & 0x80000000u) | m.y));
 }
@@ -244,19 +224,10 @@ SFFD_CR_INLINE double sffdRoundedRoot(double x, double s) {
   int es = sffdExponent64(us);
   if (us.y >= 0x80000000u || es < 2 || es > 2045) return s;
   uvec2 m = us;
-  int dir = 0;   // as for float
-  for (uint i = 0u; i < uint(SFFD_CR_CHECKS) + SFFD_CR_OPAQUE_ZERO; ++i) {
-    bool above = sffdRootAbove64(ux, dir < 0 ? sffdPrev64(m) : m);
-    if (dir >= 0 && above) {
-      m = sffdNext64(m);
-      dir = 1;
-    } else if (dir == 0) {
-      dir = -1;
-    } else if (dir < 0 && !above) {
-      m = sffdPrev64(m);
-    } else {
-      break;
-    }
+  for (int i = 0, state = 0; i < SFFD_CR_CHECKS + int(SFFD_CR_OPAQUE_ZERO); ++i) {
+    state = sffdStepState(state, sffdRootAbove64(ux, state < 0 ? sffdPrev64(m) : m));
+    if (state == 2) break;
+    m = state == 1 ? sffdNext64(m) : (state == -2 ? sffdPrev64(m) : m);
   }
   return packDouble2x32(m);
 }
