@@ -108,15 +108,23 @@ void injectFault(const std::string& backend, const std::string& caseName, double
 
 // Says "busy" every second (or every fifth of the case timeout, if shorter) while a kernel compile is
 // in flight and younger than kCompileTimeouts case timeouts: a driver compiling is making progress.
+// "idle" once none is, so that a later hang is not taken for a compile.
 class Heartbeat {
  public:
   Heartbeat(int fd, double timeoutSeconds)
       : thread_([this, fd, timeoutSeconds] {
           const auto period = std::chrono::duration<double>(std::min(1.0, timeoutSeconds / 5));
+          bool busy = false;
           std::unique_lock<std::mutex> lock(mutex_);
           while (!cv_.wait_for(lock, period, [this] { return stop_; })) {
             const double compiling = oldestCompileInFlightSeconds();
-            if (compiling >= 0 && compiling < kCompileTimeouts * timeoutSeconds) say(fd, "busy");
+            if (compiling >= 0 && compiling < kCompileTimeouts * timeoutSeconds) {
+              say(fd, "busy");
+              busy = true;
+            } else if (busy && compiling < 0) {
+              say(fd, "idle");
+              busy = false;
+            }
           }
         }) {}
   ~Heartbeat() {
@@ -226,7 +234,7 @@ BackendRun runBackend(const std::string& name, const std::vector<Case>& cases, c
         const std::string rest = line.find(' ') == std::string::npos ? "" : line.substr(line.find(' ') + 1);
         deadline = Clock::now() + std::chrono::duration<double>(options.timeoutSeconds);
         compiling = word == "busy";
-        if (word == "busy") {
+        if (word == "busy" || word == "idle") {
         } else if (word == "open") {
           json j = json::parse(rest);
           run.opened = true;

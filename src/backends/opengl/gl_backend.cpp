@@ -73,7 +73,8 @@ struct Program {
 };
 
 // A program whose compile and link are issued and not yet checked: with KHR_parallel_shader_compile
-// the driver works on it on its own threads until the first dispatch asks for its status.
+// the driver works on it on its own threads until the first dispatch asks for its status. It counts as
+// a compile in flight (and SFFD_TRACE_COMPILE times it) from its issue to that first use.
 struct ProgramBuild {
   GLuint shader = 0, program = 0;
   std::unique_ptr<CompileScope> compiling;
