@@ -10,12 +10,14 @@
 #include <cstring>
 #include <random>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <sffd/error.h>
 #include "backends/backend_select.h"
 #include "backends/backend_test_support.h"
 #include "backends/vulkan/vk_backend.h"
+#include "core/kernel_registry.h"
 #include "kernels/classic/classic_ffd.h"
 #include "kernels/common/shader_layout.h"
 
@@ -291,6 +293,21 @@ TEST_P(BackendContract, PrecompiledVariantsBehaveAsBuiltOnFirstUse) {
 // checks that Vulkan's validation saw nothing left behind).
 TEST_P(BackendContract, UnclaimedPrecompiledBuildsEndWithTheBackend) {
   backend().precompile({{"no_such_kernel", {}}, {"classic_ffd", {}}, {"classic_ffd", {true, true}}});
+}
+
+// A build issued ahead and never used stops counting as a compile in flight once the driver is done
+// with it (conform's heartbeat reads the count): by itself on Vulkan's workers, at the next dispatch on GL.
+TEST_P(BackendContract, UnusedPrecompiledBuildsStopCountingOnceBuilt) {
+  Backend& b = backend();
+  b.precompile({{"classic_ffd", {true, false}}});   // strict: never dispatched here
+  ClassicJob<float> job(b, 100, 100);
+  const gpu::ClassicParams p = job.params(0, 100);
+  for (int i = 0; i < 200 && oldestCompileInFlightSeconds() >= 0; ++i) {
+    b.dispatch(job.dispatchOf({}, p, job.vertIn, job.vertOut));
+    b.finish();
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  EXPECT_LT(oldestCompileInFlightSeconds(), 0);
 }
 
 // Ranges in the middle of one larger buffer, at aligned offsets; bad dispatches are internal errors.

@@ -74,7 +74,8 @@ struct Program {
 
 // A program whose compile and link are issued and not yet checked: with KHR_parallel_shader_compile
 // the driver works on it on its own threads until the first dispatch asks for its status. It counts as
-// a compile in flight (and SFFD_TRACE_COMPILE times it) from its issue to that first use.
+// a compile in flight (and SFFD_TRACE_COMPILE times it) from its issue until a dispatch sees it done
+// (GL_COMPLETION_STATUS_KHR) or it is first used.
 struct ProgramBuild {
   GLuint shader = 0, program = 0;
   std::unique_ptr<CompileScope> compiling;
@@ -320,6 +321,7 @@ class GlBackend final : public Backend {
 
   void dispatch(const Dispatch& d) override {
     ctx_->activate();
+    settleBuilds();
     const EmbeddedKernel* kernel = findKernel(d.kernel);
     if (!kernel) throw Error(ErrorKind::Internal, "gl: no kernel named '" + std::string(d.kernel) + "'");
     const Program& prog = program(*kernel, d.variant);
@@ -525,6 +527,17 @@ class GlBackend final : public Backend {
     glAttachShader(b.program, b.shader);
     glLinkProgram(b.program);
     builds_.emplace(key, std::move(b));
+  }
+
+  // Ends the compile scope of each build issued ahead that the driver has finished, so that an unused
+  // one (a job that failed before its dispatch) is not taken for a compile in flight.
+  void settleBuilds() {
+    for (auto& [key, b] : builds_) {
+      if (!b.compiling) continue;
+      GLint done = GL_FALSE;
+      glGetProgramiv(b.program, GL_COMPLETION_STATUS_KHR, &done);
+      if (done) b.compiling.reset();
+    }
   }
 
   // Waits for a build's compile and link (the status queries block until the driver is done).
