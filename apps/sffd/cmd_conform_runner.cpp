@@ -2,7 +2,7 @@
 // ends one case, not the run. The parent opens no device itself; the child reports on a pipe (one
 // line an event) and writes each case's buffers to files. While a kernel compiles, the child says "busy"
 // every second, so that a driver's long compile is not taken for a hang, up to kCompileTimeouts times the
-// case timeout (docs/CONFORMANCE.md "Timeouts"). Test hook (docs/CONFORMANCE.md):
+// case timeout (docs/CONFORMANCE.md "Statuses"). Test hook (docs/CONFORMANCE.md):
 // SFFD_CONFORM_FAULT=crash|hang|slow-compile|stuck-compile:BACKEND[:CASE] makes that child crash, hang, or
 // compile for 3 case timeouts or for ever at that case.
 #include <poll.h>

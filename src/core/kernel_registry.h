@@ -70,7 +70,7 @@ void traceFirstDispatch(std::string_view label, double deviceMs);
 // (llvmpipe and lavapipe generate the machine code later, at the first dispatch: docs/PERFORMANCE.md "Cold
 // start"). Always, it counts as a compile in flight (oldestCompileInFlightSeconds), so that a watchdog can
 // tell a driver that is compiling from one that is hung: NVIDIA's GL compiler takes 75 s over the strict
-// double clip_write (docs/CONFORMANCE.md "Timeouts").
+// double clip_write (docs/CONFORMANCE.md "Statuses").
 class CompileScope {
  public:
   CompileScope(std::string_view backend, std::string_view kernel, KernelVariant variant);
