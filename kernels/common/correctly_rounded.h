@@ -189,9 +189,9 @@ SFFD_CR_INLINE double sffdRoundedQuotient(double a, double b, double q) {
   uvec2 ua = unpackDouble2x32(a), ub = unpackDouble2x32(b);
   int ea = sffdExponent64(ua), eb = sffdExponent64(ub);
   if (ea == 0 || ea == 2047 || eb == 0 || eb == 2047) return q;
-  // sffdRefinedQuotient's Newton steps with one division, not two: each step multiplies q's error by
-  // 1 - b / b', b' the driver's b, as small as q's first error. For |b| >= 2^1022, whose reciprocal
-  // would be subnormal, by way of b 2^-64 (exact).
+  // sffdRefinedQuotient's Newton steps with one division, not two: each step multiplies q's relative
+  // error by 1 - b rb, rb the driver's 1 / b, about as small as q's first error. For |b| >= 2^1022,
+  // whose reciprocal would be subnormal (and flushed by some drivers), by way of b 2^-64 (exact).
   SFFD_CR_PRECISE double scale = eb >= 2045 ? 5.421010862427522e-20 : 1.0;   // 2^-64
   SFFD_CR_PRECISE double rb = 1.0 / (b * scale);
   for (int i = 0; i < 2; ++i) {

@@ -111,10 +111,7 @@ TEST(PieceQueue, DroppedBeforeDrainingWritesNoMore) {
   EXPECT_NO_THROW(empty.drain());
 }
 
-// Without a thread to be had (here: no address space for its stack), the pieces are written on the
-// caller's thread, in order, and a write's error comes out of that push(). In a child process: the
-// limit would hold the whole test program.
-// The child's part: 0 when the queue, without a thread, wrote as it should.
+// The child's part of the test below: 0 when the queue, without a thread, wrote as it should.
 int writeWithoutAThread() {
   long pages = 0;
   FILE* statm = std::fopen("/proc/self/statm", "r");
@@ -144,6 +141,9 @@ int writeWithoutAThread() {
   return thrown && !elsewhere && ids == std::vector<size_t>{0, 1, 2, 3, 4, 5, 6} ? 0 : 6;
 }
 
+// Without a thread to be had (here: no address space for its stack), the pieces are written on the
+// caller's thread, in order, and a write's error comes out of that push(). In a child process: the
+// limit would hold the whole test program.
 TEST(PieceQueue, WithoutAThreadWritesOnTheCallers) {
 #if defined(__SANITIZE_ADDRESS__)
   GTEST_SKIP() << "AddressSanitizer's shadow memory does not live under an address-space limit";
