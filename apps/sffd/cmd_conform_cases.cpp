@@ -8,6 +8,7 @@
 
 #include "apps/sffd/conform.h"
 #include "apps/sffd/deform_job.h"
+#include "core/fnv1a.h"
 #include "core/job_budget.h"
 #include "kernels/accurate/accurate_patches.h"
 #include "kernels/classic/classic_ffd.h"
@@ -68,10 +69,9 @@ Case makeCase(const std::string& name, std::vector<std::string> argv) {
 
 std::string fnv1a(const std::string& path) {
   std::ifstream f(path, std::ios::binary);
-  uint64_t h = 1469598103934665603ull;
+  uint64_t h = kFnv1aSeed;
   char buf[65536];
-  while (f.read(buf, sizeof buf) || f.gcount())
-    for (std::streamsize i = 0; i < f.gcount(); ++i) h = (h ^ uint8_t(buf[i])) * 1099511628211ull;
+  while (f.read(buf, sizeof buf) || f.gcount()) h = fnv1a64(buf, size_t(f.gcount()), h);
   char hex[17];
   std::snprintf(hex, sizeof hex, "%016llx", (unsigned long long)h);
   return hex;

@@ -30,6 +30,7 @@ Device Device::open(const DeviceRequest& request, std::vector<std::string>* note
   r.device = request.deviceSubstring;
   r.validation = request.validation;
   r.deviceLimits = request.deviceLimits;
+  r.shaderCache = request.shaderCache;
   OpenedBackend b = openBackend(r, notes);
   Device d(b.label, std::move(b.backend));
   d.impl_->info = b.info;

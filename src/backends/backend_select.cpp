@@ -26,6 +26,7 @@ OpenedBackend openNamed(const std::string& name, const BackendRequest& r) {
     vk::Options o;
     o.deviceSubstring = r.device;
     o.validation = r.validation;
+    o.shaderCache = r.shaderCache;
     OpenedBackend b;
     b.backend = vk::createBackend(o);
     b.info = b.backend->info();

@@ -21,6 +21,7 @@ struct BackendRequest {
   std::string device;           // device-name substring
   bool validation = false;      // Vulkan validation layer
   bool deviceLimits = false;    // gles: the device's own limits instead of the ES 3.1 minima
+  std::string shaderCache = {}; // Vulkan: "" default folder, "none", or a folder (DeviceRequest::shaderCache)
 };
 
 // Opens the backend; throws a device Error (exit 3) when the one asked for is unusable. For "auto",

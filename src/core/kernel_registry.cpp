@@ -144,6 +144,10 @@ CompileScope::~CompileScope() {
   std::fprintf(stderr, "sffd: compile %s: %.1f ms\n", what_.c_str(), ms);
 }
 
+void CompileScope::note(std::string_view words) {
+  if (!what_.empty()) what_ += " (" + std::string(words) + ")";
+}
+
 double oldestCompileInFlightSeconds() {
   std::lock_guard<std::mutex> lock(gCompilesMutex);
   if (gCompiles.empty()) return -1;

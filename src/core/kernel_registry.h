@@ -77,6 +77,8 @@ class CompileScope {
   ~CompileScope();
   CompileScope(const CompileScope&) = delete;
   CompileScope& operator=(const CompileScope&) = delete;
+  // Adds a few words to the trace line ("from the shader cache").
+  void note(std::string_view words);
 
  private:
   std::string what_;   // empty: tracing is off

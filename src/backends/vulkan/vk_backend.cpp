@@ -79,10 +79,14 @@ constexpr VkAccessFlags kWorkAccess =
 
 class VulkanBackend final : public Backend {
  public:
-  explicit VulkanBackend(const Options& options)
+  explicit VulkanBackend(const Options& options) : VulkanBackend(options, shaderCacheFolder(options.shaderCache)) {}
+
+  VulkanBackend(const Options& options, std::optional<std::filesystem::path> shaderCache)
       : instance_(validationRequested(options.validation)),
-        device_(instance_, selectDevice(instance_, options.deviceSubstring)),
-        kernels_(device_),
+        // VK_EXT_shader_object came with the 1.3.246 headers.
+        device_(instance_, selectDevice(instance_, options.deviceSubstring),
+                shaderCache.has_value() && instance_.validationKnows(VK_MAKE_API_VERSION(0, 1, 3, 246))),
+        kernels_(device_, shaderCache ? std::optional<ShaderBinaryCache>(*shaderCache) : std::nullopt),
         recorder_(device_, kernels_.setLayout()) {}
 
   explicit VulkanBackend(const vulkan::DeviceConfig& c)
@@ -188,7 +192,7 @@ class VulkanBackend final : public Backend {
   }
 
   void dispatch(const Dispatch& d) override {
-    VkPipeline pipeline = kernels_.pipeline(d.kernel, d.variant);   // throws before anything is recorded
+    const Kernel kernel = kernels_.kernel(d.kernel, d.variant);   // throws before anything is recorded
     const DeviceLimits& limits = device_.info().limits;
     for (int i = 0; i < 3; ++i)
       if (d.groups[i] > limits.maxWorkGroupCount[i])
@@ -229,7 +233,7 @@ class VulkanBackend final : public Backend {
     const Api& api = device_.api();
     api.vkUpdateDescriptorSets(device_.handle(), count, writes, 0, nullptr);
     VkCommandBuffer cmd = recorder_.commands();
-    api.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
+    kernels_.bind(cmd, kernel);
     api.vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, kernels_.pipelineLayout(), 0, 1, &set, 0, nullptr);
     recorder_.beginDispatch(std::string(d.label.empty() ? d.kernel : d.label));
     api.vkCmdDispatch(cmd, d.groups[0], d.groups[1], d.groups[2]);
@@ -249,6 +253,8 @@ class VulkanBackend final : public Backend {
   }
 
   std::vector<DispatchTiming> takeTimings() override { return std::exchange(timings_, {}); }
+
+  bool usesShaderObjects() const { return kernels_.usesShaderObjects(); }
 
   VkBuffer vkBuffer(BufferId id) const {
     return id == 0 || id > buffers_.size() || !buffers_[id - 1].live ? VK_NULL_HANDLE : buffers_[id - 1].memory.buffer;
@@ -314,6 +320,11 @@ std::vector<DeviceInfo> listDevices() {
 std::unique_ptr<Backend> createBackend(const Options& options) { return std::make_unique<VulkanBackend>(options); }
 
 std::unique_ptr<Backend> adoptBackend(const vulkan::DeviceConfig& config) { return std::make_unique<VulkanBackend>(config); }
+
+bool usesShaderObjects(const Backend& backend) {
+  const auto* vk = dynamic_cast<const VulkanBackend*>(&backend);
+  return vk && vk->usesShaderObjects();
+}
 
 VkBuffer vkBufferOf(const Backend& backend, BufferId buffer) {
   const auto* vk = dynamic_cast<const VulkanBackend*>(&backend);

@@ -10,8 +10,9 @@
 namespace sffd::vk {
 
 struct Options {
-  std::string deviceSubstring;   // picks the first device whose name contains it (case-insensitive)
+  std::string deviceSubstring = {};   // picks the first device whose name contains it (case-insensitive)
   bool validation = false;       // VK_LAYER_KHRONOS_validation; also on when SFFD_VK_VALIDATION=1
+  std::string shaderCache = {};  // "" the default folder, "none", or a folder (core/shader_binary_cache.h)
 };
 
 // Every physical device, best first (discrete, integrated, virtual, CPU). Throws a device Error when
@@ -23,5 +24,8 @@ size_t validationMessageCount();
 // Device memory allocations (vkAllocateMemory) sffd made so far in this process: tests check that a warm
 // edit makes none (a discrete GPU's driver takes a fraction of a millisecond for each).
 size_t deviceMemoryAllocations();
+// Whether a backend of createBackend's makes its kernels as shader objects (a shader cache and a
+// driver with VK_EXT_shader_object) rather than pipelines; false for any other backend.
+bool usesShaderObjects(const Backend& backend);
 
 }  // namespace sffd::vk

@@ -8,12 +8,16 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include <sffd/error.h>
 #include "backends/backend_test_support.h"
+#include "core/shader_binary_cache.h"
 #include "kernels/common/shader_layout.h"
 
 namespace sffd {
@@ -240,6 +244,78 @@ TEST_F(VkBackendTest, MissingDriverIsDeviceError) {
   ScopedEnv icds("VK_ICD_FILENAMES", "/nonexistent/sffd.json");
   EXPECT_EQ(errorKindOf([] { vk::createBackend({}); }), ErrorKind::Device);
   EXPECT_EQ(errorKindOf([] { vk::listDevices(); }), ErrorKind::Device);
+}
+
+// The output of classic_ffd on the identity lattice, strict and fast (and double where the device has it).
+std::vector<float> classicOutputs(Backend& gpu) {
+  std::vector<float> out;
+  for (bool strict : {true, false}) {
+    ClassicJob<float> job(gpu, 300);
+    job.dispatch({.strict = strict}, 0, 300, job.vertIn, job.vertOut);
+    std::vector<float> v = job.download(job.vertOut, 0, 600);
+    out.insert(out.end(), v.begin(), v.end());
+  }
+  if (gpu.info().limits.float64) {
+    ClassicJob<double> job(gpu, 300);
+    job.dispatch({.strict = true, .f64 = true}, 0, 300, job.vertIn, job.vertOut);
+    for (double d : job.download(job.vertOut, 0, 600)) out.push_back(float(d));
+  }
+  return out;
+}
+
+// Where the driver has VK_EXT_shader_object (Mesa 25's lavapipe: scripts/mesa.sh run -- sffd_vk_tests),
+// a backend with a shader cache stores each kernel's binary, the next one makes its kernels from them,
+// and damaged files are rebuilt from the SPIR-V: the same bits every time, and the same as pipelines'.
+TEST_F(VkBackendTest, ShaderCacheKeepsTheDriversBinariesForTheNextBackend) {
+  SFFD_SKIP_WITHOUT("vulkan");
+  ScopedEnv noValidation("SFFD_VK_VALIDATION", "0");   // the system's layer may predate the extension
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("sffd-vk-shader-cache-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  const std::vector<float> pipelines = classicOutputs(*vk::createBackend({.shaderCache = "none"}));
+  auto withCache = vk::createBackend({.shaderCache = dir.string()});
+  if (!vk::usesShaderObjects(*withCache)) {
+    fs::remove_all(dir);
+    GTEST_SKIP() << withCache->info().driver << " has no VK_EXT_shader_object";
+  }
+  auto files = [&] {
+    std::map<fs::path, uintmax_t> sizes;
+    for (const fs::directory_entry& e : fs::directory_iterator(dir)) sizes[e.path()] = e.file_size();
+    return sizes;
+  };
+  ShaderBinaryCache::Counts c0 = ShaderBinaryCache::counts();
+  EXPECT_EQ(classicOutputs(*withCache), pipelines);
+  withCache.reset();
+  ShaderBinaryCache::Counts c1 = ShaderBinaryCache::counts();
+  const size_t variants = c1.stores - c0.stores;
+  EXPECT_GE(variants, 2u);
+  EXPECT_EQ(c1.misses - c0.misses, variants);
+  const std::map<fs::path, uintmax_t> stored = files();
+  EXPECT_EQ(stored.size(), variants);
+
+  EXPECT_EQ(classicOutputs(*vk::createBackend({.shaderCache = dir.string()})), pipelines);
+  ShaderBinaryCache::Counts c2 = ShaderBinaryCache::counts();
+  EXPECT_EQ(c2.hits - c1.hits, variants);
+  EXPECT_EQ(c2.stores, c1.stores);
+
+  // Damaged: each file cut short, or its binary's bytes changed where the driver itself would not notice.
+  bool cut = true;
+  for (const auto& [path, bytes] : stored) {
+    if (cut) {
+      fs::resize_file(path, bytes / 2);
+    } else {
+      std::fstream f(path, std::ios::in | std::ios::out | std::ios::binary);
+      f.seekp(std::streamoff(bytes - 8));
+      f.write("garbage!", 8);
+    }
+    cut = !cut;
+  }
+  EXPECT_EQ(classicOutputs(*vk::createBackend({.shaderCache = dir.string()})), pipelines);
+  ShaderBinaryCache::Counts c3 = ShaderBinaryCache::counts();
+  EXPECT_EQ(c3.misses - c2.misses, variants);
+  EXPECT_EQ(c3.stores - c2.stores, variants);
+  EXPECT_EQ(files(), stored);   // whole again
+  fs::remove_all(dir);
 }
 
 }  // namespace

@@ -2,6 +2,8 @@
 
 #include <atomic>
 #include <bit>
+#include <cstring>
+#include <type_traits>
 #include <string>
 #include <vector>
 
@@ -24,7 +26,27 @@ std::atomic<size_t> gAllocations{0};   // deviceMemoryAllocations()
 
 size_t deviceMemoryAllocations() { return gAllocations.load(); }
 
-Device::Device(const Instance& instance, const PhysicalDevice& physical)
+namespace {
+
+// Whether the device offers shader objects: the extension, the one it needs below Vulkan 1.3 (sffd's
+// instance asks for 1.2), and the feature.
+bool offersShaderObjects(const Api& api, VkPhysicalDevice physical) {
+  if (!hasDeviceExtension(api, physical, "VK_EXT_shader_object") ||
+      !hasDeviceExtension(api, physical, VK_KHR_DYNAMIC_RENDERING_EXTENSION_NAME))
+    return false;
+  auto objects = vkStruct<VkPhysicalDeviceShaderObjectFeaturesEXT>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SHADER_OBJECT_FEATURES_EXT);
+  auto rendering = vkStruct<VkPhysicalDeviceDynamicRenderingFeaturesKHR>(
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DYNAMIC_RENDERING_FEATURES_KHR);
+  rendering.pNext = &objects;
+  auto features = vkStruct<VkPhysicalDeviceFeatures2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2);
+  features.pNext = &rendering;
+  api.vkGetPhysicalDeviceFeatures2(physical, &features);
+  return objects.shaderObject && rendering.dynamicRendering;
+}
+
+}  // namespace
+
+Device::Device(const Instance& instance, const PhysicalDevice& physical, bool shaderObjects)
     : api_(instance.api()), info_(physical.info), family_(physical.computeFamily), timestampBits_(physical.timestampBits) {
   chooseMemory(physical.handle);
 
@@ -42,7 +64,23 @@ Device::Device(const Instance& instance, const PhysicalDevice& physical)
   if (hasDeviceExtension(api_, physical.handle, "VK_KHR_portability_subset"))
     extensions.push_back("VK_KHR_portability_subset");
 
+  // Shader objects (VK_EXT_shader_object), so that kernels can be made from the driver's own binaries.
+  // The extension needs dynamic rendering enabled with it, though compute never renders.
+  auto objectFeatures =
+      vkStruct<VkPhysicalDeviceShaderObjectFeaturesEXT>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SHADER_OBJECT_FEATURES_EXT);
+  auto renderingFeatures = vkStruct<VkPhysicalDeviceDynamicRenderingFeaturesKHR>(
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DYNAMIC_RENDERING_FEATURES_KHR);
+  shaderObjects = shaderObjects && offersShaderObjects(api_, physical.handle);
+  if (shaderObjects) {
+    extensions.push_back("VK_EXT_shader_object");
+    extensions.push_back(VK_KHR_DYNAMIC_RENDERING_EXTENSION_NAME);
+    objectFeatures.shaderObject = VK_TRUE;
+    renderingFeatures.dynamicRendering = VK_TRUE;
+    renderingFeatures.pNext = &objectFeatures;
+  }
+
   auto ci = vkStruct<VkDeviceCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO);
+  if (shaderObjects) ci.pNext = &renderingFeatures;
   ci.queueCreateInfoCount = 1;
   ci.pQueueCreateInfos = &queueInfo;
   ci.pEnabledFeatures = &features;
@@ -57,6 +95,25 @@ Device::Device(const Instance& instance, const PhysicalDevice& physical)
     throw;
   }
   api_.vkGetDeviceQueue(device_, family_, 0, &queue_);
+  if (shaderObjects) loadShaderObjects(physical.handle);
+}
+
+void Device::loadShaderObjects(VkPhysicalDevice physical) {
+  ShaderObjects so;
+  auto load = [&](auto& fn, const char* name) {
+    fn = reinterpret_cast<std::remove_reference_t<decltype(fn)>>(api_.vkGetDeviceProcAddr(device_, name));
+    return fn != nullptr;
+  };
+  if (!load(so.vkCreateShadersEXT, "vkCreateShadersEXT") || !load(so.vkDestroyShaderEXT, "vkDestroyShaderEXT") ||
+      !load(so.vkGetShaderBinaryDataEXT, "vkGetShaderBinaryDataEXT") || !load(so.vkCmdBindShadersEXT, "vkCmdBindShadersEXT"))
+    return;   // pipelines then, as on a driver without the extension
+  auto props = vkStruct<VkPhysicalDeviceShaderObjectPropertiesEXT>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SHADER_OBJECT_PROPERTIES_EXT);
+  auto props2 = vkStruct<VkPhysicalDeviceProperties2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2);
+  props2.pNext = &props;
+  api_.vkGetPhysicalDeviceProperties2(physical, &props2);
+  std::memcpy(so.binaryUuid, props.shaderBinaryUUID, VK_UUID_SIZE);
+  so.binaryVersion = props.shaderBinaryVersion;
+  shaderObjects_ = so;
 }
 
 Device::Device(const Instance& instance, const PhysicalDevice& physical, VkDevice borrowed, VkQueue queue)

@@ -4,8 +4,10 @@
 // storage, host-visible staging).
 #pragma once
 #include <cstdint>
+#include <optional>
 
 #include "backends/vulkan/vk_instance.h"
+#include "backends/vulkan/vk_shader_object.h"
 
 namespace sffd::vk {
 
@@ -26,8 +28,9 @@ struct Allocation {
 
 class Device {
  public:
-  // Creates the device with shaderFloat64 enabled when the hardware has it.
-  Device(const Instance& instance, const PhysicalDevice& physical);
+  // Creates the device with shaderFloat64 enabled when the hardware has it, and with
+  // VK_EXT_shader_object when `shaderObjects` asks for it and the driver offers it.
+  Device(const Instance& instance, const PhysicalDevice& physical, bool shaderObjects = false);
   // Borrows an application's device and queue (interop; never destroyed here): `physical` describes
   // the queue's family, and its float64 limit says whether shaderFloat64 was enabled.
   Device(const Instance& instance, const PhysicalDevice& physical, VkDevice borrowed, VkQueue queue);
@@ -43,6 +46,8 @@ class Device {
   const VkPhysicalDeviceProperties& properties() const { return props_; }
   const DeviceInfo& info() const { return info_; }
   bool owned() const { return owned_; }
+  // VK_EXT_shader_object's entry points where it was enabled; null otherwise (and on adopted devices).
+  const ShaderObjects* shaderObjects() const { return shaderObjects_ ? &*shaderObjects_ : nullptr; }
   // Leaves the VkDevice alive at destruction: a hung device may still run our work.
   void abandon() { owned_ = false; }
 
@@ -53,6 +58,7 @@ class Device {
  private:
   uint32_t memoryType(uint32_t allowedTypes, MemoryUse use) const;
   void chooseMemory(VkPhysicalDevice physical);
+  void loadShaderObjects(VkPhysicalDevice physical);
 
   Api api_;
   DeviceInfo info_;
@@ -64,6 +70,7 @@ class Device {
   uint32_t family_ = 0;
   uint32_t timestampBits_ = 0;
   bool owned_ = true;
+  std::optional<ShaderObjects> shaderObjects_;
 };
 
 }  // namespace sffd::vk

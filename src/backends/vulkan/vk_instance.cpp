@@ -44,14 +44,15 @@ VkDebugUtilsMessengerCreateInfoEXT messengerInfo() {
   return info;
 }
 
-bool hasLayer(const Api& api, const char* name) {
+// The layer's specVersion (the Vulkan headers it was built with); 0 when it is not installed.
+uint32_t layerVersion(const Api& api, const char* name) {
   uint32_t count = 0;
   api.vkEnumerateInstanceLayerProperties(&count, nullptr);
   std::vector<VkLayerProperties> layers(count);
   api.vkEnumerateInstanceLayerProperties(&count, layers.data());
   for (const VkLayerProperties& l : layers)
-    if (std::strcmp(l.layerName, name) == 0) return true;
-  return false;
+    if (std::strcmp(l.layerName, name) == 0) return std::max(l.specVersion, 1u);
+  return 0;
 }
 
 // Instance extensions of the implementation and implicit layers, plus those of `layer` if given.
@@ -173,7 +174,7 @@ Instance::Instance(bool validation) : api_(Api::load()) {
   std::vector<const char*> layers, extensions;
   bool debugUtils = false;
   if (validation) {
-    if (hasLayer(api_, kValidationLayer)) {
+    if ((validationLayerVersion_ = layerVersion(api_, kValidationLayer)) != 0) {
       layers.push_back(kValidationLayer);
       debugUtils = hasInstanceExtension(api_, VK_EXT_DEBUG_UTILS_EXTENSION_NAME) ||
                    hasInstanceExtension(api_, VK_EXT_DEBUG_UTILS_EXTENSION_NAME, kValidationLayer);

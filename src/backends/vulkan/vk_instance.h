@@ -44,12 +44,18 @@ class Instance {
   // One physical device described, its first compute family picked.
   PhysicalDevice describe(VkPhysicalDevice handle) const;
   bool owned() const { return owned_; }
+  // Whether an extension of the given Vulkan header version may be used: the validation layer, when on,
+  // must know it (one built with older headers reports every use of it as an error).
+  bool validationKnows(uint32_t headerVersion) const {
+    return validationLayerVersion_ == 0 || validationLayerVersion_ >= headerVersion;
+  }
 
  private:
   Api api_;
   VkInstance instance_ = VK_NULL_HANDLE;
   VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
   bool owned_ = true;
+  uint32_t validationLayerVersion_ = 0;   // the layer's specVersion when it is on
 };
 
 }  // namespace sffd::vk

@@ -2,17 +2,20 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <optional>
 #include <system_error>
 #include <thread>
 
 #include <sffd/error.h>
+#include "core/fnv1a.h"
 #include "core/kernel_registry.h"
 #include "kernels/common/shader_layout.h"
 
 namespace sffd::vk {
 
-Kernels::Kernels(Device& device) : device_(device) {
+Kernels::Kernels(Device& device, std::optional<ShaderBinaryCache> cache) : device_(device) {
+  if (device_.shaderObjects()) cache_ = std::move(cache);
   const Api& api = device_.api();
   VkDevice dev = device_.handle();
 
@@ -35,7 +38,7 @@ Kernels::Kernels(Device& device) : device_(device) {
   auto ci = vkStruct<VkPipelineCacheCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_CACHE_CREATE_INFO);
   try {
     check(api.vkCreatePipelineLayout(dev, &pi, nullptr, &pipelineLayout_), "vkCreatePipelineLayout");
-    check(api.vkCreatePipelineCache(dev, &ci, nullptr, &cache_), "vkCreatePipelineCache");
+    check(api.vkCreatePipelineCache(dev, &ci, nullptr, &pipelineCache_), "vkCreatePipelineCache");
   } catch (...) {
     destroy();
     throw;
@@ -55,17 +58,20 @@ void Kernels::destroy() {
   workers_.clear();
   for (auto& [key, building] : building_) {
     try {
-      pipelines_.emplace(key, building.get());
+      built_.emplace(key, building.get());
     } catch (...) {   // a build that failed, or was never made, and was never asked for
     }
   }
   building_.clear();
-  for (auto& [key, pipeline] : pipelines_) api.vkDestroyPipeline(dev, pipeline, nullptr);
-  pipelines_.clear();
-  if (cache_) api.vkDestroyPipelineCache(dev, cache_, nullptr);
+  for (auto& [key, k] : built_) {
+    if (k.pipeline) api.vkDestroyPipeline(dev, k.pipeline, nullptr);
+    if (k.shader) device_.shaderObjects()->vkDestroyShaderEXT(dev, k.shader, nullptr);
+  }
+  built_.clear();
+  if (pipelineCache_) api.vkDestroyPipelineCache(dev, pipelineCache_, nullptr);
   if (pipelineLayout_) api.vkDestroyPipelineLayout(dev, pipelineLayout_, nullptr);
   if (setLayout_) api.vkDestroyDescriptorSetLayout(dev, setLayout_, nullptr);
-  cache_ = VK_NULL_HANDLE;
+  pipelineCache_ = VK_NULL_HANDLE;
   pipelineLayout_ = VK_NULL_HANDLE;
   setLayout_ = VK_NULL_HANDLE;
 }
@@ -75,20 +81,29 @@ Kernels::Key Kernels::keyOf(std::string_view kernel, KernelVariant& variant) con
   return {std::string(kernel), variantKey(variant)};
 }
 
-VkPipeline Kernels::pipeline(std::string_view kernel, KernelVariant variant) {
-  Key key = keyOf(kernel, variant);
-  if (auto it = pipelines_.find(key); it != pipelines_.end()) return it->second;
-  VkPipeline pipeline = VK_NULL_HANDLE;
+Kernel Kernels::kernel(std::string_view name, KernelVariant variant) {
+  Key key = keyOf(name, variant);
+  if (auto it = built_.find(key); it != built_.end()) return it->second;
+  Kernel k;
   if (auto it = building_.find(key); it != building_.end()) {
-    std::future<VkPipeline> f = std::move(it->second);
+    std::future<Kernel> f = std::move(it->second);
     building_.erase(it);
     buildIfQueued(key);
-    pipeline = f.get();
+    k = f.get();
   } else {
-    pipeline = build(key.first, variant);
+    k = build(key.first, variant);
   }
-  pipelines_.emplace(std::move(key), pipeline);
-  return pipeline;
+  built_.emplace(std::move(key), k);
+  return k;
+}
+
+void Kernels::bind(VkCommandBuffer commands, const Kernel& k) const {
+  if (k.shader) {
+    const VkShaderStageFlagBits stage = VK_SHADER_STAGE_COMPUTE_BIT;
+    device_.shaderObjects()->vkCmdBindShadersEXT(commands, 1, &stage, &k.shader);
+  } else {
+    device_.api().vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_COMPUTE, k.pipeline);
+  }
 }
 
 void Kernels::precompile(const std::vector<KernelUse>& kernels) {
@@ -98,7 +113,7 @@ void Kernels::precompile(const std::vector<KernelUse>& kernels) {
     for (const KernelUse& use : kernels) {
       KernelVariant variant = use.variant;
       Key key = keyOf(use.kernel, variant);
-      if (pipelines_.count(key) || building_.count(key)) continue;
+      if (built_.count(key) || building_.count(key)) continue;
       const EmbeddedKernel* k = findKernel(use.kernel);
       QueuedBuild b{key.first, variant, k ? spirvFor(*k, variant).size() : 0, {}};
       building_.emplace(std::move(key), b.done.get_future());
@@ -156,7 +171,7 @@ void Kernels::buildQueued(bool inOrder) {
   }
 }
 
-VkPipeline Kernels::build(const std::string& kernel, KernelVariant variant) const {
+Kernel Kernels::build(const std::string& kernel, KernelVariant variant) const {
   const int v = variantIndex(variant);
   const EmbeddedKernel* k = findKernel(kernel);
   if (!k) throw Error(ErrorKind::Internal, "unknown kernel '" + kernel + "'");
@@ -166,9 +181,17 @@ VkPipeline Kernels::build(const std::string& kernel, KernelVariant variant) cons
   const std::span<const uint32_t> spirv = spirvFor(*k, variant);
   if (spirv.empty())
     throw Error(ErrorKind::Internal, "kernel '" + kernel + "' has no SPIR-V for variant " + std::to_string(v));
+  CompileScope compiling("vulkan", kernel, variant);
+  // The assumptions as a specialization constant (ignored by modules that do not declare it).
+  const uint32_t assumptions = variant.assumptions;
+  VkSpecializationMapEntry entry{SFFD_SPEC_ASSUMPTIONS, 0, sizeof(assumptions)};
+  VkSpecializationInfo spec{1, &entry, sizeof(assumptions), &assumptions};
+  return cache_ ? buildShader(kernel, variant, spirv, spec, compiling) : buildPipeline(spirv, spec);
+}
+
+Kernel Kernels::buildPipeline(std::span<const uint32_t> spirv, const VkSpecializationInfo& spec) const {
   const Api& api = device_.api();
   VkDevice dev = device_.handle();
-  CompileScope compiling("vulkan", kernel, variant);
   auto mi = vkStruct<VkShaderModuleCreateInfo>(VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO);
   mi.codeSize = spirv.size_bytes();
   mi.pCode = spirv.data();
@@ -180,17 +203,59 @@ VkPipeline Kernels::build(const std::string& kernel, KernelVariant variant) cons
   ci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
   ci.stage.module = module;
   ci.stage.pName = "main";
-  // The assumptions as a specialization constant (ignored by modules that do not declare it).
-  const uint32_t assumptions = variant.assumptions;
-  VkSpecializationMapEntry entry{SFFD_SPEC_ASSUMPTIONS, 0, sizeof(assumptions)};
-  VkSpecializationInfo spec{1, &entry, sizeof(assumptions), &assumptions};
   ci.stage.pSpecializationInfo = &spec;
   ci.layout = pipelineLayout_;
-  VkPipeline pipeline = VK_NULL_HANDLE;
-  VkResult r = api.vkCreateComputePipelines(dev, cache_, 1, &ci, nullptr, &pipeline);
+  Kernel k;
+  VkResult r = api.vkCreateComputePipelines(dev, pipelineCache_, 1, &ci, nullptr, &k.pipeline);
   api.vkDestroyShaderModule(dev, module, nullptr);   // the pipeline keeps what it needs
   check(r, "vkCreateComputePipelines");
-  return pipeline;
+  return k;
+}
+
+Kernel Kernels::buildShader(const std::string& kernel, KernelVariant variant, std::span<const uint32_t> spirv,
+                            const VkSpecializationInfo& spec, CompileScope& compiling) const {
+  const ShaderObjects& so = *device_.shaderObjects();
+  VkDevice dev = device_.handle();
+  // Everything the driver's binary depends on: the driver's binary format, the kernel's SPIR-V and
+  // its specialization (the assumptions, part of the variant's key).
+  std::string key = "vulkan";
+  char hex[3];
+  for (uint8_t b : so.binaryUuid) {
+    std::snprintf(hex, sizeof hex, "%02x", b);
+    key += hex;
+  }
+  key += " " + std::to_string(so.binaryVersion) + " " + kernel + " " + std::to_string(variantKey(variant)) + " " +
+         std::to_string(spirv.size_bytes()) + " " + std::to_string(fnv1a64(spirv.data(), spirv.size_bytes()));
+
+  auto ci = vkStruct<VkShaderCreateInfoEXT>(VK_STRUCTURE_TYPE_SHADER_CREATE_INFO_EXT);
+  ci.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+  ci.pName = "main";
+  ci.setLayoutCount = 1;
+  ci.pSetLayouts = &setLayout_;
+  ci.pSpecializationInfo = &spec;
+  Kernel k;
+  if (std::optional<std::vector<uint8_t>> binary = cache_->load(key)) {
+    ci.codeType = VK_SHADER_CODE_TYPE_BINARY_EXT;
+    ci.codeSize = binary->size();
+    ci.pCode = binary->data();
+    // Anything but success (the driver's VK_INCOMPATIBLE_SHADER_BINARY_EXT, an error) is a miss.
+    if (so.vkCreateShadersEXT(dev, 1, &ci, nullptr, &k.shader) == VK_SUCCESS && k.shader) {
+      compiling.note("from the shader cache");
+      return k;
+    }
+    k.shader = VK_NULL_HANDLE;
+  }
+  ci.codeType = VK_SHADER_CODE_TYPE_SPIRV_EXT;
+  ci.codeSize = spirv.size_bytes();
+  ci.pCode = spirv.data();
+  check(so.vkCreateShadersEXT(dev, 1, &ci, nullptr, &k.shader), "vkCreateShadersEXT");
+  size_t bytes = 0;
+  if (so.vkGetShaderBinaryDataEXT(dev, k.shader, &bytes, nullptr) == VK_SUCCESS && bytes > 0) {
+    std::vector<uint8_t> binary(bytes);
+    if (so.vkGetShaderBinaryDataEXT(dev, k.shader, &bytes, binary.data()) == VK_SUCCESS)
+      cache_->store(key, std::span(binary.data(), bytes));
+  }
+  return k;
 }
 
 }  // namespace sffd::vk

@@ -24,6 +24,7 @@ namespace sffd::vk {
   X(vkGetPhysicalDeviceProperties)             \
   X(vkGetPhysicalDeviceProperties2)            \
   X(vkGetPhysicalDeviceFeatures)               \
+  X(vkGetPhysicalDeviceFeatures2)              \
   X(vkGetPhysicalDeviceQueueFamilyProperties)  \
   X(vkGetPhysicalDeviceMemoryProperties)       \
   X(vkCreateDevice)                            \
