@@ -51,7 +51,7 @@ done; done; done
 load
 for mesa in system 25.0; do for backend in vulkan gl; do for _ in 1 2; do for b in "$BASE" "$HEAD"; do
   prefix=(); [ $mesa = system ] || prefix=("${MESA25[@]}")
-  MESA_SHADER_CACHE_DISABLE=true SFFD_TRACE_COMPILE=1 run "$b" /usr/bin/time -o "$tmp/time" -f "%U %S" "${prefix[@]}" :: \
+  MESA_SHADER_CACHE_DISABLE=true SFFD_SHADER_CACHE_DISABLE=1 SFFD_TRACE_COMPILE=1 run "$b" /usr/bin/time -o "$tmp/time" -f "%U %S" "${prefix[@]}" :: \
     bench "$T" -l "$L" "${A[@]}" --backends $backend --repeat 1 --warmup 0 --json --quiet > "$tmp/c.json" 2> "$tmp/c.err"
   python3 -c 'import json,sys
 r=json.load(open(sys.argv[1]))["runs"][0]; u,s=open(sys.argv[2]).read().split()

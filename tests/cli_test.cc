@@ -125,6 +125,36 @@ TEST(Cli, LatticeThenDeformWritesStats) {
   EXPECT_LE(phases, j["timings_ms"]["total"].get<double>() + 1e-6);
 }
 
+// The shader cache's counts in --stats: where the Vulkan driver has VK_EXT_shader_object (lavapipe 25),
+// a first run stores each kernel's binary and a second makes every kernel from them; elsewhere all 0.
+TEST(Cli, StatsCountTheShaderCache) {
+  fs::path dir = tempDir("shader_cache");
+  const std::string stats = (dir / "s.json").string(), env = "SFFD_SHADER_CACHE_DIR=" + (dir / "cache").string();
+  auto run = [&] {
+    RunResult r = runSffd("deform " + kData + "/sphere.obj -l " + kData + "/lattices/sphere_twist.npy --tess 2 -o " +
+                              (dir / "t.ply").string() + " --stats " + stats + " --quiet",
+                          env);
+    EXPECT_EQ(r.status, 0) << r.err;
+    std::ifstream sf(stats);
+    return nlohmann::json::parse(sf);
+  };
+  nlohmann::json first = run(), second = run();
+  ASSERT_TRUE(first.contains("shader_cache")) << first.dump();
+  const nlohmann::json& a = first["shader_cache"];
+  const nlohmann::json& b = second["shader_cache"];
+  if (a["misses"] == 0) {   // not in use on this device
+    EXPECT_EQ(a, (nlohmann::json{{"hits", 0}, {"misses", 0}, {"stores", 0}}));
+    EXPECT_FALSE(fs::exists(dir / "cache"));
+    return;
+  }
+  EXPECT_EQ(first["backend"], "vulkan");
+  EXPECT_EQ(a["hits"], 0);
+  EXPECT_EQ(a["stores"], a["misses"]);
+  EXPECT_EQ(b["hits"], a["misses"]);
+  EXPECT_EQ(b["misses"], 0);
+  EXPECT_EQ(b["stores"], 0);
+}
+
 // Accurate FFD's stats add its three dispatches' times, which make up its deform stage.
 TEST(Cli, AccurateStatsGiveTheKernelsSteps) {
   fs::path dir = tempDir("accurate_steps");

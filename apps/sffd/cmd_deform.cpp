@@ -13,6 +13,7 @@
 #include <sffd/error.h>
 #include "apps/sffd/deform_job.h"
 #include "core/job_budget.h"
+#include "core/shader_binary_cache.h"
 #include "pipelines/deformer_internal.h"
 
 namespace sffd::cli {
@@ -113,6 +114,10 @@ int run(const ParsedArgs& args) {
     // Smooth and accurate: the host-memory estimate checked against SFFD_MEMORY_LIMIT (bytes); classic: null.
     const std::optional<JobEstimate>& estimate = run.deformer.internal().estimate;
     j["host_memory_estimate"] = estimate ? nlohmann::ordered_json(estimate->hostBytes) : nlohmann::ordered_json();
+    // Kernels made from the shader cache's binaries, made from SPIR-V for want of one, and binaries stored
+    // (docs/CLI.md "Shader cache"); all 0 where the cache is not used (no VK_EXT_shader_object, not Vulkan).
+    const ShaderBinaryCache::Counts cache = ShaderBinaryCache::counts();
+    j["shader_cache"] = {{"hits", cache.hits}, {"misses", cache.misses}, {"stores", cache.stores}};
     // The deform stage's steps where it has several: --split (deform.sample, ...), which the fused kernel
     // does not have, and accurate's three dispatches (accurate_samples, _patches, _tessellate).
     for (const auto& [step, ms] : t.steps)
