@@ -46,7 +46,7 @@ step devices
 "$S" devices --json > "$OUT/devices.json"
 
 # NVIDIA's drivers keep compiled shaders under __GL_SHADER_DISK_CACHE_PATH (GL and Vulkan alike): a new
-# folder is an empty cache; sffd keeps the drivers' Vulkan shader binaries under SFFD_SHADER_CACHE_DIR (docs/CLI.md).
+# folder is an empty cache.
 emptyCache() { mktemp -d "$W/cache.XXXX"; }
 
 if want compile; then
@@ -55,7 +55,7 @@ for b in vulkan gl; do
   for m in fast strict strict-double; do
     case $m in fast) flag=();; strict) flag=(--strict);; strict-double) flag=(--strict --precision double);; esac
     a=$(date +%s%N)
-    SFFD_TRACE_COMPILE=1 __GL_SHADER_DISK_CACHE_PATH=$(emptyCache) SFFD_SHADER_CACHE_DIR=$(emptyCache) timeout 400 "$S" deform "$T" -l "$L" "${A[@]}" \
+    SFFD_TRACE_COMPILE=1 __GL_SHADER_DISK_CACHE_PATH=$(emptyCache) timeout 400 "$S" deform "$T" -l "$L" "${A[@]}" \
       --backend $b "${flag[@]}" -o "$W/c.ply" --binary --quiet > "$W/trace" 2>&1
     rc=$?
     echo "$b $m: exit $rc, $(( ($(date +%s%N) - a) / 1000000 )) ms; $(grep -o 'compile [a-z]* [a-z_]*[^:]*: [0-9.]* ms' "$W/trace" | sed 's/^compile [a-z]* //' | paste -sd';')"
@@ -79,7 +79,7 @@ fi
 
 if want bench; then
 step "bench (the first process with an empty driver cache)"
-__GL_SHADER_DISK_CACHE_PATH=$(emptyCache) SFFD_SHADER_CACHE_DIR=$(emptyCache) timeout 200 "$S" bench "$T" -l "$L" "${A[@]}" --backends vulkan,gl --repeat 20 \
+__GL_SHADER_DISK_CACHE_PATH=$(emptyCache) timeout 200 "$S" bench "$T" -l "$L" "${A[@]}" --backends vulkan,gl --repeat 20 \
   --json > "$OUT/bench_first.json" 2> "$W/err" || tail -3 "$W/err"
 for m in fast strict; do
   flag=(); [ $m = strict ] && flag=(--strict)

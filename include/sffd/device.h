@@ -48,9 +48,9 @@ struct DeviceRequest {
   // an axis) whatever the driver reports, as a minimum phone would (docs/GLES.md). SFFD_GLES_LIMITS=
   // device|minimum overrides it.
   bool deviceLimits = false;
-  // Vulkan: where kernels the driver has translated are kept for later processes, on drivers that can
-  // give them back (VK_EXT_shader_object binaries; lavapipe 25 then skips its SPIR-V translation, about
-  // 70 ms of a run). "" (default): env SFFD_SHADER_CACHE_DIR, else $XDG_CACHE_HOME/sffd, else
+  // Vulkan: where kernels the driver has translated are kept for later processes, on CPU devices whose
+  // driver can give them back (VK_EXT_shader_object binaries; lavapipe 25 then skips its SPIR-V
+  // translation, about 70 ms of a run; GPU drivers keep their own pipeline caches). "" (default): env SFFD_SHADER_CACHE_DIR, else $XDG_CACHE_HOME/sffd, else
   // ~/.cache/sffd, none when SFFD_SHADER_CACHE_DISABLE=1; "none": no cache; anything else: that folder.
   // At most 64 MiB, least recently used first out. Results are the same with or without it.
   std::string shaderCache = {};

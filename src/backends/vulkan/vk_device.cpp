@@ -64,13 +64,16 @@ Device::Device(const Instance& instance, const PhysicalDevice& physical, bool sh
   if (hasDeviceExtension(api_, physical.handle, "VK_KHR_portability_subset"))
     extensions.push_back("VK_KHR_portability_subset");
 
-  // Shader objects (VK_EXT_shader_object), so that kernels can be made from the driver's own binaries.
-  // The extension needs dynamic rendering enabled with it, though compute never renders.
+  // Shader objects (VK_EXT_shader_object), so that kernels can be made from the driver's own binaries,
+  // on CPU devices only: lavapipe keeps no translation of a kernel between processes by itself, while GPU
+  // drivers keep whole pipelines in their own disk caches (NVIDIA's, Mesa's radv and anv), where shader
+  // objects would gain nothing and add a path no GPU run has tested. The extension needs dynamic rendering
+  // enabled with it, though compute never renders.
   auto objectFeatures =
       vkStruct<VkPhysicalDeviceShaderObjectFeaturesEXT>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SHADER_OBJECT_FEATURES_EXT);
   auto renderingFeatures = vkStruct<VkPhysicalDeviceDynamicRenderingFeaturesKHR>(
       VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DYNAMIC_RENDERING_FEATURES_KHR);
-  shaderObjects = shaderObjects && offersShaderObjects(api_, physical.handle);
+  shaderObjects = shaderObjects && info_.type == "cpu" && offersShaderObjects(api_, physical.handle);
   if (shaderObjects) {
     extensions.push_back("VK_EXT_shader_object");
     extensions.push_back(VK_KHR_DYNAMIC_RENDERING_EXTENSION_NAME);

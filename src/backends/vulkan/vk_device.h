@@ -29,7 +29,7 @@ struct Allocation {
 class Device {
  public:
   // Creates the device with shaderFloat64 enabled when the hardware has it, and with
-  // VK_EXT_shader_object when `shaderObjects` asks for it and the driver offers it.
+  // VK_EXT_shader_object when `shaderObjects` asks for it on a CPU device (lavapipe) that offers it.
   Device(const Instance& instance, const PhysicalDevice& physical, bool shaderObjects = false);
   // Borrows an application's device and queue (interop; never destroyed here): `physical` describes
   // the queue's family, and its float64 limit says whether shaderFloat64 was enabled.
