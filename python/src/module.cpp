@@ -87,10 +87,11 @@ void bindDevices(py::module_& m) {
   m.def("devices", [] { return listDevices(); }, "Every device that can be opened here.");
 
   py::class_<Device, std::shared_ptr<Device>>(m, "Device", "An opened device; what backend= accepts besides a name.")
-      .def(py::init([](const std::string& name, const std::string& match) {
-             return std::make_shared<Device>(Device::open({.name = name, .deviceSubstring = match}));
+      .def(py::init([](const std::string& name, const std::string& match, const std::string& shaderCache) {
+             return std::make_shared<Device>(
+                 Device::open({.name = name, .deviceSubstring = match, .shaderCache = shaderCache}));
            }),
-           "name"_a = "auto", "match"_a = "")
+           "name"_a = "auto", "match"_a = "", "shader_cache"_a = "")
       .def_property_readonly("label", &Device::label)
       .def_property_readonly("name", [](const Device& d) { return d.info().name; })
       .def_property_readonly("api", [](const Device& d) { return d.info().api; })

@@ -20,6 +20,18 @@ def test_devices():
     assert sffd.device("cpu") is sffd.device("cpu")   # opened once, shared
 
 
+def test_device_with_a_shader_cache_folder_gives_the_same_bits(sphere, tmp_path):
+    v, t, _ = sphere
+    lat = sffd.Lattice.fitted(v)
+    lat.control_points = lat.control_points * 1.1
+    outs = []
+    for cache in ("none", str(tmp_path / "cache"), str(tmp_path / "cache")):
+        dev = sffd.Device("auto", shader_cache=cache)
+        outs.append(sffd.deform(v, t, lat, backend=dev, tess=2, strict=True)[0])
+    for o in outs[1:]:
+        np.testing.assert_array_equal(o, outs[0])
+
+
 def test_identity_and_affine_lattices(sphere):
     v, t, n = sphere
     lat = sffd.Lattice.fitted(v, counts=(4, 5, 6), degree=(2, 3, 2))
