@@ -196,6 +196,11 @@ TEST(ConformRunner, InjectedCrashHangAndLongCompileAreResultsAndTheRunGoesOn) {
   EXPECT_EQ(r.status, 1) << r.out << r.err;
   EXPECT_TRUE(has(r.err, "cpu first: Timeout: a kernel compile ran past 20 s (10 times --timeout)")) << r.err;
   EXPECT_TRUE(has(r.out, "second/classic.normals vulkan vs cpu: max_abs=0")) << r.out;
+  // A hang after a compile has ended is no progress, reported after --timeout, not after ten.
+  r = runSffd(args, "SFFD_CONFORM_FAULT=compile-then-hang:cpu:first");
+  EXPECT_EQ(r.status, 1) << r.out << r.err;
+  EXPECT_TRUE(has(r.err, "cpu first: Timeout: no progress for 2 s")) << r.err;
+  EXPECT_TRUE(has(r.out, "second/classic.normals vulkan vs cpu: max_abs=0")) << r.out;
 
   // The crash listed in a baseline is an expected failure (exit 0); a listed test that passes is not.
   std::ofstream(dir / "failures.csv") << "# test,status\nfirst/classic.positions/vulkan-vs-cpu,Crash\n"

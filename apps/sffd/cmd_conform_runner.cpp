@@ -88,7 +88,8 @@ void say(int fd, const std::string& line) {
 }
 
 // The test hook: "crash:vulkan", "hang:gl-egl:CASE", "slow-compile:cpu:CASE" (a compile of 3 case
-// timeouts, which is progress) or "stuck-compile:cpu" (one that never ends).
+// timeouts, which is progress), "stuck-compile:cpu" (one that never ends) or "compile-then-hang:cpu" (a
+// slow compile, then a hang: no progress once the compile has ended).
 void injectFault(const std::string& backend, const std::string& caseName, double timeoutSeconds) {
   const char* v = std::getenv("SFFD_CONFORM_FAULT");
   if (!v) return;
@@ -98,11 +99,15 @@ void injectFault(const std::string& backend, const std::string& caseName, double
   if (kind == "crash") ::raise(SIGSEGV);
   if (kind == "hang")
     for (;;) ::pause();
-  if (kind == "slow-compile" || kind == "stuck-compile") {
-    CompileScope compiling(backend, "injected", {});
-    if (kind == "stuck-compile")
+  if (kind == "slow-compile" || kind == "stuck-compile" || kind == "compile-then-hang") {
+    {
+      CompileScope compiling(backend, "injected", {});
+      if (kind == "stuck-compile")
+        for (;;) ::pause();
+      std::this_thread::sleep_for(std::chrono::duration<double>(3 * timeoutSeconds));
+    }
+    if (kind == "compile-then-hang")
       for (;;) ::pause();
-    std::this_thread::sleep_for(std::chrono::duration<double>(3 * timeoutSeconds));
   }
 }
 
