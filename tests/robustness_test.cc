@@ -480,7 +480,8 @@ class RobustOdd : public Robust, public ::testing::WithParamInterface<std::strin
 
 // Each odd mesh: a lattice fitted to it and twisted, then deformed on Vulkan (validation layer on) and
 // on the CPU reference; classic: same triangles as read, finite results, no warning, the input untouched.
-// And by every method that makes patches (the default, smooth, and accurate), in fast and strict float:
+// And by every method that makes patches (the default, smooth, and accurate), in fast and strict float, and
+// in fast float at --tess 1, 2 and 7 (scripts/odd_sweep.sh sweeps more options, outside CI):
 // a written, finite result (degenerate triangles between opposite corner normals gave NaN normals, which
 // no writer accepts, until snormalize left a vector without a direction as it is).
 TEST_P(RobustOdd, IsProcessed) {
@@ -506,6 +507,15 @@ TEST_P(RobustOdd, IsProcessed) {
         std::vector<std::string> args = {"deform", mesh, "-l", lat, "--method", method, "--backend", backend, "--tess", "3", "-o", o, "--quiet"};
         if (strict) args.push_back("--strict");
         r = runSffd(args);
+        ASSERT_EQ(r.status, 0) << context << "\n" << r.err;
+        expectNoReports(r, context);
+        EXPECT_TRUE(allFinite(sffd::readMesh(o))) << context;
+      }
+    // Every other kind of tessellation level: the fewest sub-triangles (1), an even one, an odd one above 3.
+    for (const char* method : {"smooth", "accurate"})
+      for (const char* tess : {"1", "2", "7"}) {
+        const std::string context = std::string(backend) + " " + method + " --tess " + tess;
+        r = runSffd({"deform", mesh, "-l", lat, "--method", method, "--backend", backend, "--tess", tess, "-o", o, "--quiet"});
         ASSERT_EQ(r.status, 0) << context << "\n" << r.err;
         expectNoReports(r, context);
         EXPECT_TRUE(allFinite(sffd::readMesh(o))) << context;
