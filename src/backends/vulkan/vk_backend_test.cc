@@ -18,29 +18,13 @@
 #include <sffd/error.h>
 #include "backends/backend_test_support.h"
 #include "core/shader_binary_cache.h"
+#include "tests/support/scoped_env.h"
 #include "kernels/common/shader_layout.h"
 
 namespace sffd {
 namespace {
 
-// Sets an environment variable for one scope and restores the previous value.
-class ScopedEnv {
- public:
-  ScopedEnv(const char* name, const char* value) : name_(name) {
-    if (const char* old = std::getenv(name)) old_ = old;
-    setenv(name, value, 1);
-  }
-  ~ScopedEnv() {
-    if (old_)
-      setenv(name_, old_->c_str(), 1);
-    else
-      unsetenv(name_);
-  }
-
- private:
-  const char* name_;
-  std::optional<std::string> old_;
-};
+using test::ScopedEnv;
 
 class VkBackendTest : public ::testing::Test {
  protected:
