@@ -30,6 +30,7 @@ Kernels::Kernels(Device& device, std::optional<ShaderBinaryCache> cache) : devic
   auto li = vkStruct<VkDescriptorSetLayoutCreateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO);
   li.bindingCount = 1 + SFFD_MAX_STORAGE_BINDINGS;
   li.pBindings = bindings;
+  setLayoutHash_ = fnv1a64(bindings, sizeof bindings);   // no pointers in them (no immutable samplers)
   check(api.vkCreateDescriptorSetLayout(dev, &li, nullptr, &setLayout_), "vkCreateDescriptorSetLayout");
 
   auto pi = vkStruct<VkPipelineLayoutCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO);
@@ -216,15 +217,17 @@ Kernel Kernels::buildShader(const std::string& kernel, KernelVariant variant, st
                             const VkSpecializationInfo& spec, CompileScope& compiling) const {
   const ShaderObjects& so = *device_.shaderObjects();
   VkDevice dev = device_.handle();
-  // Everything the driver's binary depends on: the driver's binary format, the kernel's SPIR-V and
-  // its specialization (the assumptions, part of the variant's key).
+  // Everything the driver's binary depends on: the driver's binary format, the kernel's SPIR-V, its
+  // specialization (the assumptions, part of the variant's key) and the descriptor set layout it was
+  // made for (lavapipe lowers the bindings into the binary; the SPIR-V need not change with it).
   std::string key = "vulkan";
   char hex[3];
   for (uint8_t b : so.binaryUuid) {
     std::snprintf(hex, sizeof hex, "%02x", b);
     key += hex;
   }
-  key += " " + std::to_string(so.binaryVersion) + " " + kernel + " " + std::to_string(variantKey(variant)) + " " +
+  key += " " + std::to_string(so.binaryVersion) + " " + std::to_string(setLayoutHash_) + " " + kernel + " " +
+         std::to_string(variantKey(variant)) + " " +
          std::to_string(spirv.size_bytes()) + " " + std::to_string(fnv1a64(spirv.data(), spirv.size_bytes()));
 
   auto ci = vkStruct<VkShaderCreateInfoEXT>(VK_STRUCTURE_TYPE_SHADER_CREATE_INFO_EXT);

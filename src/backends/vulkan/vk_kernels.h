@@ -77,6 +77,7 @@ class Kernels {
 
   Device& device_;
   VkDescriptorSetLayout setLayout_ = VK_NULL_HANDLE;
+  uint64_t setLayoutHash_ = 0;   // of its bindings: part of a shader binary's key
   VkPipelineLayout pipelineLayout_ = VK_NULL_HANDLE;
   VkPipelineCache pipelineCache_ = VK_NULL_HANDLE;   // in memory only: Mesa and vendor drivers keep their own disk caches
   std::optional<ShaderBinaryCache> cache_;   // shader objects' binaries; none: pipelines
