@@ -18,6 +18,7 @@
 
 #include "apps/sffd/cli.h"
 #include "apps/sffd/deform_job.h"
+#include "core/shader_binary_cache.h"
 #include "core/wall_clock.h"
 #include "kernels/smooth/smooth_deform.h"
 #include "pipelines/deformer_internal.h"
@@ -58,6 +59,7 @@ struct BackendResult {
   Series stages, host;        // GPU (or CPU) stage times; host wall times
   size_t subTriangles = 0;
   double peakRss = 0;
+  ShaderBinaryCache::Counts shaderCache;   // during this backend's runs (docs/CLI.md "Shader cache")
 };
 
 void addStages(Series& s, const Timings& pre, const Timings& def) {
@@ -135,9 +137,12 @@ int run(const ParsedArgs& args) {
     req.name = name;
     if (name != "cpu") req.deviceSubstring = args.get("--device");
     std::vector<std::string> notes;
+    const ShaderBinaryCache::Counts before = ShaderBinaryCache::counts();
     Device device = Device::open(req, &notes);
     if (name != "cpu" && device.info().api == "cpu") throw Error(ErrorKind::Device, "backend '" + name + "' gave no GPU device");
     results.push_back(benchDevice(device, job, S));
+    const ShaderBinaryCache::Counts after = ShaderBinaryCache::counts();
+    results.back().shaderCache = {after.hits - before.hits, after.misses - before.misses, after.stores - before.stores};
   }
 
   const size_t subs = results.empty() ? 0 : results.front().subTriangles;
@@ -162,6 +167,7 @@ int run(const ParsedArgs& args) {
       run["stages_ms"] = stages;
       run["host_wall_ms"] = host;
       run["peak_rss_mb"] = r.peakRss;
+      run["shader_cache"] = {{"hits", r.shaderCache.hits}, {"misses", r.shaderCache.misses}, {"stores", r.shaderCache.stores}};
       j["runs"].push_back(run);
     }
     std::printf("%s\n", j.dump(1).c_str());
@@ -185,6 +191,9 @@ int run(const ParsedArgs& args) {
                   m["max"].get<double>());
     }
     std::printf("  cold first run       %9.3f ms   peak RSS %.1f MiB\n", r.coldMs, r.peakRss);
+    if (r.shaderCache.hits + r.shaderCache.misses > 0)
+      std::printf("  shader cache         %llu kernels from it, %llu from SPIR-V\n", (unsigned long long)r.shaderCache.hits,
+                  (unsigned long long)r.shaderCache.misses);
   }
   return 0;
 }
