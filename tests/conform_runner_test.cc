@@ -93,8 +93,10 @@ TEST(ConformRunner, BackendWithoutADisplayIsSkippedUnlessRequired) {
 
 TEST(ConformRunner, JunitIsWellFormedAndJsonHasTheFields) {
   fs::path dir = tempDir("conform_reports");
+  const fs::path cache = dir / "shader cache";
   RunResult r = runSffd("conform " + kCube2 + " --method accurate --tess 2 --backends vulkan,gl-egl,cpu --junit " +
-                        (dir / "r.xml").string() + " --json " + (dir / "r.json").string());
+                            (dir / "r.xml").string() + " --json " + (dir / "r.json").string(),
+                        "SFFD_SHADER_CACHE_DIR='" + cache.string() + "'");
   ASSERT_EQ(r.status, 0) << r.out << r.err;
   // 3 buffers x 3 pairs; parsed by Python's XML parser as a CI would.
   const std::string check = "python3 -c \"import sys, xml.etree.ElementTree as E; r = E.parse(sys.argv[1]).getroot(); "
@@ -104,9 +106,15 @@ TEST(ConformRunner, JunitIsWellFormedAndJsonHasTheFields) {
   json j = json::parse(slurp(dir / "r.json"));
   EXPECT_EQ(j["status"], "PASS");
   ASSERT_EQ(j["backends"].size(), 3u);
-  for (const char* k : {"backend", "device", "driver", "driver_version", "vendor_id", "device_id", "uuid"})
+  for (const char* k : {"backend", "device", "driver", "driver_version", "vendor_id", "device_id", "uuid", "shader_cache"})
     EXPECT_TRUE(j["backends"][0].contains(k)) << k;
   EXPECT_EQ(j["backends"][0]["driver_version"].is_string(), true) << j["backends"][0];
+  // The shader cache names the folder where Vulkan's kernels came from it (lavapipe 25), else null.
+  for (const json& b : j["backends"])
+    if (b["backend"] != "vulkan" || !b["shader_cache"].is_string())
+      EXPECT_TRUE(b["shader_cache"].is_null()) << b;
+    else
+      EXPECT_EQ(b["shader_cache"], cache.string()) << b;
   ASSERT_EQ(j["results"].size(), 9u);
   for (const char* k : {"case", "buffer", "pair", "status", "max_abs", "max_ulp", "mismatched", "total", "tolerance",
                         "first_mismatch"})

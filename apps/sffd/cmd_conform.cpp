@@ -94,6 +94,7 @@ std::vector<BackendRun> readDump(const fs::path& dir, const std::vector<Case>& c
     r.info.name = b.value("device", "");
     r.info.driver = b.value("driver", "");
     if (b["driver_version"].is_string()) r.info.driverVersion = b["driver_version"];
+    if (b.contains("shader_cache") && b["shader_cache"].is_string()) r.info.shaderCache = b["shader_cache"];
     r.dir = dir / b.at("dir").get<std::string>();
     for (const Case& c : cases) {
       const json& st = b.at("cases").contains(c.name) ? b["cases"][c.name] : json{{"status", "Skip"}, {"detail", "not in the dump"}};

@@ -30,7 +30,7 @@ std::string deviceJson(const std::string& label, const DeviceInfo& info) {
   return json{{"backend", label}, {"api", info.api}, {"provider", info.provider}, {"device", info.name},
               {"type", info.type}, {"driver", info.driver}, {"driver_version", str(info.driverVersion)},
               {"vendor_id", id(info.vendorId)}, {"device_id", id(info.deviceId)}, {"uuid", str(info.uuid)},
-              {"float64", info.limits.float64}}.dump();
+              {"float64", info.limits.float64}, {"shader_cache", str(info.shaderCache)}}.dump();
 }
 
 namespace {

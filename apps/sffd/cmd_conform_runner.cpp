@@ -182,7 +182,7 @@ DeviceInfo infoFromJson(const json& j) {
   auto num = [&](const char* k) { return j.contains(k) && j[k].is_number() ? j[k].get<uint32_t>() : 0u; };
   DeviceInfo d;
   d.api = str("api"), d.provider = str("provider"), d.name = str("device"), d.driver = str("driver"), d.type = str("type");
-  d.driverVersion = str("driver_version"), d.uuid = str("uuid");
+  d.driverVersion = str("driver_version"), d.uuid = str("uuid"), d.shaderCache = str("shader_cache");
   d.vendorId = num("vendor_id"), d.deviceId = num("device_id");
   d.limits.float64 = j.value("float64", false);
   return d;

@@ -34,6 +34,10 @@ struct DeviceInfo {
   uint32_t vendorId = 0, deviceId = 0;
   std::string driverVersion;
   std::string uuid;
+  // Vulkan on an opened device: the folder its kernels' binaries are kept in between processes (docs/CLI.md
+  // "Shader cache"), where it makes them as shader objects from there; empty when it makes pipelines (every
+  // other device, and listDevices(), which opens none).
+  std::string shaderCache;
   DeviceLimits limits;
 };
 

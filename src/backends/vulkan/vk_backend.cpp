@@ -87,13 +87,17 @@ class VulkanBackend final : public Backend {
         device_(instance_, selectDevice(instance_, options.deviceSubstring),
                 shaderCache.has_value() && instance_.validationKnows(VK_MAKE_API_VERSION(0, 1, 3, 246))),
         kernels_(device_, shaderCache ? std::optional<ShaderBinaryCache>(*shaderCache) : std::nullopt),
-        recorder_(device_, kernels_.setLayout()) {}
+        recorder_(device_, kernels_.setLayout()),
+        info_(device_.info()) {
+    if (kernels_.usesShaderObjects()) info_.shaderCache = shaderCache->string();
+  }
 
   explicit VulkanBackend(const vulkan::DeviceConfig& c)
       : instance_(c.instance, c.getInstanceProcAddr),
         device_(instance_, adoptedPhysical(instance_, c), c.device, c.queue),
         kernels_(device_),
-        recorder_(device_, kernels_.setLayout()) {}
+        recorder_(device_, kernels_.setLayout()),
+        info_(device_.info()) {}
 
   ~VulkanBackend() override {
     // A device that timed out and still has not finished: nothing it may still use is freed.
@@ -113,7 +117,7 @@ class VulkanBackend final : public Backend {
     device_.release(downloadStaging_);
   }
 
-  const DeviceInfo& info() const override { return device_.info(); }
+  const DeviceInfo& info() const override { return info_; }
 
   BufferId createBuffer(uint64_t bytes) override {
     Allocation a = device_.allocate(
@@ -300,6 +304,7 @@ class VulkanBackend final : public Backend {
   Device device_;
   Kernels kernels_;
   Recorder recorder_;
+  DeviceInfo info_;   // the device's, with the shader cache in use
   std::vector<Buffer> buffers_;   // index id - 1
   std::vector<BufferId> freeIds_;
   std::vector<DispatchTiming> timings_;
