@@ -3,8 +3,8 @@
 // line an event) and writes each case's buffers to files. While a kernel compiles, the child says "busy"
 // every second, so that a driver's long compile is not taken for a hang, up to kCompileTimeouts times the
 // case timeout (docs/CONFORMANCE.md "Statuses"). Test hook (docs/CONFORMANCE.md):
-// SFFD_CONFORM_FAULT=crash|hang|slow-compile|stuck-compile:BACKEND[:CASE] makes that child crash, hang, or
-// compile for 3 case timeouts or for ever at that case.
+// SFFD_CONFORM_FAULT=crash|hang|slow-compile|stuck-compile|compile-then-hang:BACKEND[:CASE] makes that child
+// crash, hang, compile for 3 case timeouts or for ever, or compile then hang at that case.
 #include <poll.h>
 #include <signal.h>
 #include <sys/wait.h>

@@ -258,8 +258,6 @@ class VulkanBackend final : public Backend {
 
   std::vector<DispatchTiming> takeTimings() override { return std::exchange(timings_, {}); }
 
-  bool usesShaderObjects() const { return kernels_.usesShaderObjects(); }
-
   VkBuffer vkBuffer(BufferId id) const {
     return id == 0 || id > buffers_.size() || !buffers_[id - 1].live ? VK_NULL_HANDLE : buffers_[id - 1].memory.buffer;
   }
@@ -325,11 +323,6 @@ std::vector<DeviceInfo> listDevices() {
 std::unique_ptr<Backend> createBackend(const Options& options) { return std::make_unique<VulkanBackend>(options); }
 
 std::unique_ptr<Backend> adoptBackend(const vulkan::DeviceConfig& config) { return std::make_unique<VulkanBackend>(config); }
-
-bool usesShaderObjects(const Backend& backend) {
-  const auto* vk = dynamic_cast<const VulkanBackend*>(&backend);
-  return vk && vk->usesShaderObjects();
-}
 
 VkBuffer vkBufferOf(const Backend& backend, BufferId buffer) {
   const auto* vk = dynamic_cast<const VulkanBackend*>(&backend);

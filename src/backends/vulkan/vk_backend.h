@@ -24,8 +24,5 @@ size_t validationMessageCount();
 // Device memory allocations (vkAllocateMemory) sffd made so far in this process: tests check that a warm
 // edit makes none (a discrete GPU's driver takes a fraction of a millisecond for each).
 size_t deviceMemoryAllocations();
-// Whether a backend of createBackend's makes its kernels as shader objects (a shader cache and a
-// driver with VK_EXT_shader_object) rather than pipelines; false for any other backend.
-bool usesShaderObjects(const Backend& backend);
 
 }  // namespace sffd::vk
