@@ -448,7 +448,16 @@ TEST_F(Robust, AFailedWriteStopsTheJobAndLeavesNothing) {
         if (binary) args.push_back("--binary");
         const std::string context = std::string(backend) + " " + name + (binary ? " binary" : "");
         const Result r = runSffd(args, {}, false, 256 * 1024);
-        expectInputError(r, out(name) + ": cannot write: ", context);
+        // lavapipe from Mesa 24 on keeps device memory in a file, which the limit also holds: then the job
+        // stops before it writes, with a device error that names the limit (vk_device.cpp), never a SIGBUS.
+        if (std::string(backend) == "vulkan" && r.err.find("without memory behind it") != std::string::npos) {
+          EXPECT_EQ(r.status, 3) << context << "\n" << r.err;
+          EXPECT_EQ(r.err.rfind("sffd: error: Vulkan: the driver gave a buffer of ", 0), 0u) << context << "\n" << r.err;
+          EXPECT_NE(r.err.find("(ulimit -f: 256 KiB)"), std::string::npos) << context << "\n" << r.err;
+          EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << context << "\n" << r.err;
+        } else {
+          expectInputError(r, out(name) + ": cannot write: ", context);
+        }
         expectNoReports(r, context);
         expectNothingWritten(context);
       }

@@ -7,6 +7,11 @@
 #include <string>
 #include <vector>
 
+#include <sys/mman.h>
+#include <sys/resource.h>
+#include <unistd.h>
+#include <cerrno>
+
 #include <sffd/error.h>
 #include "core/huge_pages.h"
 #include "backends/vulkan/vk_backend.h"
@@ -21,6 +26,35 @@ constexpr VkMemoryPropertyFlags kExcluded = VK_MEMORY_PROPERTY_LAZILY_ALLOCATED_
                                             VK_MEMORY_PROPERTY_DEVICE_COHERENT_BIT_AMD;
 
 std::atomic<size_t> gAllocations{0};   // deviceMemoryAllocations()
+
+// Whether the mapped device memory [data, data + bytes) is there to touch. lavapipe (Mesa 24 on) keeps
+// device memory in one memory file that it grows with ftruncate without checking the result: under a
+// file size limit (ulimit -f) the growth fails, the allocation and the map succeed, and the first touch
+// past the file's end is a SIGBUS. Populating the range's last page (it ends the file) fails with
+// EFAULT there instead of faulting. True where the kernel cannot tell (before Linux 5.14).
+bool mappedMemoryIsThere(const void* data, size_t bytes) {
+#ifdef MADV_POPULATE_READ
+  if (!data || bytes == 0) return true;
+  const uintptr_t page = uintptr_t(::sysconf(_SC_PAGESIZE));
+  const uintptr_t last = (uintptr_t(data) + bytes - 1) & ~(page - 1);
+  return ::madvise(reinterpret_cast<void*>(last), page, MADV_POPULATE_READ) == 0 || errno != EFAULT;
+#else
+  (void)data, (void)bytes;
+  return true;
+#endif
+}
+
+// The error for device memory the driver could not back: names the file size limit where there is one.
+Error unbackedMemoryError(uint64_t bytes) {
+  std::string why = "its memory file could not grow";
+  struct rlimit limit {};
+  if (::getrlimit(RLIMIT_FSIZE, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY)
+    why += " past the file size limit (ulimit -f: " + std::to_string(uint64_t(limit.rlim_cur) / 1024) +
+           " KiB); raise it, or use another backend";
+  else
+    why += " (is memory full?)";
+  return deviceError("Vulkan: the driver gave a buffer of " + std::to_string(bytes) + " bytes without memory behind it: " + why + ".");
+}
 
 }  // namespace
 
@@ -207,6 +241,7 @@ Allocation Device::allocate(uint64_t bytes, VkBufferUsageFlags usage, MemoryUse 
     if (mappable && (use != MemoryUse::Storage || unified_))
     {
       check(api_.vkMapMemory(device_, a.memory, 0, VK_WHOLE_SIZE, 0, &a.mapped), "vkMapMemory");
+      if (info_.type == "cpu" && !mappedMemoryIsThere(a.mapped, req.size)) throw unbackedMemoryError(bytes);
       // On a CPU device (lavapipe, SwiftShader) device memory is the driver's malloc'd host memory:
       // huge pages asked for before anything touches it (core/huge_pages.h).
       if (info_.type == "cpu") adviseHugePages(a.mapped, bytes);
