@@ -106,9 +106,52 @@ void latticeBernstein2(real s, out real3 b, out real3 db) {
   db = real3(d0, d1, d2);
 }
 
-// One row of three coefficients along w: the value and the w-derivative sums.
-void latticeRow2(uint c, real3 bw, real3 dbw, out real3 q, out real3 qw) {
-  real3 p0 = latticeCoeffAt(c), p1 = latticeCoeffAt(c + 1u), p2 = latticeCoeffAt(c + 2u);
+// The knot box whose 27 coefficients a sub-triangle's evaluations read, held in registers. A kernel that
+// evaluates the lattice many times per invocation defines SFFD_LATTICE_BOX_CACHE; where the host asks for
+// the rolled form (prelude.glsl sffdRollsLoops: llvmpipe and lavapipe of Mesa 23 on, whose reads at an
+// index that differs between lanes are a load per lane and component, and whose code skips a branch no
+// lane takes) each evaluation reads the coefficients from here and refills it only when its box differs
+// from the last one's, which for a small sub-triangle is rare: the 19 evaluations of a smooth sub-triangle
+// read 81 values instead of 1,539 (Mesa 25.0: 24 % of deform_smooth's instructions were those reads).
+// The same values in the same order, so the same bits. Elsewhere (Mesa 22.3 runs both sides of every
+// branch; GPUs) every read goes to the lattice.
+#ifdef SFFD_LATTICE_BOX_CACHE
+real3 latticeCachedBox[27];
+uint latticeCachedBase = 0xffffffffu;
+// Rows written out: a loop might stay rolled, and an array indexed by a variable lives in memory.
+void latticeCacheRow(uint base, uint k) {
+  latticeCachedBox[k] = latticeCoeffAt(base + k);
+  latticeCachedBox[k + 1u] = latticeCoeffAt(base + k + 1u);
+  latticeCachedBox[k + 2u] = latticeCoeffAt(base + k + 2u);
+}
+void latticeCacheBox(uint base) {
+  if (base != latticeCachedBase) {
+    latticeCacheRow(base, 0u);
+    latticeCacheRow(base, 3u);
+    latticeCacheRow(base, 6u);
+    latticeCacheRow(base, 9u);
+    latticeCacheRow(base, 12u);
+    latticeCacheRow(base, 15u);
+    latticeCacheRow(base, 18u);
+    latticeCacheRow(base, 21u);
+    latticeCacheRow(base, 24u);
+    latticeCachedBase = base;
+  }
+}
+#endif
+
+// Coefficient k (0..26, a constant after inlining) of the knot box whose first is `base`.
+real3 latticeBoxCoeff(uint base, uint k) {
+#ifdef SFFD_LATTICE_BOX_CACHE
+  if (sffdRollsLoops()) return latticeCachedBox[k];
+#endif
+  return latticeCoeffAt(base + k);
+}
+
+// One row of three coefficients along w (from coefficient k of the box at `base`): the value and the
+// w-derivative sums.
+void latticeRow2(uint base, uint k, real3 bw, real3 dbw, out real3 q, out real3 qw) {
+  real3 p0 = latticeBoxCoeff(base, k), p1 = latticeBoxCoeff(base, k + 1u), p2 = latticeBoxCoeff(base, k + 2u);
   P real3 r = ((real3(0) + p0 * bw.x) + p1 * bw.y) + p2 * bw.z;
   P real3 rw = ((real3(0) + p0 * dbw.x) + p1 * dbw.y) + p2 * dbw.z;
   q = r;
@@ -116,11 +159,11 @@ void latticeRow2(uint c, real3 bw, real3 dbw, out real3 q, out real3 qw) {
 }
 
 // One slab of nine coefficients (fixed u index): sums over v and w.
-void latticeSlab2(uint c, real3 bv, real3 dbv, real3 bw, real3 dbw, out real3 sp, out real3 spv, out real3 spw) {
+void latticeSlab2(uint base, uint k, real3 bv, real3 dbv, real3 bw, real3 dbw, out real3 sp, out real3 spv, out real3 spw) {
   real3 q0, q0w, q1, q1w, q2, q2w;
-  latticeRow2(c, bw, dbw, q0, q0w);
-  latticeRow2(c + 3u, bw, dbw, q1, q1w);
-  latticeRow2(c + 6u, bw, dbw, q2, q2w);
+  latticeRow2(base, k, bw, dbw, q0, q0w);
+  latticeRow2(base, k + 3u, bw, dbw, q1, q1w);
+  latticeRow2(base, k + 6u, bw, dbw, q2, q2w);
   P real3 a = ((real3(0) + q0 * bv.x) + q1 * bv.y) + q2 * bv.z;
   P real3 av = ((real3(0) + q0 * dbv.x) + q1 * dbv.y) + q2 * dbv.z;
   P real3 aw = ((real3(0) + q0w * bv.x) + q1w * bv.y) + q2w * bv.z;
@@ -136,9 +179,9 @@ void latticeVolume2(uint base, real su, real sv, real sw, out real3 R, out real3
   latticeBernstein2(sv, bv, dbv);
   latticeBernstein2(sw, bw, dbw);
   real3 s0, s0v, s0w, s1, s1v, s1w, s2, s2v, s2w;
-  latticeSlab2(base, bv, dbv, bw, dbw, s0, s0v, s0w);
-  latticeSlab2(base + 9u, bv, dbv, bw, dbw, s1, s1v, s1w);
-  latticeSlab2(base + 18u, bv, dbv, bw, dbw, s2, s2v, s2w);
+  latticeSlab2(base, 0u, bv, dbv, bw, dbw, s0, s0v, s0w);
+  latticeSlab2(base, 9u, bv, dbv, bw, dbw, s1, s1v, s1w);
+  latticeSlab2(base, 18u, bv, dbv, bw, dbw, s2, s2v, s2w);
   P real3 r = ((real3(0) + s0 * bu.x) + s1 * bu.y) + s2 * bu.z;
   P real3 ru = ((real3(0) + s0 * dbu.x) + s1 * dbu.y) + s2 * dbu.z;
   P real3 rv = ((real3(0) + s0v * bu.x) + s1v * bu.y) + s2v * bu.z;
@@ -188,6 +231,9 @@ LatticeSample latticeEvaluate(LatticeParams L, real3 x) {
   P real3 R = real3(0), Ru = real3(0), Rv = real3(0), Rw = real3(0);
   bool degree2 = sffdAssumes(SFFD_ASSUME_DEGREE2) || (!sffdAssumes(SFFD_ASSUME_GENERAL_DEGREE) && L.degree.xyz == uvec3(2u));
   if (degree2) {
+#ifdef SFFD_LATTICE_BOX_CACHE
+    if (sffdRollsLoops()) latticeCacheBox(base);
+#endif
     latticeVolume2(base, s0, s1, s2, R, Ru, Rv, Rw);
   } else {
     real bu[SFFD_MAX_DEGREE + 1], dbu[SFFD_MAX_DEGREE + 1];

@@ -12,6 +12,7 @@
 // Declared before lattice_eval.glsl, which then reads the lattice from the block when the host put it there.
 layout(std140, SFFD_SET binding = SFFD_BINDING_PARAMS) uniform DeformBlock { DeformParams params; };
 #define SFFD_LATTICE_INLINE 1
+#define SFFD_LATTICE_BOX_CACHE 1
 #include "../common/lattice_eval.glsl"
 #include "../pn/pn_eval.glsl"
 // Fit-table reads: from the parameter block when the host put the table there (layout.h), as the
