@@ -194,11 +194,40 @@ void latticeVolume2(uint base, real su, real sv, real sw, out real3 R, out real3
 
 // Evaluates the volume at world point x: lattice parameter p = A x + c, then the knot box's Bezier volume.
 // One axis of latticeEvaluate: the knot box of parameter p, the local coordinate in it and its size.
-void latticeAxis(uint first, uint n, real p, inout bool inside, out uint span, out real s, out real h) {
+// With SFFD_LATTICE_BOX_CACHE in the rolled form (above), the last span on each axis and its breaks are
+// kept too: p's span is the kept one exactly when p lies in [k0, k1) of it (no lower bound for the first,
+// no upper for the last; the breaks ascend, so the count below gives the same), and then neither the count
+// over the breaks nor the two reads at the span (each a read per lane there) run.
+#ifdef SFFD_LATTICE_BOX_CACHE
+uvec3 latticeCachedSpan = uvec3(0xffffffffu);
+real3 latticeCachedK0 = real3(0), latticeCachedK1 = real3(0);
+#endif
+void latticeAxis(uint axis, uint first, uint n, real p, inout bool inside, out uint span, out real s, out real h) {
   real lo = latticeFrameAt(first), hi = latticeFrameAt(first + n);
   if (p < lo || p > hi) inside = false;
-  span = latticeSpan(first, n, p);
-  real k0 = latticeFrameAt(first + span), k1 = latticeFrameAt(first + span + 1u);
+  real k0, k1;
+  bool kept = false;
+#ifdef SFFD_LATTICE_BOX_CACHE
+  if (sffdRollsLoops()) {
+    uint ks = componentOf(latticeCachedSpan, axis);
+    k0 = componentOf(latticeCachedK0, axis);
+    k1 = componentOf(latticeCachedK1, axis);
+    span = ks;
+    kept = ks != 0xffffffffu && (ks == 0u || k0 <= p) && (ks == n - 1u || p < k1);
+  }
+#endif
+  if (!kept) {
+    span = latticeSpan(first, n, p);
+    k0 = latticeFrameAt(first + span);
+    k1 = latticeFrameAt(first + span + 1u);
+#ifdef SFFD_LATTICE_BOX_CACHE
+    if (sffdRollsLoops()) {
+      latticeCachedSpan = withComponent(latticeCachedSpan, axis, span);
+      latticeCachedK0 = withComponent(latticeCachedK0, axis, k0);
+      latticeCachedK1 = withComponent(latticeCachedK1, axis, k1);
+    }
+#endif
+  }
   P real hh = k1 - k0;
   P real pk = p - k0;
   P real sa = sdiv(pk, hh);
@@ -222,9 +251,9 @@ LatticeSample latticeEvaluate(LatticeParams L, real3 x) {
   S.inside = true;
   uint span0, span1, span2;
   real s0, s1, s2, h0, h1, h2;
-  latticeAxis(L.break_offset.x, L.boxes.x, latticeAffineRow(0u, x), S.inside, span0, s0, h0);
-  latticeAxis(L.break_offset.y, L.boxes.y, latticeAffineRow(1u, x), S.inside, span1, s1, h1);
-  latticeAxis(L.break_offset.z, L.boxes.z, latticeAffineRow(2u, x), S.inside, span2, s2, h2);
+  latticeAxis(0u, L.break_offset.x, L.boxes.x, latticeAffineRow(0u, x), S.inside, span0, s0, h0);
+  latticeAxis(1u, L.break_offset.y, L.boxes.y, latticeAffineRow(1u, x), S.inside, span1, s1, h1);
+  latticeAxis(2u, L.break_offset.z, L.boxes.z, latticeAffineRow(2u, x), S.inside, span2, s2, h2);
   S.h = real3(h0, h1, h2);
   uint box = (span0 * L.boxes.y + span1) * L.boxes.z + span2;
   uint base = box * L.boxes.w;

@@ -113,6 +113,7 @@ real3 withComponent(real3 v, uint i, real x) { return real3(i == 0u ? x : v.x, i
 uvec3 withComponent(uvec3 v, uint i, uint x) { return uvec3(i == 0u ? x : v.x, i == 1u ? x : v.y, i == 2u ? x : v.z); }
 // Component i of v, likewise without a variable index.
 real componentOf(real3 v, uint i) { return i == 0u ? v.x : (i == 1u ? v.y : v.z); }
+uint componentOf(uvec3 v, uint i) { return i == 0u ? v.x : (i == 1u ? v.y : v.z); }
 
 // Whether a vector of squared length len2 has a direction to normalize to (layout.h); snormalize returns
 // one without as it is, a zero normal rather than a NaN that no writer accepts.
