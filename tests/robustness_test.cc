@@ -448,7 +448,7 @@ TEST_F(Robust, AFailedWriteStopsTheJobAndLeavesNothing) {
         if (binary) args.push_back("--binary");
         const std::string context = std::string(backend) + " " + name + (binary ? " binary" : "");
         const Result r = runSffd(args, {}, false, 256 * 1024);
-        // lavapipe from Mesa 24 on keeps device memory in a file, which the limit also holds: then the job
+        // lavapipe of Mesa 25.0 keeps device memory in a file, which the limit also holds: then the job
         // stops before it writes, with a device error that names the limit (vk_device.cpp), never a SIGBUS.
         if (std::string(backend) == "vulkan" && r.err.find("without memory behind it") != std::string::npos) {
           EXPECT_EQ(r.status, 3) << context << "\n" << r.err;

@@ -27,7 +27,7 @@ constexpr VkMemoryPropertyFlags kExcluded = VK_MEMORY_PROPERTY_LAZILY_ALLOCATED_
 
 std::atomic<size_t> gAllocations{0};   // deviceMemoryAllocations()
 
-// Whether the mapped device memory [data, data + bytes) is there to touch. lavapipe (Mesa 24 on) keeps
+// Whether the mapped device memory [data, data + bytes) is there to touch. lavapipe (Mesa 25.0) keeps
 // device memory in one memory file that it grows with ftruncate without checking the result: under a
 // file size limit (ulimit -f) the growth fails, the allocation and the map succeed, and the first touch
 // past the file's end is a SIGBUS. Populating the range's last page (it ends the file) fails with
@@ -241,10 +241,13 @@ Allocation Device::allocate(uint64_t bytes, VkBufferUsageFlags usage, MemoryUse 
     if (mappable && (use != MemoryUse::Storage || unified_))
     {
       check(api_.vkMapMemory(device_, a.memory, 0, VK_WHOLE_SIZE, 0, &a.mapped), "vkMapMemory");
-      if (info_.type == "cpu" && !mappedMemoryIsThere(a.mapped, req.size)) throw unbackedMemoryError(bytes);
-      // On a CPU device (lavapipe, SwiftShader) device memory is the driver's malloc'd host memory:
-      // huge pages asked for before anything touches it (core/huge_pages.h).
-      if (info_.type == "cpu") adviseHugePages(a.mapped, bytes);
+      // On a CPU device (lavapipe, SwiftShader) device memory is the driver's host memory: huge pages asked
+      // for before anything touches it (core/huge_pages.h), then whether it is there at all (after the
+      // advice, so that the probe's read maps the huge zero page, not a small page in a huge page's place).
+      if (info_.type == "cpu") {
+        adviseHugePages(a.mapped, bytes);
+        if (!mappedMemoryIsThere(a.mapped, req.size)) throw unbackedMemoryError(bytes);
+      }
     }
   } catch (...) {
     release(a);
