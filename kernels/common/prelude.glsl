@@ -103,7 +103,8 @@ uint sffdRolled(uint n) { return sffdAssumes(SFFD_ASSUME_ROLLED_LOOPS) ? n + (gl
 // 25.0 compiles fastest, at some warm cost), elsewhere the straight code Mesa 22.3 runs fastest. A
 // constant expression rather than a call: where the assumptions are constant (GL, the SPIR-V compiled
 // ahead) the compiler drops the other form before the driver sees it (chosen after inlining, the
-// forms cost lavapipe 22.3 5 to 25 % more clip_write instructions).
+// forms cost lavapipe 22.3 5 to 25 % more clip_write instructions). The same drivers skip a branch no lane
+// takes, which the knot box kept in registers relies on (lattice_eval.glsl SFFD_LATTICE_BOX_CACHE).
 const bool sffdRollsLoopsHere = (sffdAssumptions & SFFD_ASSUME_ROLLED_LOOPS) != 0u;
 #define sffdRollsLoops() sffdRollsLoopsHere
 
