@@ -192,16 +192,16 @@ void latticeVolume2(uint base, real su, real sv, real sw, out real3 R, out real3
   Rw = rw;
 }
 
-// Evaluates the volume at world point x: lattice parameter p = A x + c, then the knot box's Bezier volume.
-// One axis of latticeEvaluate: the knot box of parameter p, the local coordinate in it and its size.
 // With SFFD_LATTICE_BOX_CACHE in the rolled form (above), the last span on each axis and its breaks are
 // kept too: p's span is the kept one exactly when p lies in [k0, k1) of it (no lower bound for the first,
-// no upper for the last; the breaks ascend, so the count below gives the same), and then neither the count
-// over the breaks nor the two reads at the span (each a read per lane there) run.
+// no upper for the last; the breaks ascend, so the count in latticeSpan gives the same), and then neither
+// that count nor the two reads at the span (each a read per lane there) run.
 #ifdef SFFD_LATTICE_BOX_CACHE
 uvec3 latticeCachedSpan = uvec3(0xffffffffu);
 real3 latticeCachedK0 = real3(0), latticeCachedK1 = real3(0);
 #endif
+
+// One axis of latticeEvaluate: the knot box of parameter p, the local coordinate in it and its size.
 void latticeAxis(uint axis, uint first, uint n, real p, inout bool inside, out uint span, out real s, out real h) {
   real lo = latticeFrameAt(first), hi = latticeFrameAt(first + n);
   if (p < lo || p > hi) inside = false;
