@@ -198,6 +198,23 @@ TEST(Cli, MissingVulkanLoaderIsADeviceError) {
   EXPECT_FALSE(fs::exists("/tmp/never.obj"));
 }
 
+// The inputs are read while the device opens (loadJobAndOpenDevice): a bad input is still the one error
+// reported when the device fails too, as when the inputs were read first, and a good one gives the device's.
+TEST(Cli, AnInputErrorWinsOverADeviceError) {
+  const std::string lattice = " -l " + kData + "/lattices/cube_bend.npy --backend vulkan";
+  const std::string noDevice = "SFFD_VULKAN_LIBRARY=libvulkan-missing.so.9";
+  for (std::string command : {"deform -o /tmp/never.obj ", "error "}) {
+    RunResult r = runSffd(command + kData + "/no-such-mesh.obj" + lattice, noDevice);
+    EXPECT_EQ(r.status, 2) << command << " " << r.err;
+    expectOneErrorLine(r);
+    EXPECT_NE(r.err.find("no-such-mesh.obj"), std::string::npos) << r.err;
+    r = runSffd(command + kData + "/cube.obj" + lattice, noDevice);
+    EXPECT_EQ(r.status, 3) << command << " " << r.err;
+    expectOneErrorLine(r);
+  }
+  EXPECT_FALSE(fs::exists("/tmp/never.obj"));
+}
+
 TEST(Cli, MissingIcdIsADeviceErrorAndAutoFallsBack) {
   std::string args = "deform " + kData + "/cube.obj -l " + kData + "/lattices/cube_bend.npy --method classic ";
   fs::path dir = tempDir("fallback");

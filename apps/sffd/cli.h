@@ -78,6 +78,15 @@ void checkOutputPath(const std::string& out, const std::vector<std::string>& inp
 // Opens the device the options ask for (--backend, --device), printing fallback notes unless --quiet.
 Device openDeviceFromArgs(const ParsedArgs& args);
 
+// loadJob and openDeviceFromArgs at once: the inputs are read on a thread while the device opens on the
+// caller's (where a GL context is current). An input error wins over a device error, as when one came first.
+struct JobAndDevice {
+  Job job;
+  Device device;
+  double openMs = 0;   // the device's opening; the rest of the call is the wait for the inputs after it
+};
+JobAndDevice loadJobAndOpenDevice(const ParsedArgs& args);
+
 // --precision auto|float|double resolved for a backend (auto: double where the device has it).
 bool wantDouble(const ParsedArgs& args, const DeviceInfo& info, bool autoDouble);
 

@@ -1,4 +1,5 @@
 // sffd deform MESH -l LATTICE -o OUT: deforms a mesh and writes the result with vertex normals.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <memory>
@@ -54,10 +55,11 @@ int run(const ParsedArgs& args) {
     auto t = std::chrono::steady_clock::now();
     return std::chrono::duration<double, std::milli>(t - std::exchange(lapStart, t)).count();
   };
-  Job job = loadJob(args);
-  const double readMs = lap();
-  Device device = openDeviceFromArgs(args);
-  const double openMs = lap();
+  JobAndDevice opened = loadJobAndOpenDevice(args);
+  Job& job = opened.job;
+  Device& device = opened.device;
+  // The phases add up to the wall time: `read` is what the inputs took beyond the device's opening.
+  const double openMs = opened.openMs, readMs = std::max(0.0, lap() - openMs);
   // Smooth and accurate results go to a .ply or .stl as they are welded (MeshFileWriter), never held whole
   // (--patches reads the Deformer again afterwards: then the result is taken as before).
   const bool streamed = methodOf(args.get("--method", "smooth")) != Method::Classic && !args.has("--patches") &&

@@ -19,8 +19,9 @@ nlohmann::ordered_json statsJson(const ErrorStats& s) { return {{"avg", s.avg}, 
 int run(const ParsedArgs& args) {
   checkJobOptions(args);
 
-  Job job = loadJob(args);
-  Device device = openDeviceFromArgs(args);
+  JobAndDevice opened = loadJobAndOpenDevice(args);
+  Job& job = opened.job;
+  Device& device = opened.device;
   DeformRun run = runDeformJob(args, job, device);
   const bool f64 = run.deformer.doublePrecision();
   // job.mesh as the method used it (its triangles are the patches' parents).

@@ -91,8 +91,9 @@ int run(const ParsedArgs& args) {
     meshes.push_back(std::move(mesh));
     captions.push_back("");
   } else {
-    Job job = loadJob(args);
-    Device device = openDeviceFromArgs(args);
+    JobAndDevice opened = loadJobAndOpenDevice(args);
+    Job& job = opened.job;
+    Device& device = opened.device;
     computedOn = ", deformed on " + device.label();
     if (compare == "input") {
       meshes.push_back(job.mesh);

@@ -1,8 +1,11 @@
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <future>
+#include <optional>
 
 #include "apps/sffd/cli.h"
 #include "core/backend.h"
@@ -153,6 +156,24 @@ Device openDeviceFromArgs(const ParsedArgs& args) {
   Device d = Device::open(r, &notes);
   for (const std::string& n : notes) note(args, n);
   return d;
+}
+
+JobAndDevice loadJobAndOpenDevice(const ParsedArgs& args) {
+  using Clock = std::chrono::steady_clock;
+  // Opening a device costs lavapipe and llvmpipe 20-30 ms (the Vulkan loader, LLVM's start-up), about what
+  // reading the teapot takes. Nothing on this thread calls warnOnSuccess (the reader's) before the join.
+  std::future<Job> reading = std::async(std::launch::async, [&args] { return loadJob(args); });
+  const Clock::time_point t = Clock::now();
+  std::optional<Device> device;
+  try {
+    device.emplace(openDeviceFromArgs(args));
+  } catch (...) {
+    reading.get();   // the input's error first, as when the inputs were read before the device opened
+    throw;
+  }
+  const double openMs = std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+  Job job = reading.get();
+  return {std::move(job), std::move(*device), openMs};
 }
 
 double creaseAngleOf(const ParsedArgs& args) {
