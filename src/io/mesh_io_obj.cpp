@@ -40,6 +40,7 @@ template <class Vec>
 std::vector<int64_t> firstEqual(const std::vector<Vec>& values) {
   std::vector<int64_t> canon(values.size());
   std::unordered_map<std::array<uint64_t, 3>, int64_t, NormalKeyHash> first;
+  first.reserve(values.size());   // one table, no rehash as it grows
   for (size_t i = 0; i < values.size(); ++i) {
     std::array<uint64_t, 3> key{};
     for (int c = 0; c < Vec::length(); ++c) {
