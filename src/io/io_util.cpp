@@ -125,17 +125,11 @@ std::string quoted(std::string_view t) {
   return s + "'";
 }
 
-namespace {
-// The C locale's white space whatever locale the embedding program set, and inline: std::isspace is a call
-// per character, a tenth of reading a large OBJ (perf).
-constexpr bool isSpace(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f' || c == '\v'; }
-}  // namespace
-
 void Tokenizer::skipSpace() {
   while (pos_ < text_.size()) {
     char c = text_[pos_];
     if (c == '\n') ++line_;
-    else if (!(c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v')) break;
+    else if (!isSpace(c)) break;
     ++pos_;
   }
 }

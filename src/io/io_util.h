@@ -74,7 +74,11 @@ class LineReader {
   size_t line_ = 0;
 };
 
-// Splits on spaces and tabs (and other ASCII whitespace).
+// White space as the C locale has it (space, \t, \n, \r, \f, \v), whatever locale the embedding program set;
+// inline because std::isspace, a call per character, was a tenth of reading a large OBJ (perf).
+constexpr bool isSpace(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f' || c == '\v'; }
+
+// Splits on ASCII white space (isSpace).
 void splitTokens(std::string_view line, std::vector<std::string_view>& out);
 std::string_view trim(std::string_view s);
 

@@ -130,7 +130,7 @@ class LineMap {
     if (path.empty()) return;
     // The element's line: the last non-blank character read (the parser reads at most one past a token).
     const char* q = furthest_;
-    while (q > text_.data() && std::isspace(static_cast<unsigned char>(q[-1]))) --q;
+    while (q > text_.data() && io::isSpace(q[-1])) --q;
     size_t off = q > text_.data() ? size_t(q - 1 - text_.data()) : 0;
     lines_.emplace(path, lineOfOffset(off));
   }

@@ -230,7 +230,7 @@ NpyHeader parseNpyHeader(const std::string& path, std::string_view h) {
   size_t i = 0;
   auto fail = [&](const std::string& what) { return inputError(path, 0, "bad .npy header (" + what + "): " + io::quoted(h)); };
   auto ws = [&]() {
-    while (i < h.size() && std::isspace(static_cast<unsigned char>(h[i]))) ++i;
+    while (i < h.size() && io::isSpace(h[i])) ++i;
   };
   auto expect = [&](char c) {
     ws();

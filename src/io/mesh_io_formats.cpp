@@ -438,7 +438,7 @@ namespace {
 
 bool startsWithSolid(const std::string& text) {
   size_t i = 0;
-  while (i < text.size() && std::isspace(static_cast<unsigned char>(text[i]))) ++i;
+  while (i < text.size() && io::isSpace(text[i])) ++i;
   return text.compare(i, 5, "solid") == 0;
 }
 
