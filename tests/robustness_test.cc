@@ -76,8 +76,8 @@ class Robust : public ::testing::Test {
   // Runs sffd (no shell) with `env` added, stdout/stderr captured; wait4 gives the child's peak RSS.
   // SFFD_VK_VALIDATION=1 where the layer is installed: every Vulkan run is under it, whose messages are
   // printed as "sffd: vulkan ..." lines and fail the checks below.
-  // leakCheck: a sanitizer build checks leaks too (runs that fail before any driver is loaded; Mesa's
-  // drivers leak at exit, scripts/test.sh).
+  // leakCheck: a sanitizer build checks leaks too, for runs on --backend cpu only: the device opens while
+  // the inputs are read (loadJobAndOpenDevice), and Mesa's drivers leak at exit (scripts/test.sh).
   // fileSizeLimit: the largest file the run may write (RLIMIT_FSIZE, SIGXFSZ ignored): a larger write fails
   // as on a full disk.
   Result runSffd(const std::vector<std::string>& args, const std::vector<std::string>& env = {}, bool leakCheck = false,
@@ -260,7 +260,7 @@ TEST_F(Robust, EveryCorpusFileIsRefused) {
     const auto mtime = fs::last_write_time(f);
     const bool asLattice = isLatticeFile(f);   // fuzz regression files keep the extension of the reader that failed
     std::vector<std::string> args = {"deform", asLattice ? mesh : f.string(), "-l", asLattice ? f.string() : lattice,
-                                     "--method", "classic", "-o", out("result.obj")};
+                                     "--method", "classic", "--backend", "cpu", "-o", out("result.obj")};
     Result r = runSffd(args, {}, /*leakCheck=*/true);
     std::string where = f.string();
     if (!fromFuzzer) {
@@ -308,7 +308,7 @@ TEST_F(Robust, HugeHeaderCountsAllocateNothing) {
   };
   for (const Case& c : cases) {
     std::string p = write(c.name, c.bytes);
-    Result r = runSffd({"deform", p, "-l", lattice, "--method", "classic", "-o", out("o.obj")}, {}, true);
+    Result r = runSffd({"deform", p, "-l", lattice, "--method", "classic", "--backend", "cpu", "-o", out("o.obj")}, {}, true);
     expectInputError(r, p, c.name);
     EXPECT_LT(r.maxRssKiB, 400 * 1024) << c.name << ": peak RSS " << r.maxRssKiB << " KiB";
     expectNothingWritten(c.name);
