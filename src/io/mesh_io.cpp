@@ -5,8 +5,8 @@
 #include <cmath>
 #include <cstring>
 #include <ostream>
-#include <unordered_map>
 
+#include "core/key3_map.h"
 #include "io/atomic_file.h"
 #include "io/gltf_io.h"
 #include <sffd/error.h>
@@ -93,36 +93,26 @@ glm::dvec3 unitOrZ(const glm::dvec3& v) {
   return glm::dvec3(0, 0, 1);
 }
 
-struct PositionKey {
-  uint64_t x, y, z;
-  bool operator==(const PositionKey& o) const { return x == o.x && y == o.y && z == o.z; }
-};
-struct PositionKeyHash {
-  size_t operator()(const PositionKey& k) const {
-    uint64_t h = k.x * 0x9E3779B97F4A7C15ull;
-    h ^= k.y + 0x7F4A7C159E3779B9ull + (h << 6) + (h >> 2);
-    h ^= k.z + 0x94D049BB133111EBull + (h << 6) + (h >> 2);
-    return size_t(h ^ (h >> 31));
+// + 0.0 turns -0.0 into +0.0, so that equal values give equal keys.
+Key3 keyOf(const glm::dvec3& p) {
+  Key3 k;
+  for (int c = 0; c < 3; ++c) {
+    const double d = p[c] + 0.0;
+    std::memcpy(&k[size_t(c)], &d, 8);
   }
-};
-PositionKey keyOf(const glm::dvec3& p) {
-  PositionKey k;
-  // + 0.0 turns -0.0 into +0.0, so that equal values give equal keys.
-  double x = p.x + 0.0, y = p.y + 0.0, z = p.z + 0.0;
-  std::memcpy(&k.x, &x, 8);
-  std::memcpy(&k.y, &y, 8);
-  std::memcpy(&k.z, &z, 8);
   return k;
 }
 
 }  // namespace
 
 std::vector<uint32_t> meshio::distinctPositions(const std::vector<glm::dvec3>& positions, uint32_t& count) {
-  std::unordered_map<PositionKey, uint32_t, PositionKeyHash> ids;
-  ids.reserve(positions.size());
+  Key3Map ids(positions.size());
   std::vector<uint32_t> id(positions.size());
-  for (size_t v = 0; v < positions.size(); ++v) id[v] = ids.emplace(keyOf(positions[v]), uint32_t(ids.size())).first->second;
-  count = uint32_t(ids.size());
+  count = 0;
+  for (size_t v = 0; v < positions.size(); ++v) {
+    id[v] = ids.of(keyOf(positions[v]), count);
+    count += id[v] == count;
+  }
   return id;
 }
 

@@ -7,9 +7,9 @@
 #include <cctype>
 #include <cmath>
 #include <cstring>
-#include <unordered_map>
 
 #include <sffd/error.h>
+#include "core/key3_map.h"
 #include "io/io_util.h"
 #include "io/mesh_io_internal.h"
 
@@ -443,14 +443,20 @@ bool startsWithSolid(const std::string& text) {
 }
 
 struct Welder {
-  std::unordered_map<std::string, uint32_t> ids;   // key: the 24 bytes of the position (+0.0: no -0)
+  Key3Map ids;   // key: the bits of the position (+0.0: no -0)
   Mesh* mesh;
+  const std::string& path;
   uint32_t add(glm::dvec3 p) {
     p += glm::dvec3(0.0);
-    std::string key(reinterpret_cast<const char*>(&p), sizeof p);
-    auto [it, isNew] = ids.emplace(std::move(key), uint32_t(mesh->positions.size()));
-    if (isNew) mesh->positions.push_back(p);
-    return it->second;
+    Key3 key;
+    std::memcpy(key.data(), &p, sizeof key);
+    const uint32_t next = uint32_t(mesh->positions.size());
+    const uint32_t id = ids.of(key, next);
+    if (id == next) {
+      if (next >= kMaxVertices) throw inputError(path, 0, "too many vertices");
+      mesh->positions.push_back(p);
+    }
+    return id;
   }
 };
 
@@ -466,8 +472,7 @@ Mesh readStlBinary(const std::string& path, const std::string& text) {
                                   " bytes), the file has " + std::to_string(text.size()) + " bytes");
   if (n == 0) throw inputError(path, 0, "no triangles");
   Mesh mesh;
-  Welder w{{}, &mesh};
-  w.ids.reserve(n / 2 + 1);
+  Welder w{Key3Map(n / 2 + 1), &mesh, path};
   mesh.triangles.reserve(n);
   const char* p = text.data() + 84;
   for (uint32_t t = 0; t < n; ++t, p += 50) {
@@ -492,7 +497,7 @@ Mesh readStlAscii(const std::string& path, const std::string& text) {
   std::string_view t;
   size_t line = 1;
   Mesh mesh;
-  Welder w{{}, &mesh};
+  Welder w{Key3Map(0), &mesh, path};
   std::vector<uint32_t> poly;
   auto expect = [&](const char* word) {
     if (!tz.next(t, line)) throw inputError(path, line, std::string("file ends, expected '") + word + "' (truncated?)");

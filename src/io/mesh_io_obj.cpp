@@ -12,9 +12,9 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
-#include <unordered_map>
 
 #include <sffd/error.h>
+#include "core/key3_map.h"
 #include "io/io_util.h"
 #include "io/mesh_io_internal.h"
 
@@ -25,29 +25,19 @@ struct Corner {
   int64_t p, t, n;   // 0-based; t, n: -1 when absent
 };
 
-struct NormalKeyHash {
-  size_t operator()(const std::array<uint64_t, 3>& k) const {
-    uint64_t h = k[0] * 0x9E3779B97F4A7C15ull;
-    h ^= k[1] + 0x7F4A7C159E3779B9ull + (h << 6) + (h >> 2);
-    h ^= k[2] + 0x94D049BB133111EBull + (h << 6) + (h >> 2);
-    return size_t(h);
-  }
-};
-
 // The index of each value's first equal value (bit equality, -0 = +0): equal normals or texture
-// coordinates given twice count as one.
+// coordinates given twice count as one. At most kMaxVertices values.
 template <class Vec>
 std::vector<int64_t> firstEqual(const std::vector<Vec>& values) {
   std::vector<int64_t> canon(values.size());
-  std::unordered_map<std::array<uint64_t, 3>, int64_t, NormalKeyHash> first;
-  first.reserve(values.size());   // one table, no rehash as it grows
+  Key3Map first(values.size());
   for (size_t i = 0; i < values.size(); ++i) {
-    std::array<uint64_t, 3> key{};
+    Key3 key{};
     for (int c = 0; c < Vec::length(); ++c) {
       double d = values[i][c] + 0.0;
       std::memcpy(&key[size_t(c)], &d, 8);
     }
-    canon[i] = first.emplace(key, int64_t(i)).first->second;
+    canon[i] = first.of(key, uint32_t(i));
   }
   return canon;
 }
@@ -180,6 +170,7 @@ Mesh readObj(const std::string& path, const std::string& text) {
       posColor.push_back(rgb);
     } else if (kw == "vn") {
       nrm.push_back(readVec(line, "normal"));
+      if (nrm.size() > kMaxVertices) throw fail(line, "too many normals");
     } else if (kw == "vt") {
       if (tok.size() < 2) throw fail(line, "texture coordinate needs a value");
       glm::dvec2 t(0.0);
@@ -188,6 +179,7 @@ Mesh readObj(const std::string& path, const std::string& text) {
         if (!std::isfinite(t[int(c)])) throw fail(line, "non-finite texture coordinate " + io::quoted(tok[1 + c]));
       }
       tex.push_back(t);
+      if (tex.size() > kMaxVertices) throw fail(line, "too many texture coordinates");
     } else if (kw == "usemtl" && tok.size() >= 2) {
       material = indexOfName(materialNames, tok[1]);
     } else if (kw == "g") {
@@ -259,7 +251,7 @@ Mesh readObj(const std::string& path, const std::string& text) {
   std::vector<Slot> slot(pos.size());
   std::vector<uint32_t> positionOf(pos.size());
   for (size_t i = 0; i < pos.size(); ++i) positionOf[i] = uint32_t(i);
-  std::unordered_map<std::array<uint64_t, 3>, uint32_t, NormalKeyHash> extra;   // (position, n + 1, t + 1) -> vertex
+  Key3Map extra(0);   // (position, n + 1, t + 1) -> vertex
   std::vector<uint32_t> vid;
   mesh.triangles.reserve(corners.size());
   const bool perTriangleMaterial = !materialNames.empty(), perTriangleGroup = !groupNames.empty();
@@ -273,16 +265,14 @@ Mesh readObj(const std::string& path, const std::string& text) {
         slot[size_t(k.p)] = s;
         v = uint32_t(k.p);
       } else {
-        const std::array<uint64_t, 3> key{uint64_t(k.p), uint64_t(s.n + 1), uint64_t(s.t + 1)};
-        auto it = extra.find(key);
-        if (it == extra.end()) {
+        const uint32_t next = uint32_t(mesh.positions.size());
+        v = extra.of({uint64_t(k.p), uint64_t(s.n + 1), uint64_t(s.t + 1)}, next);
+        if (v == next) {
           if (mesh.positions.size() >= kMaxVertices) throw fail(faceLine[f], "too many vertices");
-          it = extra.emplace(key, uint32_t(mesh.positions.size())).first;
           mesh.positions.push_back(pos[size_t(k.p)]);
           slot.push_back(s);
           positionOf.push_back(uint32_t(k.p));
         }
-        v = it->second;
       }
       vid.push_back(v);
     }
@@ -308,7 +298,11 @@ Mesh readObj(const std::string& path, const std::string& text) {
   }
   if (anyColor)
     for (size_t v = 0; v < n; ++v) mesh.colors.push_back(glm::dvec4(posColor[positionOf[v]], 1.0));
-  for (const std::string& name : materialNames) mesh.materials.push_back(Material{name, glm::dvec4(1.0), ""});
+  for (const std::string& name : materialNames) {
+    Material m;
+    m.name = name;
+    mesh.materials.push_back(std::move(m));
+  }
   mesh.groups = std::move(groupNames);
   mesh.materialLibraries = std::move(libraries);
   if (!mesh.materialLibraries.empty() && !mesh.materials.empty()) readMaterialLibraries(mesh, path);

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "core/huge_pages.h"
+#include "core/key3_map.h"
 
 namespace sffd {
 
@@ -94,79 +95,6 @@ bool sameNormal(const double* a, const double* b) {
   return std::abs(a[0] - b[0]) <= kRounding && std::abs(a[1] - b[1]) <= kRounding && std::abs(a[2] - b[2]) <= kRounding;
 }
 
-struct Key3Hash {
-  size_t operator()(const std::array<uint64_t, 3>& k) const {
-    uint64_t h = k[0] * 0x9E3779B97F4A7C15ull;
-    h = (h ^ (h >> 29) ^ k[1]) * 0xBF58476D1CE4E5B9ull;
-    h = (h ^ (h >> 31) ^ k[2]) * 0x94D049BB133111EBull;
-    return size_t(h ^ (h >> 32));
-  }
-};
-
-// A hash map from 3-word keys to a slot, by open addressing with linear probing (one flat table: no
-// allocation a key, as the node-based std::unordered_map makes). The all-zero key marks an empty slot;
-// Locations never makes it. A returned slot stays valid until the next of(). A rehash (growth, remap)
-// builds the new table in the storage the last one left: a streamed weld rehashes every compaction,
-// and fresh storage each time cost more in page faults and the kernel's zeroing than the weld itself.
-class Key3Map {
- public:
-  explicit Key3Map(size_t expected) : expected_(expected) {}
-  uint32_t& of(const std::array<uint64_t, 3>& key, uint32_t fresh) {
-    if (slots_.empty()) {   // allocated at the first key (PatchWelder::forgetPassedLocations expects fewer)
-      size_t n = 16;
-      while (n < 2 * expected_) n *= 2;
-      resizeHuge(slots_, n);
-    }
-    if (2 * (used_ + 1) > slots_.size()) grow();
-    Slot* s = find(key);
-    if (same(s->key, kEmpty)) s->key = key, s->value = fresh, ++used_;
-    return s->value;
-  }
-  // Keeps the keys whose value v has a new value to[v] (kNone: the key goes), in a table sized for them.
-  void remap(const std::vector<uint32_t>& to, uint32_t none) {
-    size_t kept = 0;
-    for (const Slot& s : slots_) kept += !same(s.key, kEmpty) && to[s.value] != none;
-    size_t n = 16;
-    while (n < 4 * kept) n *= 2;
-    emptyTable(n);
-    used_ = kept;
-    for (const Slot& s : spare_)
-      if (!same(s.key, kEmpty) && to[s.value] != none) *find(s.key) = {s.key, to[s.value]};
-  }
-
- private:
-  struct Slot {
-    std::array<uint64_t, 3> key{0, 0, 0};
-    uint32_t value = 0;
-  };
-  static constexpr std::array<uint64_t, 3> kEmpty{0, 0, 0};
-  Slot* find(const std::array<uint64_t, 3>& key) {
-    const size_t mask = slots_.size() - 1;
-    for (size_t i = Key3Hash()(key) & mask;; i = (i + 1) & mask)
-      if (same(slots_[i].key, key) || same(slots_[i].key, kEmpty)) return &slots_[i];
-  }
-  void grow() {
-    emptyTable(slots_.size() * 2);
-    for (const Slot& s : spare_)
-      if (!same(s.key, kEmpty)) *find(s.key) = s;
-  }
-  // slots_ becomes n empty slots in the spare storage, spare_ the table it was.
-  void emptyTable(size_t n) {
-    if (spare_.capacity() < n) {
-      freeStorage(spare_);
-      reserveHuge(spare_, n);
-    }
-    spare_.assign(n, Slot{});
-    spare_.swap(slots_);
-  }
-  // std::array's == calls memcmp here, a call for each probe.
-  static bool same(const std::array<uint64_t, 3>& a, const std::array<uint64_t, 3>& b) {
-    return ((a[0] ^ b[0]) | (a[1] ^ b[1]) | (a[2] ^ b[2])) == 0;
-  }
-  std::vector<Slot> slots_, spare_;
-  size_t expected_, used_ = 0;
-};
-
 // Where on the input surface a patch-boundary vertex lies, from its pre-image: a corner by the input's
 // weldId, a parent edge by its two welded corners and the barycentric of the higher one (the clip
 // measures edge points from the lower weldId and the tessellation sums the same two products on
@@ -191,11 +119,10 @@ class Locations {
       const int hi = w[a] < w[b] ? b : a;
       // Every parent on that edge has both corners.
       if (!lastUse_.empty()) until = std::min(lastUse_[w[a]], lastUse_[w[b]]);
-      // Never all zero: the two weldIds differ.
       return other_.of({uint64_t(std::min(w[a], w[b])) << 32 | std::max(w[a], w[b]), bitsOf(lam[hi]), 0}, kNone);
     }
     // Apart from the edge keys: their last word is 0, the bits of +0, and inside a parent no barycentric
-    // is 0 (so neither is this key all zero).
+    // is 0.
     until = parent;
     return other_.of({uint64_t(parent), bitsOf(lam[0]), bitsOf(lam[1])}, kNone);
   }
