@@ -59,12 +59,6 @@ void appendRaw(std::string& s, T v) {
   s.append(b, sizeof(T));
 }
 
-// Binary PLY: float or double, as the digits ask (the same rule as the text header's type).
-void appendReal(std::string& s, double v, bool f64) {
-  if (f64) appendRaw(s, v);
-  else appendRaw(s, float(v));
-}
-
 uint8_t colorByte(double c) { return uint8_t(std::lround(std::clamp(c, 0.0, 1.0) * 255.0)); }
 
 }  // namespace
@@ -97,19 +91,8 @@ std::string plyHeader(size_t vertices, size_t faces, int digits, const Carried& 
   return s;
 }
 
-void appendPlyVertex(std::string& s, const Mesh& mesh, size_t v, int digits, const Carried& has, bool binary) {
-  const bool f64 = digits > 9;
-  const int colorChannels = has.alpha ? 4 : 3;
-  if (binary) {
-    for (int c = 0; c < 3; ++c) appendReal(s, mesh.positions[v][c], f64);
-    if (has.normals)
-      for (int c = 0; c < 3; ++c) appendReal(s, mesh.normals[v][c], f64);
-    if (has.texcoords)
-      for (int c = 0; c < 2; ++c) appendReal(s, mesh.texcoords[v][c], f64);
-    if (has.colors)
-      for (int c = 0; c < colorChannels; ++c) appendRaw(s, colorByte(mesh.colors[v][c]));
-    return;
-  }
+namespace {
+void appendPlyVertexText(std::string& s, const Mesh& mesh, size_t v, int digits, const Carried& has) {
   appendVec(s, mesh.positions[v], digits);
   if (has.normals) {
     s += ' ';
@@ -119,25 +102,71 @@ void appendPlyVertex(std::string& s, const Mesh& mesh, size_t v, int digits, con
     s += ' ';
     io::appendNumber(s, mesh.texcoords[v][c], digits);
   }
-  for (int c = 0; has.colors && c < colorChannels; ++c) {
+  for (int c = 0; has.colors && c < (has.alpha ? 4 : 3); ++c) {
     s += ' ';
     appendIndex(s, colorByte(mesh.colors[v][c]));
   }
   s += '\n';
 }
 
-void appendPlyFace(std::string& s, const std::array<uint32_t, 3>& t, bool binary) {
-  if (binary) {
-    appendRaw(s, uint8_t(3));
-    for (uint32_t i : t) appendRaw(s, int32_t(i));
+// Binary records are written in place, in room made for all of them: appended field by field (a size
+// check and a copy of 4 bytes each) they cost as much as the weld beside them.
+template <class Real>
+void appendPlyVerticesBinary(std::string& s, const Mesh& mesh, size_t first, size_t count, const Carried& has) {
+  const int colorChannels = has.alpha ? 4 : 3;
+  const size_t record = sizeof(Real) * (3 + (has.normals ? 3 : 0) + (has.texcoords ? 2 : 0)) + (has.colors ? colorChannels : 0);
+  const size_t at = s.size();
+  s.resize(at + count * record);
+  char* p = s.data() + at;
+  auto put = [&p](double x) {
+    const Real r = Real(x);
+    std::memcpy(p, &r, sizeof r);
+    p += sizeof r;
+  };
+  for (size_t v = first; v < first + count; ++v) {
+    const glm::dvec3& x = mesh.positions[v];
+    put(x.x), put(x.y), put(x.z);
+    if (has.normals) {
+      const glm::dvec3& n = mesh.normals[v];
+      put(n.x), put(n.y), put(n.z);
+    }
+    if (has.texcoords) put(mesh.texcoords[v].x), put(mesh.texcoords[v].y);
+    for (int c = 0; has.colors && c < colorChannels; ++c) *p++ = char(colorByte(mesh.colors[v][c]));
+  }
+}
+}  // namespace
+
+void appendPlyVertices(std::string& s, const Mesh& mesh, size_t first, size_t count, int digits, const Carried& has,
+                       bool binary) {
+  if (!binary) {
+    for (size_t v = first; v < first + count; ++v) appendPlyVertexText(s, mesh, v, digits, has);
+  } else if (digits > 9) {
+    appendPlyVerticesBinary<double>(s, mesh, first, count, has);
+  } else {
+    appendPlyVerticesBinary<float>(s, mesh, first, count, has);
+  }
+}
+
+void appendPlyFaces(std::string& s, const std::array<uint32_t, 3>* triangles, size_t count, bool binary) {
+  if (!binary) {
+    for (size_t f = 0; f < count; ++f) {
+      s += '3';
+      for (uint32_t i : triangles[f]) {
+        s += ' ';
+        appendIndex(s, i);
+      }
+      s += '\n';
+    }
     return;
   }
-  s += '3';
-  for (uint32_t i : t) {
-    s += ' ';
-    appendIndex(s, i);
+  // A count byte, then the three indices as int: an index's uint32_t bits are its int's.
+  const size_t at = s.size();
+  s.resize(at + 13 * count);
+  char* p = s.data() + at;
+  for (size_t f = 0; f < count; ++f, p += 13) {
+    p[0] = 3;
+    std::memcpy(p + 1, triangles[f].data(), 12);
   }
-  s += '\n';
 }
 
 std::string stlHeader(bool binary, size_t triangles) {
@@ -311,12 +340,13 @@ void writePly(std::ostream& os, const Mesh& mesh, int digits, const Carried& has
   ChunkedWriter w(os);
   std::string& s = w.buf();
   s += plyHeader(mesh.positions.size(), mesh.triangles.size(), digits, has, binary);
-  for (size_t v = 0; v < mesh.positions.size(); ++v) {
-    appendPlyVertex(s, mesh, v, digits, has, binary);
+  constexpr size_t kBlock = 4096;   // records between flushes
+  for (size_t v = 0; v < mesh.positions.size(); v += kBlock) {
+    appendPlyVertices(s, mesh, v, std::min(kBlock, mesh.positions.size() - v), digits, has, binary);
     w.maybeFlush();
   }
-  for (const auto& t : mesh.triangles) {
-    appendPlyFace(s, t, binary);
+  for (size_t f = 0; f < mesh.triangles.size(); f += kBlock) {
+    appendPlyFaces(s, &mesh.triangles[f], std::min(kBlock, mesh.triangles.size() - f), binary);
     w.maybeFlush();
   }
   w.flush();

@@ -124,8 +124,8 @@ struct MeshFileWriter::Impl {
         append(held.triangleMaterial, piece.triangleMaterial), append(held.triangleGroup, piece.triangleGroup);
         break;
       case Mode::Ply:
-        for (size_t v = 0; v < n; ++v) meshio::appendPlyVertex(vbuf, piece, v, digits, has, options.binary);
-        for (const auto& t : piece.triangles) meshio::appendPlyFace(fbuf, t, options.binary);
+        meshio::appendPlyVertices(vbuf, piece, 0, n, digits, has, options.binary);
+        meshio::appendPlyFaces(fbuf, piece.triangles.data(), piece.triangles.size(), options.binary);
         if (vbuf.size() >= kFlushBytes) flushTo(vbuf, vertexSpill->stream(), path);
         if (fbuf.size() >= kFlushBytes) flushTo(fbuf, faceSpill->stream(), path);
         break;

@@ -23,8 +23,10 @@ void checkFiniteVertex(const std::string& path, size_t v, const glm::dvec3& posi
 
 // PLY: float properties for `digits` <= 9, double above (the text header's rule too).
 std::string plyHeader(size_t vertices, size_t faces, int digits, const Carried& has, bool binary);
-void appendPlyVertex(std::string& s, const Mesh& mesh, size_t v, int digits, const Carried& has, bool binary);
-void appendPlyFace(std::string& s, const std::array<uint32_t, 3>& t, bool binary);
+// Vertices [first, first + count) and `count` faces from `triangles`.
+void appendPlyVertices(std::string& s, const Mesh& mesh, size_t first, size_t count, int digits, const Carried& has,
+                       bool binary);
+void appendPlyFaces(std::string& s, const std::array<uint32_t, 3>* triangles, size_t count, bool binary);
 
 // STL: the header (binary: its triangle count), each facet (the normal from mesh.positions, or for a degenerate
 // triangle the mean of mesh.normals when `withNormals`), the footer.

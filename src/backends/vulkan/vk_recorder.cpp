@@ -24,8 +24,8 @@ constexpr uint32_t kQueriesPerPool = 512;   // 256 dispatches
 Recorder::Recorder(Device& device, VkDescriptorSetLayout setLayout)
     : device_(device),
       setLayout_(setLayout),
-      params_{VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, MemoryUse::Params, kParamChunkBytes, ~VkDeviceSize(0)},
-      staging_{VK_BUFFER_USAGE_TRANSFER_SRC_BIT, MemoryUse::Upload, kStagingChunkBytes, kStagingKeptBytes} {
+      params_{VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, MemoryUse::Params, kParamChunkBytes, ~VkDeviceSize(0), {}},
+      staging_{VK_BUFFER_USAGE_TRANSFER_SRC_BIT, MemoryUse::Upload, kStagingChunkBytes, kStagingKeptBytes, {}} {
   const Api& api = device_.api();
   VkDevice dev = device_.handle();
   timestamps_ = device_.info().limits.timestamps;
