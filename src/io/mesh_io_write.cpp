@@ -193,27 +193,36 @@ glm::dvec3 facetNormal(const Mesh& mesh, const std::array<uint32_t, 3>& t, bool 
 }
 }  // namespace
 
-void appendStlFacet(std::string& s, const Mesh& mesh, const std::array<uint32_t, 3>& t, bool withNormals, int digits,
-                    bool binary) {
-  if (binary) {
-    auto vec = [&](const glm::dvec3& v) {
-      for (int c = 0; c < 3; ++c) appendRaw(s, float(v[c]));
+void appendStlFacets(std::string& s, const Mesh& mesh, const std::array<uint32_t, 3>* triangles, size_t count,
+                     bool withNormals, int digits, bool binary) {
+  if (binary) {   // 50 bytes a facet, written in place as the PLY records are
+    const size_t at = s.size();
+    s.resize(at + 50 * count);
+    char* p = s.data() + at;
+    auto vec = [&p](const glm::dvec3& v) {
+      const float f[3] = {float(v.x), float(v.y), float(v.z)};
+      std::memcpy(p, f, 12);
+      p += 12;
     };
-    vec(facetNormal(mesh, t, withNormals));
-    for (uint32_t i : t) vec(mesh.positions[i]);
-    appendRaw(s, uint16_t(0));   // attribute byte count
+    for (size_t f = 0; f < count; ++f) {
+      vec(facetNormal(mesh, triangles[f], withNormals));
+      for (uint32_t i : triangles[f]) vec(mesh.positions[i]);
+      *p++ = 0, *p++ = 0;   // attribute byte count
+    }
     return;
   }
   // Text, so that coordinates keep `digits` digits.
-  s += "  facet normal ";
-  appendVec(s, facetNormal(mesh, t, withNormals), digits);
-  s += "\n    outer loop\n";
-  for (uint32_t i : t) {
-    s += "      vertex ";
-    appendVec(s, mesh.positions[i], digits);
-    s += '\n';
+  for (size_t f = 0; f < count; ++f) {
+    s += "  facet normal ";
+    appendVec(s, facetNormal(mesh, triangles[f], withNormals), digits);
+    s += "\n    outer loop\n";
+    for (uint32_t i : triangles[f]) {
+      s += "      vertex ";
+      appendVec(s, mesh.positions[i], digits);
+      s += '\n';
+    }
+    s += "    endloop\n  endfacet\n";
   }
-  s += "    endloop\n  endfacet\n";
 }
 
 }  // namespace meshio
@@ -384,8 +393,9 @@ void writeStl(std::ostream& os, const Mesh& mesh, int digits, bool withNormals, 
   ChunkedWriter w(os);
   std::string& s = w.buf();
   s += stlHeader(binary, mesh.triangles.size());
-  for (const auto& t : mesh.triangles) {
-    appendStlFacet(s, mesh, t, withNormals, digits, binary);
+  constexpr size_t kBlock = 4096;   // facets between flushes
+  for (size_t f = 0; f < mesh.triangles.size(); f += kBlock) {
+    appendStlFacets(s, mesh, &mesh.triangles[f], std::min(kBlock, mesh.triangles.size() - f), withNormals, digits, binary);
     w.maybeFlush();
   }
   s += stlFooter(binary);

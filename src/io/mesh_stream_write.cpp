@@ -132,7 +132,7 @@ struct MeshFileWriter::Impl {
       case Mode::Stl:
         append(held.positions, piece.positions);
         append(held.normals, piece.normals);
-        for (const auto& t : piece.triangles) meshio::appendStlFacet(vbuf, held, t, has.normals, digits, options.binary);
+        meshio::appendStlFacets(vbuf, held, piece.triangles.data(), piece.triangles.size(), has.normals, digits, options.binary);
         if (vbuf.size() >= kFlushBytes) flushTo(vbuf, out->stream(), path);
         break;
     }

@@ -28,11 +28,11 @@ void appendPlyVertices(std::string& s, const Mesh& mesh, size_t first, size_t co
                        bool binary);
 void appendPlyFaces(std::string& s, const std::array<uint32_t, 3>* triangles, size_t count, bool binary);
 
-// STL: the header (binary: its triangle count), each facet (the normal from mesh.positions, or for a degenerate
-// triangle the mean of mesh.normals when `withNormals`), the footer.
+// STL: the header (binary: its triangle count), `count` facets from `triangles` (each one's normal from
+// mesh.positions, or for a degenerate triangle the mean of mesh.normals when `withNormals`), the footer.
 std::string stlHeader(bool binary, size_t triangles);
-void appendStlFacet(std::string& s, const Mesh& mesh, const std::array<uint32_t, 3>& t, bool withNormals, int digits,
-                    bool binary);
+void appendStlFacets(std::string& s, const Mesh& mesh, const std::array<uint32_t, 3>* triangles, size_t count,
+                     bool withNormals, int digits, bool binary);
 std::string stlFooter(bool binary);
 
 }  // namespace sffd::meshio
