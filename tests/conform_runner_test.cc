@@ -199,6 +199,10 @@ TEST(ConformRunner, InjectedCrashHangAndLongCompileAreResultsAndTheRunGoesOn) {
   r = runSffd(args, "SFFD_CONFORM_FAULT=slow-compile:cpu:first");
   EXPECT_EQ(r.status, 0) << r.out << r.err;
   EXPECT_TRUE(has(r.out, "first/classic.positions vulkan vs cpu: max_abs=0 max_ulp=0 mismatched=0/")) << r.out;
+  // So is a device's opening that lasts longer than --timeout (a disk busy writing back, a GPU driver's first start).
+  r = runSffd(args, "SFFD_CONFORM_FAULT=slow-open:vulkan");
+  EXPECT_EQ(r.status, 0) << r.out << r.err;
+  EXPECT_TRUE(has(r.out, "second/classic.positions vulkan vs cpu: max_abs=0 max_ulp=0 mismatched=0/")) << r.out;
   // ... for at most ten timeouts.
   r = runSffd(args, "SFFD_CONFORM_FAULT=stuck-compile:cpu:first");
   EXPECT_EQ(r.status, 1) << r.out << r.err;

@@ -1,15 +1,17 @@
 // sffd conform: each backend runs in a forked child process, so that a driver that crashes or hangs
 // ends one case, not the run. The parent opens no device itself; the child reports on a pipe (one
-// line an event) and writes each case's buffers to files. While a kernel compiles, the child says "busy"
-// every second, so that a driver's long compile is not taken for a hang, up to kCompileTimeouts times the
-// case timeout (docs/CONFORMANCE.md "Statuses"). Test hook (docs/CONFORMANCE.md):
+// line an event) and writes each case's buffers to files. While a kernel compiles or the device opens, the
+// child says "busy" every second, so that a driver's long compile is not taken for a hang, up to
+// kCompileTimeouts times the case timeout (docs/CONFORMANCE.md "Statuses"). Test hook (docs/CONFORMANCE.md):
 // SFFD_CONFORM_FAULT=crash|hang|slow-compile|stuck-compile|compile-then-hang:BACKEND[:CASE] makes that child
-// crash, hang, compile for 3 case timeouts or for ever, or compile then hang at that case.
+// crash, hang, compile for 3 case timeouts or for ever, or compile then hang at that case; slow-open:BACKEND
+// makes its device's opening last 3 case timeouts.
 #include <poll.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <condition_variable>
 #include <cstdlib>
@@ -89,13 +91,15 @@ void say(int fd, const std::string& line) {
 
 // The test hook: "crash:vulkan", "hang:gl-egl:CASE", "slow-compile:cpu:CASE" (a compile of 3 case
 // timeouts, which is progress), "stuck-compile:cpu" (one that never ends) or "compile-then-hang:cpu" (a
-// slow compile, then a hang: no progress once the compile has ended).
+// slow compile, then a hang: no progress once the compile has ended), at the start of a case; "slow-open:cpu"
+// (an opening of 3 case timeouts, progress too) while the device opens (caseName empty).
 void injectFault(const std::string& backend, const std::string& caseName, double timeoutSeconds) {
   const char* v = std::getenv("SFFD_CONFORM_FAULT");
   if (!v) return;
   std::string s = v, kind = s.substr(0, s.find(':')), rest = s.find(':') == std::string::npos ? "" : s.substr(s.find(':') + 1);
   std::string b = rest.substr(0, rest.find(':')), c = rest.find(':') == std::string::npos ? "" : rest.substr(rest.find(':') + 1);
-  if (b != backend || (!c.empty() && c != caseName)) return;
+  if (b != backend || (!c.empty() && c != caseName) || (kind == "slow-open") != caseName.empty()) return;
+  if (kind == "slow-open") std::this_thread::sleep_for(std::chrono::duration<double>(3 * timeoutSeconds));
   if (kind == "crash") ::raise(SIGSEGV);
   if (kind == "hang")
     for (;;) ::pause();
@@ -112,8 +116,10 @@ void injectFault(const std::string& backend, const std::string& caseName, double
 }
 
 // Says "busy" every second (or every fifth of the case timeout, if shorter) while a kernel compile is
-// in flight and younger than kCompileTimeouts case timeouts: a driver compiling is making progress.
-// "idle" once none is, so that a later hang is not taken for a compile.
+// in flight, or the device is being opened, for less than kCompileTimeouts case timeouts: a driver
+// compiling or starting is making progress (a device's opening waited seconds on a disk busy writing back,
+// and a GPU driver's first opening can take seconds too). "idle" once neither is, so that a later hang is
+// not taken for a compile.
 class Heartbeat {
  public:
   Heartbeat(int fd, double timeoutSeconds)
@@ -122,7 +128,9 @@ class Heartbeat {
           bool busy = false;
           std::unique_lock<std::mutex> lock(mutex_);
           while (!cv_.wait_for(lock, period, [this] { return stop_; })) {
-            const double compiling = oldestCompileInFlightSeconds();
+            double compiling = oldestCompileInFlightSeconds();
+            if (openingSince_)
+              compiling = std::max(compiling, std::chrono::duration<double>(Clock::now() - *openingSince_).count());
             if (compiling >= 0 && compiling < kCompileTimeouts * timeoutSeconds) {
               say(fd, "busy");
               busy = true;
@@ -140,11 +148,18 @@ class Heartbeat {
     cv_.notify_one();
     thread_.join();
   }
+  // Brackets the device's opening.
+  void opening(bool on) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    openingSince_ = on ? std::optional<Clock::time_point>(Clock::now()) : std::nullopt;
+  }
 
  private:
+  using Clock = std::chrono::steady_clock;
   std::mutex mutex_;
   std::condition_variable cv_;
   bool stop_ = false;
+  std::optional<Clock::time_point> openingSince_;
   std::thread thread_;   // last: starts once the members it reads exist
 };
 
@@ -157,8 +172,12 @@ void childMain(const std::string& name, const std::vector<Case>& cases, size_t f
     DeviceRequest req;
     req.name = name;
     req.deviceSubstring = options.deviceSubstring;
+    heartbeat.opening(true);
+    injectFault(name, "", options.timeoutSeconds);
     device.emplace(Device::open(req));
+    heartbeat.opening(false);
   } catch (const std::exception& e) {
+    heartbeat.opening(false);
     say(fd, std::string("skip-backend ") + e.what());
     return;
   }
@@ -272,13 +291,14 @@ BackendRun runBackend(const std::string& name, const std::vector<Case>& cases, c
     const Status s = timedOut ? Status::Timeout : Status::Crash;
     char t[128];
     if (compiling)
-      std::snprintf(t, sizeof t, "a kernel compile ran past %g s (%g times --timeout)",
+      std::snprintf(t, sizeof t, "%s ran past %g s (%g times --timeout)", run.opened ? "a kernel compile" : "opening the device",
                     kCompileTimeouts * options.timeoutSeconds, kCompileTimeouts);
     else
       std::snprintf(t, sizeof t, "no progress for %g s", options.timeoutSeconds);
     const std::string why = timedOut ? std::string(t) : signalText(status);
     if (current < 0) {   // died opening the device or between cases: nothing more can be trusted
-      for (size_t i = next; i < cases.size(); ++i) run.cases[i] = {s, why + (run.opened ? "" : " while opening the device")};
+      const std::string where = run.opened || (timedOut && compiling) ? "" : " while opening the device";
+      for (size_t i = next; i < cases.size(); ++i) run.cases[i] = {s, why + where};
       break;
     }
     run.cases[size_t(current)] = {s, why};
