@@ -115,11 +115,11 @@ void injectFault(const std::string& backend, const std::string& caseName, double
   }
 }
 
-// Says "busy" every second (or every fifth of the case timeout, if shorter) while a kernel compile is
-// in flight, or the device is being opened, for less than kCompileTimeouts case timeouts: a driver
-// compiling or starting is making progress (lavapipe's opening took seconds after runs that wrote
-// gigabytes, and a GPU driver's first opening can take seconds too). "idle" once neither is, so that a later hang is
-// not taken for a compile.
+// Says "busy" every second (or every fifth of the case timeout, if shorter) while a kernel compile is in
+// flight, or the device is being opened, for less than kCompileTimeouts case timeouts: a driver compiling
+// or starting is making progress (lavapipe's opening took seconds after runs that wrote gigabytes, and a
+// GPU driver's first opening can take seconds too). "idle" once neither is, so that a later hang is not
+// taken for a compile.
 class Heartbeat {
  public:
   Heartbeat(int fd, double timeoutSeconds)
