@@ -6,7 +6,6 @@
 #include <cstring>
 #include <ostream>
 
-#include "core/key3_map.h"
 #include "io/atomic_file.h"
 #include "io/gltf_io.h"
 #include <sffd/error.h>
@@ -93,16 +92,6 @@ glm::dvec3 unitOrZ(const glm::dvec3& v) {
   return glm::dvec3(0, 0, 1);
 }
 
-// + 0.0 turns -0.0 into +0.0, so that equal values give equal keys.
-Key3 keyOf(const glm::dvec3& p) {
-  Key3 k;
-  for (int c = 0; c < 3; ++c) {
-    const double d = p[c] + 0.0;
-    std::memcpy(&k[size_t(c)], &d, 8);
-  }
-  return k;
-}
-
 }  // namespace
 
 std::vector<uint32_t> meshio::distinctPositions(const std::vector<glm::dvec3>& positions, uint32_t& count) {
@@ -110,7 +99,7 @@ std::vector<uint32_t> meshio::distinctPositions(const std::vector<glm::dvec3>& p
   std::vector<uint32_t> id(positions.size());
   count = 0;
   for (size_t v = 0; v < positions.size(); ++v) {
-    id[v] = ids.of(keyOf(positions[v]), count);
+    id[v] = ids.of(bitsKey(positions[v]), count);
     count += id[v] == count;
   }
   return id;

@@ -9,7 +9,6 @@
 #include <cstring>
 
 #include <sffd/error.h>
-#include "core/key3_map.h"
 #include "io/io_util.h"
 #include "io/mesh_io_internal.h"
 
@@ -443,18 +442,15 @@ bool startsWithSolid(const std::string& text) {
 }
 
 struct Welder {
-  Key3Map ids;   // key: the bits of the position (+0.0: no -0)
+  Key3Map ids;   // key: bitsKey of the position
   Mesh* mesh;
   const std::string& path;
-  uint32_t add(glm::dvec3 p) {
-    p += glm::dvec3(0.0);
-    Key3 key;
-    std::memcpy(key.data(), &p, sizeof key);
+  uint32_t add(const glm::dvec3& p) {
     const uint32_t next = uint32_t(mesh->positions.size());
-    const uint32_t id = ids.of(key, next);
+    const uint32_t id = ids.of(bitsKey(p), next);
     if (id == next) {
       if (next >= kMaxVertices) throw inputError(path, 0, "too many vertices");
-      mesh->positions.push_back(p);
+      mesh->positions.push_back(p + glm::dvec3(0.0));   // -0 kept as +0
     }
     return id;
   }

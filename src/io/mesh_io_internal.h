@@ -2,9 +2,11 @@
 // by readMesh) and returns a finished Mesh or throws inputError(path, line, what).
 #pragma once
 #include <cstdint>
+#include <cstring>
 #include <string>
 #include <vector>
 
+#include "core/key3_map.h"
 #include "model/mesh.h"
 
 namespace sffd::meshio {
@@ -38,6 +40,18 @@ inline void fanTriangulate(const uint32_t* corners, size_t n, std::vector<std::a
 void addPolygon(Mesh& mesh, const uint32_t* corners, size_t n, size_t& dropped);
 // One warning line in mesh.warnings for the polygons addPolygon dropped, if any.
 void noteDroppedPolygons(Mesh& mesh, size_t dropped);
+
+// The key the readers tell equal values apart by (Key3Map): the bits of a glm::dvec2 or dvec3's components,
+// -0 as +0 (bit equality otherwise), the words past its length 0.
+template <class Vec>
+Key3 bitsKey(const Vec& v) {
+  Key3 k{};
+  for (int c = 0; c < Vec::length(); ++c) {
+    const double d = v[c] + 0.0;
+    std::memcpy(&k[size_t(c)], &d, 8);
+  }
+  return k;
+}
 
 // Index of each vertex's distinct position (first appearance order) and the number of distinct positions.
 std::vector<uint32_t> distinctPositions(const std::vector<glm::dvec3>& positions, uint32_t& count);

@@ -14,7 +14,6 @@
 #include <filesystem>
 
 #include <sffd/error.h>
-#include "core/key3_map.h"
 #include "io/io_util.h"
 #include "io/mesh_io_internal.h"
 
@@ -31,14 +30,7 @@ template <class Vec>
 std::vector<int64_t> firstEqual(const std::vector<Vec>& values) {
   std::vector<int64_t> canon(values.size());
   Key3Map first(values.size());
-  for (size_t i = 0; i < values.size(); ++i) {
-    Key3 key{};
-    for (int c = 0; c < Vec::length(); ++c) {
-      double d = values[i][c] + 0.0;
-      std::memcpy(&key[size_t(c)], &d, 8);
-    }
-    canon[i] = first.of(key, uint32_t(i));
-  }
+  for (size_t i = 0; i < values.size(); ++i) canon[i] = first.of(bitsKey(values[i]), uint32_t(i));
   return canon;
 }
 

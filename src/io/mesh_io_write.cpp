@@ -61,6 +61,8 @@ void appendRaw(std::string& s, T v) {
 
 uint8_t colorByte(double c) { return uint8_t(std::lround(std::clamp(c, 0.0, 1.0) * 255.0)); }
 
+constexpr size_t kBlock = 4096;   // records writePly and writeStl append between flushes
+
 }  // namespace
 
 namespace meshio {
@@ -349,7 +351,6 @@ void writePly(std::ostream& os, const Mesh& mesh, int digits, const Carried& has
   ChunkedWriter w(os);
   std::string& s = w.buf();
   s += plyHeader(mesh.positions.size(), mesh.triangles.size(), digits, has, binary);
-  constexpr size_t kBlock = 4096;   // records between flushes
   for (size_t v = 0; v < mesh.positions.size(); v += kBlock) {
     appendPlyVertices(s, mesh, v, std::min(kBlock, mesh.positions.size() - v), digits, has, binary);
     w.maybeFlush();
@@ -393,7 +394,6 @@ void writeStl(std::ostream& os, const Mesh& mesh, int digits, bool withNormals, 
   ChunkedWriter w(os);
   std::string& s = w.buf();
   s += stlHeader(binary, mesh.triangles.size());
-  constexpr size_t kBlock = 4096;   // facets between flushes
   for (size_t f = 0; f < mesh.triangles.size(); f += kBlock) {
     appendStlFacets(s, mesh, &mesh.triangles[f], std::min(kBlock, mesh.triangles.size() - f), withNormals, digits, binary);
     w.maybeFlush();
