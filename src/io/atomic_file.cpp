@@ -9,6 +9,8 @@
 #include <fstream>
 #include <mutex>
 #include <random>
+
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <sffd/error.h>
@@ -154,7 +156,19 @@ AtomicFile::~AtomicFile() {
 }
 
 std::ostream& AtomicFile::stream() { return impl_->out; }
+
 const std::string& AtomicFile::temporaryPath() const { return impl_->tmp; }
+
+void AtomicFile::reserve(uint64_t bytes) {
+#if defined(__linux__) && defined(FALLOC_FL_KEEP_SIZE)
+  const int fd = ::open(impl_->tmp.c_str(), O_WRONLY | O_CLOEXEC);
+  if (fd < 0) return;
+  (void)::fallocate(fd, FALLOC_FL_KEEP_SIZE, 0, off_t(bytes));   // refused (EOPNOTSUPP, ENOSPC): written as before
+  ::close(fd);
+#else
+  (void)bytes;
+#endif
+}
 
 void AtomicFile::commit() {
   impl_->out.flush();
