@@ -1,6 +1,5 @@
 // Output files appear whole or not at all: written to a temporary file beside the target, then renamed.
 #pragma once
-#include <cstdint>
 #include <functional>
 #include <memory>
 #include <ostream>
@@ -29,11 +28,6 @@ class AtomicFile {
   AtomicFile& operator=(const AtomicFile&) = delete;
   std::ostream& stream();
   const std::string& temporaryPath() const;
-  // Asks the file system for `bytes` of blocks up front, the file's size unchanged (Linux fallocate; a no-op
-  // where it is refused). Blocks written into are then not ext4's delayed allocation, which a rename over an
-  // existing file flushes first: the teapot's 18 MB PLY renamed over the last one in 7.5-11 ms, with them in
-  // 1.2-1.6 ms (docs/PERFORMANCE.md, "Output blocks reserved up front").
-  void reserve(uint64_t bytes);
   // Flushes and checks the stream (an input Error for a failed write, e.g. a full disk), then renames.
   void commit();
 

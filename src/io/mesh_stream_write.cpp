@@ -1,10 +1,9 @@
 // MeshFileWriter (<sffd/mesh.h>): writeMesh's file from a mesh handed over in pieces. PLY's header names
 // the vertex and face counts, known only at the end: vertices and faces go to two scratch files beside the
-// output, copied after the header into the output's temporary file at end(), whose blocks are reserved first
-// (AtomicFile::reserve). STL's facets go straight to the output (binary: the triangle count written over its
-// placeholder at the end). Both are formatted and written on a thread of their own (PieceQueue) while the
-// caller makes the next pieces; each piece is checked on the caller's, so that a bad vertex stops the stream
-// at the add() that gave it.
+// output, copied after the header into the output's temporary file at end(). STL's facets go straight to
+// the output (binary: the triangle count written over its placeholder at the end). Both are formatted and
+// written on a thread of their own (PieceQueue) while the caller makes the next pieces; each piece is
+// checked on the caller's, so that a bad vertex stops the stream at the add() that gave it.
 #include <algorithm>
 #include <fstream>
 
@@ -147,11 +146,8 @@ struct MeshFileWriter::Impl {
       flushTo(fbuf, faceSpill->stream(), path);
       for (AtomicFile* f : {vertexSpill.get(), faceSpill.get()})
         if (!f->stream().flush()) throw inputError(path, 0, "cannot write: write failed (disk full?)");
-      const std::string header = meshio::plyHeader(vertices, triangles, options.significantDigits, has, options.binary);
       out = std::make_unique<AtomicFile>(path, options.binary);
-      const std::streamoff vbytes = vertexSpill->stream().tellp(), fbytes = faceSpill->stream().tellp();
-      if (vbytes >= 0 && fbytes >= 0) out->reserve(header.size() + uint64_t(vbytes) + uint64_t(fbytes));
-      out->stream() << header;
+      out->stream() << meshio::plyHeader(vertices, triangles, options.significantDigits, has, options.binary);
       copyFile(vertexSpill->temporaryPath(), out->stream(), path);
       vertexSpill.reset();
       copyFile(faceSpill->temporaryPath(), out->stream(), path);

@@ -1,5 +1,5 @@
-// MeshFileWriter's PLY, whose records go through scratch files into an output with its blocks reserved up
-// front: writeMesh's bytes, over an existing file too, and no scratch file left beside it.
+// MeshFileWriter's PLY, whose records go through scratch files into the output, its blocks allocated before
+// it replaces an existing file (atomic_file.cpp): writeMesh's bytes, and no scratch file left beside it.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -88,8 +88,8 @@ TEST_F(MeshStreamWrite, PlyIsWriteMeshsFile) {
   expectWriteMeshBytes(300, false, true);
 }
 
-// Over an existing file the blocks reserved up front are the file's: its size is what was written.
-TEST_F(MeshStreamWrite, ReservedBlocksLeaveTheSizeWritten) {
+// Over a larger file, the blocks allocated before the rename are the new file's: its size is what was written.
+TEST_F(MeshStreamWrite, ReplacingALargerFileLeavesTheSizeWritten) {
   const Mesh m = grid(50);
   const MeshWriteOptions o{9, true};
   stream(m, 50, 7, dir_ / "a.ply", o);
