@@ -5,9 +5,10 @@
 # from the start of the process to its end, median and quartiles. Each build is a folder holding `sffd` and
 # its `libsffd.so.0` (`cp build/sffd build/libsffd.so.0* DIR`).
 #   scripts/whole_runs.sh BASE_DIR HEAD_DIR [RUNS]     (RUNS: 25)
-# The output replaces an existing t.ply each run, as a user's repeated command does (on ext4 the rename
-# over it flushes the new file's delayed allocation: about 13 ms for this 18 MB file; FRESH=1 writes a new
-# name each run instead).
+# Each build's output replaces the one its last run wrote (t_base.ply, t_head.ply), as a user's repeated
+# command does; one name for both made each run replace a file the other build had just written, whose
+# eviction could cost the rename as much as the change measured (docs/PERFORMANCE.md, "Output files replaced
+# without a flush"). FRESH=1 writes a new name each run instead.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 [ $# -ge 2 ] || { echo "usage: scripts/whole_runs.sh BASE_DIR HEAD_DIR [RUNS]" >&2; exit 2; }
@@ -29,7 +30,7 @@ for mesa_name, backends in (("system", ("cpu", "vulkan", "gl")), ("25.0", ("vulk
         walls = {k: [] for k in builds}
         for i in range(runs):
             for name, d in builds.items():
-                out = os.path.join(tmp, f"t{i}.ply" if fresh else "t.ply")
+                out = os.path.join(tmp, f"t{i}.ply" if fresh else f"t_{name}.ply")
                 cmd = ([mesa, "run", "--"] if mesa_name != "system" else []) + [
                     os.path.join(d, "sffd"), "deform", mesh, "-l", lattice, "--normalize", "0.9090909090909091",
                     "--edge-length", "0.2", "-o", out, "--binary", "--backend", backend, "--quiet"]
