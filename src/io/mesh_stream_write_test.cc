@@ -3,21 +3,16 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <filesystem>
-#include <fstream>
-#include <iterator>
 
 #include <sffd/mesh.h>
+
+#include "tests/support/cli_runner.h"
 
 namespace {
 
 using namespace sffd;
+using sffd::test::slurp;
 namespace fs = std::filesystem;
-
-std::string bytesOf(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), {}};
-}
 
 // An n x n grid of vertices with normals, two triangles a cell.
 Mesh grid(uint32_t n) {
@@ -58,11 +53,7 @@ void stream(const Mesh& m, uint32_t n, uint32_t rows, const fs::path& path, cons
 class MeshStreamWrite : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("sffd_stream_write_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    dir_ = sffd::test::tempDir(std::string("stream_write_") + ::testing::UnitTest::GetInstance()->current_test_info()->name());
   }
   void TearDown() override { fs::remove_all(dir_); }
 
@@ -72,7 +63,7 @@ class MeshStreamWrite : public ::testing::Test {
     writeMesh((dir_ / "whole.ply").string(), m, o);
     if (overwrite) writeMesh((dir_ / "streamed.ply").string(), grid(3), o);
     stream(m, n, 37, dir_ / "streamed.ply", o);
-    EXPECT_EQ(bytesOf(dir_ / "streamed.ply"), bytesOf(dir_ / "whole.ply"));
+    EXPECT_EQ(slurp(dir_ / "streamed.ply"), slurp(dir_ / "whole.ply"));
     size_t files = 0;
     for (const auto& e : fs::directory_iterator(dir_)) files += e.is_regular_file();
     EXPECT_EQ(files, 2u) << "a scratch file is left beside the output";
@@ -97,7 +88,7 @@ TEST_F(MeshStreamWrite, ReplacingALargerFileLeavesTheSizeWritten) {
   stream(grid(20), 20, 7, dir_ / "a.ply", o);
   EXPECT_LT(fs::file_size(dir_ / "a.ply"), size);
   writeMesh((dir_ / "b.ply").string(), grid(20), o);
-  EXPECT_EQ(bytesOf(dir_ / "a.ply"), bytesOf(dir_ / "b.ply"));
+  EXPECT_EQ(slurp(dir_ / "a.ply"), slurp(dir_ / "b.ply"));
 }
 
 }  // namespace
