@@ -52,8 +52,9 @@ target_compile_options(embed_kernels PRIVATE ${SFFD_WARNINGS})
 # without the prefix) a constant as on GL rather than the specialization constant, so that the module
 # lavapipe translates (above) holds that case only.
 set(SFFD_SPECIALIZED_deform_smooth
-    DEGREE2|LATTICE_IN_PARAMS|FIT_IN_PARAMS                 # degree 2, lattice and fit table in the parameter block
-    DEGREE2|LATTICE_IN_PARAMS|FIT_IN_PARAMS|ROLLED_LOOPS)   # the same on llvmpipe of Mesa 23 on (forDevice)
+    DEGREE2|LATTICE_IN_PARAMS|FIT_IN_PARAMS                    # degree 2, lattice and fit table in the parameter block
+    DEGREE2|LATTICE_IN_PARAMS|FIT_IN_PARAMS|ROLLED_LOOPS       # the same on llvmpipe of Mesa 23 on (forDevice)
+    DEGREE2|LATTICE_IN_PARAMS|FIT_IN_PARAMS|ONE_SAMPLE_SITE)   # a small one-shot job on lavapipe below Mesa 23
 # The pre-compute's kernels have two loop forms (prelude.glsl sffdRollsLoops) and no other assumption:
 # both compiled ahead (NONE: no bit), so that the form a driver does not use is not in its SPIR-V at all.
 # With the choice left to the specialization constant, lavapipe 22.3 ran clip_write's straight form

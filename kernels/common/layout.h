@@ -87,6 +87,9 @@
 #define SFFD_ASSUME_ROLLED_LOOPS 64u       // keep the loops bounded by sffdRolled() rolled (prelude.glsl)
 #define SFFD_ASSUME_LOOSE_DIVISION 128u    // strict kernels: the driver's a / b and sqrt may miss the correctly
                                            // rounded result, so round them (correctly_rounded.h)
+#define SFFD_ASSUME_ONE_SAMPLE_SITE 256u   // deform_smooth: the boundary's corners and edge points in one loop, one
+                                           // lattice evaluation in its code: quicker to translate, slower to run
+                                           // (a one-shot job on lavapipe below Mesa 23: kernel_registry.cpp forDevice)
 
 // The lattice part of every parameter block.
 SFFD_STRUCT_BEGIN(LatticeParams)

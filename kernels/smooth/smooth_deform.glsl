@@ -129,12 +129,41 @@ void smoothEdgePoint(SubCorners C, uint k, out real3 x, out real3 n) {
 // Steps 1 and 2 on the boundary and step 4: at corner c the deformed corner Q[c], its deformed normal
 // QN[c] and the adjusting normals (smoothCornerAdjust); at edge sample k the deformed point E[k] and
 // normal EN[k]. Loops rather than calls written out: every call inlines a whole lattice evaluation,
-// and the kernels' compile time grows with their number. (One loop for both kinds, where the host asks
-// for rolled loops, saved Mesa 25.0 about 45 ms of deform_smooth's first dispatch but cost it 11 %
-// more deform instructions warm.)
+// and the kernels' compile time grows with their number. Where the host asks for one sample site
+// (SFFD_ASSUME_ONE_SAMPLE_SITE), corners and edge points share one loop and one evaluation: lavapipe 22.3
+// translates the kernel in 34 ms instead of 42, and runs it 12 % slower (its arrays then indexed by a
+// variable); the same bits. (Mesa 25.0's rolled form tried the same: 45 ms less first dispatch, 11 % more
+// deform instructions warm.)
+const bool smoothOneSampleSite = (sffdAssumptions & SFFD_ASSUME_ONE_SAMPLE_SITE) != 0u;
 void smoothBoundarySamples(uint st, SubCorners C, out real3 Q[3], out real3 QN[3], out real3 adj[3], out real3 adjNbr[6],
                            out real3 E[6], out real3 EN[6]) {
   uint creaseBits = smoothCreaseBits(st);
+  if (smoothOneSampleSite) {
+    for (uint i = 0u; i < 9u; ++i) {
+      real3 x, n;
+      if (i < 3u) {
+        x = subCornerX(C, i);
+        n = subCornerN(C, i);
+      } else {
+        smoothEdgePoint(C, i - 3u, x, n);
+      }
+      LatticeSample S = latticeEvaluate(params.lattice, x);
+      real3 sampleN = snormalize(latticeCofactorNormal(S, n));
+      if (i < 3u) {
+        real3 ad, a0, a1;
+        smoothCornerAdjust(S, st, i, creaseBits, ad, a0, a1);
+        Q[i] = S.value;
+        QN[i] = sampleN;
+        adj[i] = ad;
+        adjNbr[2u * i] = a0;
+        adjNbr[2u * i + 1u] = a1;
+      } else {
+        E[i - 3u] = S.value;
+        EN[i - 3u] = sampleN;
+      }
+    }
+    return;
+  }
   for (uint c = 0u; c < 3u; ++c) {
     LatticeSample S = latticeEvaluate(params.lattice, subCornerX(C, c));
     real3 ad, a0, a1;

@@ -143,6 +143,36 @@ TEST_F(StreamResult, AccurateOneShotRunsItsChunksInOneBuffer) {
   EXPECT_GT(once.timings().deformMs, 0.0);
 }
 
+// A small one-shot smooth job dispatches deform_smooth in its one-site form where the device translates every
+// process (lavapipe below Mesa 23; SFFD_ASSUME_ONE_SAMPLE_SITE), a kept Deformer in the usual form: the same
+// bits, fast and strict, on Vulkan and GL here (GL keeps the usual form).
+TEST_F(StreamResult, OneShotSmoothIsTheKeptDeformersBits) {
+  for (const std::string name : {"vulkan", "gl-egl"}) {
+    std::string why;
+    std::optional<Device> device = sffd::testing::openUnlessAbsent(name, sffd::testing::openTestDevice, why);
+    if (!device) continue;
+    for (bool strict : {false, true}) {   // (double's dispatch is not the specialized one: the same code either way)
+      SCOPED_TRACE(name + (strict ? " strict" : " fast"));
+      DeformOptions o;
+      o.tess = 3;
+      o.edgeLength = 0.5;
+      o.strict = strict;
+      o.precision = Precision::Float;
+      const Lattice L = twisted(mesh_);
+      Deformer kept(*device, mesh_, L, o);
+      kept.deform(L);
+      const Mesh whole = kept.result();
+      o.once = true;
+      Deformer once(*device, mesh_, L, o);
+      once.deform(L);
+      const Mesh streamed = once.result();
+      EXPECT_EQ(streamed.positions, whole.positions);
+      EXPECT_EQ(streamed.normals, whole.normals);
+      EXPECT_EQ(streamed.triangles, whole.triangles);
+    }
+  }
+}
+
 TEST_F(StreamResult, NonFiniteVertexLeavesNoFile) {
   {
     MeshFileWriter out((dir_ / "bad.ply").string(), {9, true});

@@ -78,9 +78,12 @@ KernelVariant forDevice(KernelVariant v, const DeviceInfo& device) {
     const std::string_view r = rounding ? rounding : "";
     if (r == "fixup" || (r != "driver" && !llvmpipe)) v.assumptions |= SFFD_ASSUME_LOOSE_DIVISION;
   }
-  if (!llvmpipe) return v;
   const size_t at = device.driver.find("Mesa ");
-  if (at != std::string::npos && std::atoi(device.driver.c_str() + at + 5) >= 23) v.assumptions |= SFFD_ASSUME_ROLLED_LOOPS;
+  const int mesa = at != std::string::npos ? std::atoi(device.driver.c_str() + at + 5) : 0;
+  // The one-site form pays only where a one-shot job translates its kernels in every process and runs them
+  // once: lavapipe below Mesa 23 (no shader binaries kept; llvmpipe's GL keeps its compiled programs).
+  if (!(llvmpipe && device.api == "vulkan" && mesa < 23)) v.assumptions &= ~SFFD_ASSUME_ONE_SAMPLE_SITE;
+  if (llvmpipe && mesa >= 23) v.assumptions |= SFFD_ASSUME_ROLLED_LOOPS;
   return v;
 }
 

@@ -49,7 +49,8 @@ KernelVariant forLattice(KernelVariant v, const gpu::AccurateParams& params);
 // The variant a backend compiles for `device`: with SFFD_ASSUME_ROLLED_LOOPS on llvmpipe and lavapipe of
 // Mesa 23 and later (prelude.glsl sffdRolled; measured on 22.3, which is left without, and 25.0); strict
 // variants with SFFD_ASSUME_LOOSE_DIVISION on every driver but llvmpipe and lavapipe, whose a / b and sqrt
-// are correctly rounded (SFFD_STRICT_ROUNDING=fixup or =driver in the environment forces it on or off).
+// are correctly rounded (SFFD_STRICT_ROUNDING=fixup or =driver in the environment forces it on or off);
+// SFFD_ASSUME_ONE_SAMPLE_SITE, which a small one-shot job asks for, kept only on lavapipe below Mesa 23.
 KernelVariant forDevice(KernelVariant v, const DeviceInfo& device);
 
 std::span<const EmbeddedKernel> embeddedKernels();

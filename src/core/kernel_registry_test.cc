@@ -7,10 +7,11 @@
 using namespace sffd;
 
 namespace {
-DeviceInfo device(const char* name, const char* driver) {
+DeviceInfo device(const char* name, const char* driver, const char* api = "vulkan") {
   DeviceInfo d;
   d.name = name;
   d.driver = driver;
+  d.api = api;
   return d;
 }
 }  // namespace
@@ -28,6 +29,22 @@ TEST(KernelRegistry, RolledLoopsOnlyForMesaFrom23OnTheCpu) {
   EXPECT_EQ(forDevice(v, device("AMD Radeon RX 7600 (RADV NAVI33)", "Mesa 25.0.7")).assumptions, SFFD_ASSUME_DEGREE2);
   EXPECT_EQ(forDevice(v, device("NVIDIA H100", "550.54.15")).assumptions, SFFD_ASSUME_DEGREE2);
   EXPECT_EQ(forDevice(v, device(llvmpipe, "")).assumptions, SFFD_ASSUME_DEGREE2);
+}
+
+// deform_smooth's one-site form (a small one-shot job asks for it) only on lavapipe below Mesa 23: llvmpipe's GL
+// keeps its compiled programs, Mesa 23 on has the rolled form and shader binaries, a GPU's driver its pipelines.
+TEST(KernelRegistry, OneSampleSiteOnlyOnLavapipeBefore23) {
+  KernelVariant v;
+  v.assumptions = SFFD_ASSUME_DEGREE2 | SFFD_ASSUME_ONE_SAMPLE_SITE;
+  const char* llvmpipe = "llvmpipe (LLVM 15.0.6, 256 bits)";
+  const uint32_t asked = SFFD_ASSUME_DEGREE2 | SFFD_ASSUME_ONE_SAMPLE_SITE;
+  EXPECT_EQ(forDevice(v, device(llvmpipe, "llvmpipe Mesa 22.3.6 (LLVM 15.0.6), Vulkan 1.3.230")).assumptions, asked);
+  EXPECT_EQ(forDevice(v, device(llvmpipe, "4.5 (Core Profile) Mesa 22.3.6", "gl")).assumptions, SFFD_ASSUME_DEGREE2);
+  EXPECT_EQ(forDevice(v, device(llvmpipe, "OpenGL ES 3.2 Mesa 22.3.6", "gles")).assumptions, SFFD_ASSUME_DEGREE2);
+  EXPECT_EQ(forDevice(v, device(llvmpipe, "llvmpipe Mesa 25.0.7-2~bpo12+1 (LLVM 15.0.6), Vulkan 1.4.305")).assumptions,
+            SFFD_ASSUME_DEGREE2 | SFFD_ASSUME_ROLLED_LOOPS);
+  EXPECT_EQ(forDevice(v, device("AMD Radeon RX 7600 (RADV NAVI33)", "Mesa 22.3.6")).assumptions, SFFD_ASSUME_DEGREE2);
+  EXPECT_EQ(forDevice(v, device("NVIDIA H200", "NVIDIA 580.159.04")).assumptions, SFFD_ASSUME_DEGREE2);
 }
 
 // Strict variants round a / b and sqrt themselves (SFFD_ASSUME_LOOSE_DIVISION) on every driver but
@@ -51,8 +68,8 @@ TEST(KernelRegistry, StrictVariantsRoundDivisionWhereTheDriverDoesNot) {
 }
 
 // deform_smooth is embedded compiled for its usual dispatch (a degree-2 lattice and its fit table in the
-// parameter block; cmake/Kernels.cmake SFFD_SPECIALIZED_deform_smooth), with and without rolled loops, in
-// every variant: a Vulkan pipeline of it is made from that module, which has no specialization constant
+// parameter block; cmake/Kernels.cmake SFFD_SPECIALIZED_deform_smooth), with and without rolled loops, and in
+// the one-site form, in every variant: a Vulkan pipeline of it is made from that module, which has no specialization constant
 // left; any other dispatch gets the general module. The bits are those of layout.h, so a renumbering
 // there cannot leave the build's forms unused.
 TEST(KernelRegistry, DeformSmoothCompiledForItsUsualDispatch) {
@@ -72,7 +89,7 @@ TEST(KernelRegistry, DeformSmoothCompiledForItsUsualDispatch) {
     KernelVariant variant;
     variant.strict = v % 2, variant.f64 = v / 2;
     EXPECT_TRUE(hasSpecConstant(spirvFor(*k, variant)));
-    for (uint32_t a : {usual, usual | SFFD_ASSUME_ROLLED_LOOPS}) {
+    for (uint32_t a : {usual, usual | SFFD_ASSUME_ROLLED_LOOPS, usual | SFFD_ASSUME_ONE_SAMPLE_SITE}) {
       variant.assumptions = a;
       const std::span<const uint32_t> s = spirvFor(*k, variant);
       ASSERT_FALSE(s.empty());

@@ -18,6 +18,7 @@
 #include "model/prepared_mesh.h"
 #include "kernels/clip/split_pattern_table.h"
 #include "core/huge_pages.h"
+#include "core/job_budget.h"
 #include "core/kernel_registry.h"
 #include "core/wall_clock.h"
 #include "pipelines/device_reals.h"
@@ -86,7 +87,8 @@ void DeformSession::prepare(const Mesh& input, const Lattice& lattice, const Sta
   I.fit = makeFitTable(std::max(3, s));
   PackedLattice packed = packLattice(lattice);
   // The kernels build on other threads (where the backend can) while the mesh is prepared.
-  backend.precompile(SessionKernels{backend, options}.uses(deformParamsFor(packed, f64, &I.fit.data)));
+  I.deformVariant = deformVariantOf(options, estimateSubTriangles(input, options.edgeLength));
+  backend.precompile(SessionKernels{backend, options, I.deformVariant}.uses(deformParamsFor(packed, f64, &I.fit.data)));
   // A copy only where the creases are still to be applied.
   Mesh withCreases;
   if (!input.normalsFromFile && !options.creasesApplied) {
@@ -137,7 +139,7 @@ const SessionTimings& DeformSession::precompute(const StageProgress& progress) {
   if (streamed()) throw Error(ErrorKind::Input, "a one-shot session runs its pre-compute chunk by chunk (streamChunks)");
   Impl& I = *impl_;
   Backend& B = backend_;
-  const SessionKernels K{B, options_};
+  const SessionKernels K{B, options_, I.deformVariant};
   auto t0 = std::chrono::steady_clock::now();
   timings_ = {};
   const size_t nt = I.triangles;
@@ -252,7 +254,7 @@ const SessionTimings& DeformSession::deform(const Lattice& lattice, const StageP
     timings_.wallMs = msSince(t0);
     return timings_;
   }
-  const SessionKernels K{B, options_};
+  const SessionKernels K{B, options_, I.deformVariant};
   for (size_t ci = 0; ci < chunks_.size(); ++ci) {
     const Chunk& c = chunks_[ci];
     if (!c.count) continue;

@@ -47,6 +47,7 @@ struct DeformSession::Impl {
   size_t triangles = 0, clipCount = 0;
   std::vector<SubTriangle> knotBoxSubs;
   FitTable fit;
+  KernelVariant deformVariant;   // deformVariantOf the session's options and its estimated sub-triangles
   size_t realSize = 4;
   std::vector<BufferId> owned;   // every buffer, destroyed with the session
   std::vector<PreChunkInputs> pre;   // the pre-compute's chunks of consecutive parents
@@ -181,10 +182,24 @@ inline void planChunks(std::vector<ChunkPlan>& plan, const std::vector<uint64_t>
   }
 }
 
+// The most sub-triangles of a one-shot job that asks for deform_smooth's one-site form: lavapipe 22.3 translates
+// it 8 ms quicker and runs it about 0.14 us a sub-triangle slower (the teapot's 7,200: 8.6 -> 9.6 ms), so it pays
+// up to about 57,000 (docs/PERFORMANCE.md "One sample site for a one-shot job").
+constexpr double kOneSampleSiteMaxSubTriangles = 20000;
+
+// The deform kernel's variant for a session of about `subTriangles`: a small one-shot job dispatches it once,
+// and on lavapipe below Mesa 23 (forDevice keeps the bit only there) translating it costs more than running it.
+inline KernelVariant deformVariantOf(const DeformSessionOptions& o, double subTriangles) {
+  KernelVariant v = o.variant;
+  if (o.once && !o.split && subTriangles <= kOneSampleSiteMaxSubTriangles) v.assumptions |= SFFD_ASSUME_ONE_SAMPLE_SITE;
+  return v;
+}
+
 // The pre-compute's and the deform stage's dispatches, each followed by a barrier.
 struct SessionKernels {
   Backend& B;
   const DeformSessionOptions& o;
+  KernelVariant deformVariant;   // deformVariantOf
 
   void dispatch(const char* kernel, const char* label, const void* params, size_t paramsSize, size_t threads,
                 std::vector<BufferBinding> buffers) const {
@@ -204,7 +219,7 @@ struct SessionKernels {
   std::vector<KernelUse> uses(const gpu::DeformParams& params) const {
     std::vector<KernelUse> k = {{"pn_triangles", o.variant}};
     if (!o.knotBoxClip) k.insert(k.end(), {{"clip_count", o.variant}, {"clip_write", o.variant}});
-    for (const KernelUse& d : deformKernels(params, o.variant, o.split)) k.push_back(d);
+    for (const KernelUse& d : deformKernels(params, deformVariant, o.split)) k.push_back(d);
     return k;
   }
   // The clip kernels' parameters and bindings (a pre-compute chunk's inputs), for both passes.
@@ -254,7 +269,7 @@ struct SessionKernels {
   void deform(gpu::DeformParams params, size_t count, int fitPoints, const DeformBuffers& buffers) const {
     params.range = {0, uint32_t(count), uint32_t(fitPoints), uint32_t(o.level)};
     deformOutSections(params, count, o.level, fitPoints, o.split);
-    dispatchDeform(B, params, buffers, count, o.variant, o.split);
+    dispatchDeform(B, params, buffers, count, deformVariant, o.split);
   }
 };
 

@@ -19,7 +19,7 @@ const SessionTimings& DeformSession::streamChunks(const ChunkReader& read, const
   recordsReleased_ = true;   // once, also when `read` throws half way
   Impl& I = *impl_;
   Backend& B = backend_;
-  const SessionKernels K{B, options_};
+  const SessionKernels K{B, options_, I.deformVariant};
   const DeviceLimits& lim = B.info().limits;
   auto t0 = std::chrono::steady_clock::now();
   timings_ = {};

@@ -316,6 +316,12 @@ TEST(DeformSessionKernels, PrecompilesWhatItDispatches) {
     if (once) s.streamChunks([](const DeformSession::Chunk&, const SubTrianglePreImages&) {});
     EXPECT_FALSE(recorded.dispatched.empty());
     EXPECT_EQ(recorded.precompiled, recorded.dispatched);
+    // A small one-shot job asks for deform_smooth's one-site form (deformVariantOf; forDevice keeps it on lavapipe 22.3).
+    for (const auto& [kernel, strict, f64, assumptions] : recorded.dispatched) {
+      if (kernel == "deform_smooth") {
+        EXPECT_EQ((assumptions & SFFD_ASSUME_ONE_SAMPLE_SITE) != 0, once && !split) << assumptions;
+      }
+    }
   }
 }
 
