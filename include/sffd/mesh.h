@@ -96,7 +96,9 @@ struct MeshReadOptions {
 };
 
 // Reads by extension (.obj .off .ply .stl .om, .bpt, .gltf .glb). Polygons are triangulated; missing or zero
-// normals are recomputed (angle-weighted). Throws an input Error ("file:line: what") on a bad file.
+// normals are recomputed (angle-weighted). Throws an input Error ("file:line: what") on a bad file. A .om file
+// is read by OpenMesh in a forked child process (its reader aborts on a damaged file): as with any fork, read
+// one while no other thread of the program is inside the dynamic loader (opening a device, say) or holds a lock.
 Mesh readMesh(const std::string& path, const MeshReadOptions& options = {});
 
 struct MeshWriteOptions {
