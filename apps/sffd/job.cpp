@@ -11,7 +11,9 @@
 #include "core/backend.h"
 #include <sffd/error.h>
 #include "core/job_budget.h"
+#include "io/io_util.h"
 #include "io/lattice_io.h"
+#include "io/mesh_io_internal.h"
 #include "model/mesh.h"
 
 namespace sffd::cli {
@@ -80,13 +82,6 @@ void normalizeMesh(Mesh& mesh, double scale) {
     for (auto& p : patch.points) p = (p - c) * f;
 }
 
-namespace {
-std::string lowerExtensionOf(const std::string& path) {
-  std::string ext = fs::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
-  return ext;
-}
-}  // namespace
 
 Job loadJob(const ParsedArgs& args) {
   Job job;
@@ -104,7 +99,7 @@ Job loadJob(const ParsedArgs& args) {
   } else if (std::string w = normalsAgainstWindingWarning(job.mesh, job.meshPath); !w.empty()) {
     warnOnSuccess(w);
   }
-  const std::string ext = lowerExtensionOf(job.latticePath);
+  const std::string ext = io::lowerExtension(job.latticePath);
   if (args.has("--normalize")) {
     double s = args.getDouble("--normalize", 1.0);
     if (!(s > 0)) throw Error(ErrorKind::Input, "--normalize needs a positive scale");
@@ -118,7 +113,7 @@ Job loadJob(const ParsedArgs& args) {
 }
 
 Lattice loadJobLattice(const ParsedArgs& args, const Job& job, const std::string& latticePath) {
-  const std::string ext = lowerExtensionOf(latticePath);
+  const std::string ext = io::lowerExtension(latticePath);
   LatticeReadOptions lo;
   lo.npyDegree = args.getTriple("--degree", {2, 2, 2});
   meshBounds(job.mesh, lo.meshBoxLo, lo.meshBoxHi);
@@ -160,29 +155,25 @@ Device openDeviceFromArgs(const ParsedArgs& args) {
 
 JobAndDevice loadJobAndOpenDevice(const ParsedArgs& args) {
   using Clock = std::chrono::steady_clock;
-  // A .om mesh is read by OpenMesh in a forked child (mesh_io_om.cpp). Forked while this thread opens the device
-  // (inside the dynamic loader, the driver's threads starting), the child can wait on a lock that no thread of its
-  // own will release: seen under the sanitizers, ten minutes until its alarm. So it is read before the opening.
-  if (!args.positional.empty() && lowerExtensionOf(args.positional[0]) == ".om") {
-    Job job = loadJob(args);
-    const Clock::time_point t = Clock::now();
-    Device device = openDeviceFromArgs(args);
-    const double openMs = std::chrono::duration<double, std::milli>(Clock::now() - t).count();
-    return {std::move(job), std::move(device), openMs};
-  }
   // Opening a device costs lavapipe and llvmpipe 20-30 ms (the Vulkan loader, LLVM's start-up), about what
-  // reading the teapot takes. Nothing on this thread calls warnOnSuccess (the reader's) before the join.
-  std::future<Job> reading = std::async(std::launch::async, [&args] { return loadJob(args); });
+  // reading the teapot takes, so the inputs are read on another thread meanwhile. Not a mesh read in a forked
+  // child (meshio::readsInForkedChild): forked while this thread is inside the dynamic loader, the child can
+  // wait on a lock no thread of its own will release (seen under the sanitizers: ten minutes, until its alarm).
+  // Nothing on this thread calls warnOnSuccess (the reader's) before the join.
+  std::optional<Job> readFirst;
+  std::future<Job> reading;
+  if (!args.positional.empty() && meshio::readsInForkedChild(args.positional[0])) readFirst.emplace(loadJob(args));
+  else reading = std::async(std::launch::async, [&args] { return loadJob(args); });
   const Clock::time_point t = Clock::now();
   std::optional<Device> device;
   try {
     device.emplace(openDeviceFromArgs(args));
   } catch (...) {
-    reading.get();   // the input's error first, as when the inputs were read before the device opened
+    if (reading.valid()) reading.get();   // the input's error first, as when the inputs were read before the device opened
     throw;
   }
   const double openMs = std::chrono::duration<double, std::milli>(Clock::now() - t).count();
-  Job job = reading.get();
+  Job job = readFirst ? std::move(*readFirst) : reading.get();
   return {std::move(job), std::move(*device), openMs};
 }
 

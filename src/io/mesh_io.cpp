@@ -33,6 +33,8 @@ Mesh readMesh(const std::string& path, const MeshReadOptions& options) {
 
 namespace meshio {
 
+bool readsInForkedChild(const std::string& path) { return io::lowerExtension(path) == ".om"; }
+
 namespace {
 Mesh dispatch(const std::string& path, std::string text, const MeshReadOptions& options) {
   std::string ext = io::lowerExtension(path);
@@ -44,7 +46,7 @@ Mesh dispatch(const std::string& path, std::string text, const MeshReadOptions& 
   if (ext == ".off") return readOff(path, text);
   if (ext == ".ply") return readPly(path, text);
   if (ext == ".stl") return readStl(path, text);
-  if (ext == ".om") return readOm(path, text);
+  if (readsInForkedChild(path)) return readOm(path, text);
   if (ext == ".bpt") return readBpt(path, text, options);
   if (ext == ".gltf" || ext == ".glb") return readGltf(path, text);
   throw inputError(path, 0, "unknown mesh format " + io::quoted(ext));

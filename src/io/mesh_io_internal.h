@@ -20,6 +20,9 @@ Mesh readOff(const std::string& path, const std::string& text);
 Mesh readPly(const std::string& path, const std::string& text);
 Mesh readStl(const std::string& path, const std::string& text);
 Mesh readOm(const std::string& path, const std::string& text);
+// Whether readMesh reads `path` in a forked child process (.om, readOm): a caller with other threads forks
+// only where none of them is inside the dynamic loader or holds a lock (apps/sffd job.cpp reads it first).
+bool readsInForkedChild(const std::string& path);
 Mesh readBpt(const std::string& path, const std::string& text, const MeshReadOptions& options);
 
 // Completes a mesh whose positions, normals (one slot per vertex, possibly unset) and triangles are

@@ -18,7 +18,6 @@
 #include "model/prepared_mesh.h"
 #include "kernels/clip/split_pattern_table.h"
 #include "core/huge_pages.h"
-#include "core/job_budget.h"
 #include "core/kernel_registry.h"
 #include "core/wall_clock.h"
 #include "pipelines/device_reals.h"
@@ -87,7 +86,7 @@ void DeformSession::prepare(const Mesh& input, const Lattice& lattice, const Sta
   I.fit = makeFitTable(std::max(3, s));
   PackedLattice packed = packLattice(lattice);
   // The kernels build on other threads (where the backend can) while the mesh is prepared.
-  I.deformVariant = deformVariantOf(options, estimateSubTriangles(input, options.edgeLength));
+  I.deformVariant = deformVariantOf(options, input);
   backend.precompile(SessionKernels{backend, options, I.deformVariant}.uses(deformParamsFor(packed, f64, &I.fit.data)));
   // A copy only where the creases are still to be applied.
   Mesh withCreases;

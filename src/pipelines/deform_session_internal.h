@@ -9,6 +9,7 @@
 
 #include <sffd/error.h>
 #include "core/huge_pages.h"
+#include "core/job_budget.h"
 #include "core/kernel_registry.h"
 #include "kernels/clip/regular_clip.h"
 #include "kernels/smooth/smooth_deform.h"
@@ -47,7 +48,7 @@ struct DeformSession::Impl {
   size_t triangles = 0, clipCount = 0;
   std::vector<SubTriangle> knotBoxSubs;
   FitTable fit;
-  KernelVariant deformVariant;   // deformVariantOf the session's options and its estimated sub-triangles
+  KernelVariant deformVariant;   // deformVariantOf the session's options and mesh
   size_t realSize = 4;
   std::vector<BufferId> owned;   // every buffer, destroyed with the session
   std::vector<PreChunkInputs> pre;   // the pre-compute's chunks of consecutive parents
@@ -187,11 +188,12 @@ inline void planChunks(std::vector<ChunkPlan>& plan, const std::vector<uint64_t>
 // up to about 57,000 (docs/PERFORMANCE.md "One sample site for a one-shot job").
 constexpr double kOneSampleSiteMaxSubTriangles = 20000;
 
-// The deform kernel's variant for a session of about `subTriangles`: a small one-shot job dispatches it once,
-// and on lavapipe below Mesa 23 (forDevice keeps the bit only there) translating it costs more than running it.
-inline KernelVariant deformVariantOf(const DeformSessionOptions& o, double subTriangles) {
+// The deform kernel's variant for a session of `mesh`: a small one-shot job dispatches it once, and on lavapipe
+// below Mesa 23 (forDevice keeps the bit only there) translating it costs more than running it.
+inline KernelVariant deformVariantOf(const DeformSessionOptions& o, const Mesh& mesh) {
   KernelVariant v = o.variant;
-  if (o.once && !o.split && subTriangles <= kOneSampleSiteMaxSubTriangles) v.assumptions |= SFFD_ASSUME_ONE_SAMPLE_SITE;
+  if (o.once && !o.split && estimateSubTriangles(mesh, o.edgeLength) <= kOneSampleSiteMaxSubTriangles)
+    v.assumptions |= SFFD_ASSUME_ONE_SAMPLE_SITE;
   return v;
 }
 

@@ -3,6 +3,7 @@
 // records and output, across re-deforms, chunking, the split kernels and knot-box clipping.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <random>
 #include <set>
@@ -12,6 +13,7 @@
 #include "backends/backend_select.h"
 #include "backends/backend_test_support.h"
 #include "pipelines/deform_session.h"
+#include "pipelines/deform_session_internal.h"
 #include "pipelines/device_reals.h"
 #include "pipelines/patch_output.h"
 #include <sffd/error.h>
@@ -323,6 +325,23 @@ TEST(DeformSessionKernels, PrecompilesWhatItDispatches) {
       }
     }
   }
+}
+
+// deform_smooth's one-site form only for a one-shot, fused job of at most kOneSampleSiteMaxSubTriangles estimated
+// sub-triangles: one triangle of side 100 at l = 1 has about 10,000, at l = 0.5 about 40,000.
+TEST(DeformSessionKernels, OneSampleSiteOnlyForSmallOneShotJobs) {
+  Mesh m;
+  m.positions = {{0, 0, 0}, {100, 0, 0}, {50, 50 * std::sqrt(3.0), 0}};
+  m.triangles = {{0, 1, 2}};
+  auto asks = [&](bool once, bool split, double l) {
+    DeformSessionOptions o;
+    o.once = once, o.split = split, o.edgeLength = l;
+    return (deformVariantOf(o, m).assumptions & SFFD_ASSUME_ONE_SAMPLE_SITE) != 0;
+  };
+  EXPECT_TRUE(asks(true, false, 1.0));
+  EXPECT_FALSE(asks(true, false, 0.5));
+  EXPECT_FALSE(asks(false, false, 1.0));
+  EXPECT_FALSE(asks(true, true, 1.0));
 }
 
 // A device whose storage binding cannot hold the job's vertices and one triangle's pre-compute inputs:
