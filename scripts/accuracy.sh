@@ -6,6 +6,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 SFFD=${SFFD:-build/sffd}
 source scripts/model_set.sh   # D, TEAPOT, CUBE, SPHERE, BIG and their lattices
+source scripts/matplotlib.sh
 row() {  # label mesh lattice normalize clip l
   "$SFFD" error "$D/$2" -l "$D/lattices/$3" --normalize "$4" --clip "$5" --edge-length "$6" --tess 10 --backend cpu --json --quiet \
     | /usr/bin/python3 -c "
@@ -29,7 +30,7 @@ for l in 0.4 0.3 0.2 0.15 0.1 0.07 0.05 0.035 0.025; do
 import json, sys
 j = json.load(sys.stdin); print($l, j.get('sub_triangles', 0), j['geometry']['avg'], j['geometry']['max'], j['normal_deg']['avg'], j['normal_deg']['max'])"
 done | tee "$SWEEP"
-# The plot of docs/ACCURACY.md (Debian's python3-matplotlib, installed by scripts/figures.sh).
+# The plot of docs/ACCURACY.md.
 /usr/bin/python3 - "$SWEEP" docs/figures/l_sweep_teapot.png "$TEAPOT + $TEAPOT_L" <<'PY'
 import sys
 import matplotlib

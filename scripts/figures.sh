@@ -3,10 +3,7 @@
 # (scripts/demo.sh or scripts/test.sh) and Debian's python3-matplotlib (installed when missing).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-dpkg-query -W -f='${Status}' python3-matplotlib 2>/dev/null | grep -q "install ok installed" || {
-  SUDO=""; [ "$(id -u)" -eq 0 ] || SUDO="sudo"
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends python3-matplotlib >/dev/null
-}
+source scripts/matplotlib.sh
 SFFD=${SFFD:-build/sffd}
 source scripts/model_set.sh   # D, TEAPOT, CUBE, SPHERE, BIG and their lattices
 T=$(mktemp -d)

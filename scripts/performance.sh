@@ -15,6 +15,7 @@ REPEAT=${REPEAT:-5}
 BACKENDS=${BACKENDS:-vulkan,gl,cpu}
 source scripts/model_set.sh   # D, TEAPOT, CUBE, SPHERE, BIG and their lattices
 export BIG
+source scripts/matplotlib.sh
 OUT=out/perf
 mkdir -p "$OUT" docs/figures
 
@@ -65,19 +66,22 @@ gen_dir = lambda g: out if g == "system" else os.path.join(out, "mesa-" + g)
 load_gen = lambda g, n: json.load(open(os.path.join(gen_dir(g), n + ".json")))
 load = lambda n: load_gen(gens[0], n)
 med = lambda run, k: run["stages_ms"][k]["median"]
+# A group not measured yet (ONLY= on a fresh clone) is left out of the tables and plots, not an error.
+have = lambda n, g=None: os.path.exists(os.path.join(gen_dir(g or gens[0]), n + ".json"))
 
 for g in gens:
     print("Mesa: %s" % g)
     print("| model | input tris | sub-tris | output tris | backend | driver | PN ms | clip ms | deform ms | cold first run ms | peak RSS MiB |")
     print("|---|---|---|---|---|---|---|---|---|---|---|")
     for n in ["teapot", os.environ["BIG"], "sphere", "teapot47k"]:
+        if not have(n, g): continue
         j = load_gen(g, n)
         for r in j["runs"]:
             print("| %s | %d | %d | %d | %s | %s | %.2f | %.2f | %.2f | %.0f | %.0f |" % (
                 n, j["input_triangles"], j["sub_triangles"], j["output_triangles"], r["backend"], r.get("driver", ""),
                 med(r, "pn"), med(r, "clip"), med(r, "deform"), r["cold_first_dispatch_ms"], r["peak_rss_mb"]))
     print()
-if len(gens) == 2:   # the teapot on both generations, side by side (same binary, same run of this script)
+if len(gens) == 2 and have("teapot", gens[0]) and have("teapot", gens[1]):   # the teapot on both generations, side by side (same binary, same run of this script)
     print("| backend | PN ms %s / %s | clip ms | deform ms | cold first run ms |" % tuple(gens))
     print("|---|---|---|---|---|")
     a, b = load_gen(gens[0], "teapot"), load_gen(gens[1], "teapot")
@@ -85,7 +89,7 @@ if len(gens) == 2:   # the teapot on both generations, side by side (same binary
         print("| %s | %s |" % (ra["backend"], " | ".join("%.2f / %.2f" % (med(ra, k), med(rb, k)) for k in ["pn", "clip", "deform"]))
               + " %.0f / %.0f |" % (ra["cold_first_dispatch_ms"], rb["cold_first_dispatch_ms"]))
     print()
-j = load("teapot_split")
+j = load("teapot_split") if have("teapot_split") else {"runs": []}
 print("| backend | deform.sample | deform.fit | deform.adjust | deform.tessellate | sum |")
 print("|---|---|---|---|---|---|")
 for r in j["runs"]:
@@ -94,6 +98,7 @@ for r in j["runs"]:
         print("| %s | %s | %.2f |" % (r["backend"], " | ".join("%.2f" % med(r, k) for k in steps), med(r, "deform")))
 
 def sweep(names, xkey, xlabel, png, title, logx=True):
+    if not all(have(n) for n in names): return print("(%s: not all of %s measured, plot left as it was)" % (png, names[0]))
     fig, ax = plt.subplots(1, 2, figsize=(10, 3.6), dpi=100)
     data = [load(n) for n in names]
     for b in [r["backend"] for r in data[0]["runs"]]:
@@ -122,7 +127,7 @@ print()
 print("sweeps (backend: x -> pre-compute ms, deform ms):")
 for group in [["faces_%d" % r for r in [4, 8, 16, 26, 53, 80]], ["l_%s" % l for l in ["0.4", "0.2", "0.1", "0.05"]],
               ["tess_%d" % n for n in [1, 2, 5, 10, 20, 40]]]:
-    for n in group:
+    for n in filter(have, group):
         j = load(n)
         print(n, j["input_triangles"], j["sub_triangles"], j["output_triangles"],
               " ".join("%s %.2f %.2f" % (r["backend"], med(r, "pn") + med(r, "clip"), med(r, "deform")) for r in j["runs"]))
