@@ -15,7 +15,7 @@ set(SFFD_KERNELS
 # spirv-opt's performance passes (`-O`) without its arithmetic simplification, for the kernels of
 # SFFD_SPIRV_OPTIMIZED: lavapipe translates and optimizes each pipeline's SPIR-V in every process (its
 # disk cache keeps only machine code), and deform_smooth's inlined SSA form with its assumptions folded
-# is translated in 30-50 ms, not 100-260 (docs/PERFORMANCE.md, "SPIR-V made for the usual dispatch").
+# is translated in 30-50 ms, not 100-260 (docs/performance/kernels.md, "SPIR-V made for the usual dispatch").
 # clip_write's in 26 ms, not 35, for 6 % more instructions when it runs on lavapipe 22.3 (0.1 ms of a
 # clip that runs once a mesh, against the translation every process pays: "The whole run, again").
 # The other kernels gain nothing there, so they stay as glslang writes them. `--simplify-instructions` is left out

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# What a machine with a GPU shows that the CPU-only CI cannot (docs/PERFORMANCE.md "On a GPU",
+# What a machine with a GPU shows that the CPU-only CI cannot (docs/performance/gpu.md,
 # docs/CONFORMANCE.md "Measured matrix"). Needs a built build/sffd (or SFFD=path) and the GPU's
 # Vulkan ICD and EGL vendor where the loaders find them (VK_DRIVER_FILES, __EGL_VENDOR_LIBRARY_FILENAMES).
 #   scripts/gpu_check.sh OUT_DIR [DUMP_DIR]

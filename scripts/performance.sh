@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerates the figures of docs/PERFORMANCE.md with `sffd bench`: the per-stage tables (the paper's
+# Regenerates the figures of docs/performance/stages.md and scaling.md with `sffd bench`: the per-stage tables (the paper's
 # Tables 1 and 2) for the benchmark model set on each backend, and the scaling plots (time against
 # faces, against l, against the tessellation level). Needs a built build/sffd; writes the raw JSON to
 # out/perf/ and the plots to docs/figures/perf_*.png; prints the tables as Markdown.

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The issue-13 figures of two builds side by side (docs/PERFORMANCE.md "Issue 13's targets"): on a shared,
+# The issue-13 figures of two builds side by side (docs/performance/targets.md): on a shared,
 # noisy machine only builds run alternately in one script can be compared. Each build is a folder
 # holding `sffd` and its `libsffd.so.0` (copy them out of a build tree: `cp build/sffd build/libsffd.so.0* DIR`).
 #   scripts/side_by_side.sh BASE_DIR HEAD_DIR

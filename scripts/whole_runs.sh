@@ -7,8 +7,8 @@
 #   scripts/whole_runs.sh BASE_DIR HEAD_DIR [RUNS]     (RUNS: 25)
 # Each build's output replaces the one its last run wrote (t_base.ply, t_head.ply), as a user's repeated
 # command does; one name for both made each run replace a file the other build had just written, whose
-# eviction could cost the rename as much as the change measured (docs/PERFORMANCE.md, "Output files replaced
-# without a flush"). FRESH=1 writes a new name each run instead.
+# eviction could cost the rename as much as the change measured (docs/performance/whole_run.md,
+# "Output files replaced without a flush"). FRESH=1 writes a new name each run instead.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 [ $# -ge 2 ] || { echo "usage: scripts/whole_runs.sh BASE_DIR HEAD_DIR [RUNS]" >&2; exit 2; }

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Times the accurate FFD kernels' three dispatches (samples, control points, tessellation) on a kept
-Deformer: the medians of 5 deforms after a first, in ms (docs/PERFORMANCE.md, "The accurate kernels'
-reads"). Needs the Python package (PYTHONPATH=build/python) and numpy.
+Deformer: the medians of 5 deforms after a first, in ms (docs/performance/scaling.md, "The accurate
+kernels' reads"). Needs the Python package (PYTHONPATH=build/python) and numpy.
 
     PYTHONPATH=build/python /usr/bin/python3 tools/accurate_steps.py MESH LATTICE [--backend vulkan] [--tess 10]
 """

@@ -1,7 +1,7 @@
 // Measuring tool: how long the first Vulkan device takes to make a compute pipeline of each SPIR-V module
 // given (vkCreateComputePipelines, no pipeline cache), the median of REPEAT builds, one at a time on the
 // calling thread. On lavapipe that is its SPIR-V to NIR translation and optimisation, which it does again
-// in every process (docs/PERFORMANCE.md, "Where Mesa 22.3's whole Vulkan run goes"). The layout is the
+// in every process (docs/performance/whole_run.md, "Where Mesa 22.3's whole Vulkan run goes"). The layout is the
 // kernels' (kernels/common/layout.h); specialization constants keep their defaults.
 //   spirv_translate_time REPEAT build/spv/deform_smooth.v0.s0.spv ...
 #include <vulkan/vulkan.h>

@@ -99,7 +99,7 @@ int run(const ParsedArgs& args) {
         {"sub_triangles", run.deformer.subTriangles()},
         {"output", {{"vertices", outVertices}, {"triangles", outTriangles}}},
         {"timings_ms", {{"pn", t.pnMs}, {"clip", t.clipMs}, {"deform", t.deformMs}, {"total", totalMs}}},
-        // Where the whole run's wall time goes (docs/PERFORMANCE.md "The whole process"): the inputs read,
+        // Where the whole run's wall time goes (docs/performance/whole_run.md): the inputs read,
         // the device opened, the lattice checked, the Deformer made (pre-compute), deformed, its result taken (download,
         // weld), the output written.
         {"host_ms",

@@ -36,7 +36,7 @@ static void usage(FILE* f) {
 }
 
 int main(int argc, char** argv) {
-  sffd::restartWithHugePages(argv);   // docs/PERFORMANCE.md "Huge pages for the whole process"
+  sffd::restartWithHugePages(argv);   // docs/performance/whole_run.md "Huge pages for the whole process"
   try {
     if (argc < 2) throw Error(ErrorKind::Input, "no command given (sffd --help lists them)");
     if (!std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h") || (!std::strcmp(argv[1], "help") && argc == 2)) {

@@ -20,7 +20,7 @@ struct KernelVariant {
   bool strict = false;   // every operation precise, fixed order: bit-identical across APIs
   bool f64 = false;      // double-precision arithmetic and storage
   // SFFD_ASSUME_* bits (kernels/common/layout.h): what a lattice-evaluating kernel is compiled to
-  // assume about its lattice, so the driver compiles less code (docs/PERFORMANCE.md "Cold start").
+  // assume about its lattice, so the driver compiles less code (docs/performance/kernels.md).
   // 0: nothing, decided at run time. The same results either way.
   uint32_t assumptions = 0;
   bool operator==(const KernelVariant&) const = default;

@@ -68,10 +68,10 @@ void traceFirstDispatch(std::string_view label, double deviceMs);
 // The creation of one kernel variant by a backend (Vulkan pipeline, GL program), from construction to
 // destruction. With SFFD_TRACE_COMPILE=1 in the environment it prints one line `sffd: compile BACKEND
 // KERNEL VARIANT: MS ms` to stderr at the end: which variants a run compiles and what creating each costs
-// (llvmpipe and lavapipe generate the machine code later, at the first dispatch: docs/PERFORMANCE.md "Cold
-// start"). Always, it counts as a compile in flight (oldestCompileInFlightSeconds), so that a watchdog can
-// tell a driver that is compiling from one that is hung: NVIDIA's GL compiler takes 75 s over the strict
-// double clip_write (docs/CONFORMANCE.md "Statuses").
+// (llvmpipe and lavapipe generate the machine code later, at the first dispatch: docs/performance/kernels.md
+// "Two Mesa generations and the cold start"). Always, it counts as a compile in flight
+// (oldestCompileInFlightSeconds), so that a watchdog can tell a driver that is compiling from one that is
+// hung: NVIDIA's GL compiler takes 75 s over the strict double clip_write (docs/CONFORMANCE.md "Statuses").
 class CompileScope {
  public:
   CompileScope(std::string_view backend, std::string_view kernel, KernelVariant variant);

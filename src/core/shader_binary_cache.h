@@ -1,7 +1,7 @@
 // Shader binaries a driver made, kept on disk between processes. Where a Vulkan driver of a CPU device can
 // hand back what it made of a kernel's SPIR-V (VK_EXT_shader_object's binaries), a later process gives it that
 // instead of the SPIR-V: lavapipe 25.0 then skips its SPIR-V to NIR translation and optimisation, about
-// 70 ms of CPU a run for the four smooth kernels (docs/PERFORMANCE.md "Shader binaries kept on disk").
+// 70 ms of CPU a run for the four smooth kernels (docs/performance/kernels.md "Shader binaries kept on disk").
 // The cache is best effort: a file that is missing, unreadable, truncated or stored under another key
 // is a miss, and a failed write is forgotten; it never changes a result, only how long a build takes.
 #pragma once

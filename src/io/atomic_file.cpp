@@ -96,8 +96,8 @@ std::string temporaryBeside(const std::string& path) {
 
 // A rename over an existing file makes ext4 (auto_da_alloc) flush the new file's delayed allocation first:
 // 7.5-11 ms for the teapot's 18 MB PLY. Its blocks allocated before (fallocate, the size kept), the rename
-// takes 1-1.6 ms and the pages are written back later, as any file's (docs/PERFORMANCE.md, "Output files
-// replaced without a flush"). Best effort: where it is refused, the rename goes as before.
+// takes 1-1.6 ms and the pages are written back later, as any file's (docs/performance/whole_run.md,
+// "Output files replaced without a flush"). Best effort: where it is refused, the rename goes as before.
 void allocateBeforeReplacing(const std::string& tmp, const std::string& path) {
 #if defined(__linux__) && defined(FALLOC_FL_KEEP_SIZE)
   struct stat st {};

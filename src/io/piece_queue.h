@@ -1,7 +1,7 @@
 // A streamed file's pieces written on a thread of their own (MeshFileWriter), so that the producer (the
 // weld of a result) goes on making the next piece while the last ones are formatted and written: the
-// whole run waits for the slower of the two, not for their sum (docs/PERFORMANCE.md "The file written
-// beside the weld").
+// whole run waits for the slower of the two, not for their sum (docs/performance/whole_run.md "The file
+// written beside the weld").
 #pragma once
 #include <condition_variable>
 #include <cstddef>

@@ -185,7 +185,7 @@ inline void planChunks(std::vector<ChunkPlan>& plan, const std::vector<uint64_t>
 
 // The most sub-triangles of a one-shot job that asks for deform_smooth's one-site form: lavapipe 22.3 translates
 // it 8 ms quicker and runs it about 0.14 us a sub-triangle slower (the teapot's 7,200: 8.6 -> 9.6 ms), so it pays
-// up to about 57,000 (docs/PERFORMANCE.md "One sample site for a one-shot job").
+// up to about 57,000 (docs/performance/kernels.md "One sample site for a one-shot job").
 constexpr double kOneSampleSiteMaxSubTriangles = 20000;
 
 // The deform kernel's variant for a session of `mesh`: a small one-shot job dispatches it once, and on lavapipe

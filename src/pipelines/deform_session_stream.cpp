@@ -1,6 +1,6 @@
 // DeformSession::streamChunks: a one-shot session (DeformSessionOptions::once) runs from
 // the mesh a few parents at a time, each chunk's inputs, records and outputs made, used and done with before
-// the next, so that only one chunk's exist at a time (docs/PERFORMANCE.md "Scaling"), in device buffers the
+// the next, so that only one chunk's exist at a time (docs/performance/scaling.md), in device buffers the
 // chunks share (Impl::StreamBuffer).
 #include <chrono>
 

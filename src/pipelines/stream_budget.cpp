@@ -17,7 +17,7 @@ namespace {
 constexpr double kMiB = 1024.0 * 1024.0;
 // The program, its libraries and the CPU device's threads (a tiny job's peak RSS: 23 MiB on the CPU
 // device); a graphics driver and its shader compiler on top (Mesa's: 77 MiB more for a tiny job, 99 MiB
-// more than the CPU device's at 1 M triangles; NVIDIA's 83 MiB, docs/PERFORMANCE.md "On a GPU").
+// more than the CPU device's at 1 M triangles; NVIDIA's 83 MiB, docs/performance/gpu.md).
 constexpr double kProgramBytes = 32 * kMiB, kDriverBytes = 128 * kMiB;
 
 // The segments of an edge as the clipping counts them (regular_clip.cpp segmentCount), a hair long: the

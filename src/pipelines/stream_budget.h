@@ -1,7 +1,7 @@
 // The host memory of a one-shot smooth job with regular clipping (DeformSession::streamed: `sffd deform`
 // into a .ply or .stl) and of a one-shot accurate job (AccurateRun with DeformOptions::once). Such a job
 // never holds all of its sub-triangles' output: estimateSmoothJob (job_budget.h), which assumes it does, is
-// far above what it needs (5.96 GiB for a run that peaks at 241 MB, docs/PERFORMANCE.md "Scaling"). This
+// far above what it needs (5.96 GiB for a run that peaks at 241 MB, docs/performance/scaling.md). This
 // estimate counts what stays alive, phase by phase.
 #pragma once
 #include <cstdint>

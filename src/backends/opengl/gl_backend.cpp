@@ -308,7 +308,7 @@ class GlBackend final : public Backend {
   // Issues the compile and link of each variant where the driver compiles on threads of its own
   // (KHR_parallel_shader_compile); their status is asked for at the first dispatch. Without it a compile
   // blocks the caller, so each is compiled at its first use as before. NVIDIA's GL otherwise compiles a
-  // job's kernels one after the other: 148 s for strict double (PERFORMANCE.md "On a GPU", run 4).
+  // job's kernels one after the other: 148 s for strict double (docs/performance/gpu.md, run 4).
   void precompile(const std::vector<KernelUse>& kernels) override {
     if (!parallelCompile_) return;
     ctx_->activate();

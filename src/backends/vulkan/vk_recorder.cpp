@@ -14,7 +14,7 @@ namespace {
 constexpr uint32_t kSetsPerPool = 256;
 constexpr VkDeviceSize kParamChunkBytes = 64 << 10;
 // Staging: the lattice and the clip offsets of an interactive edit fit the first chunk; a streamed chunk's
-// inputs (about 8 MiB beyond the vertices, docs/PERFORMANCE.md "Scaling") fit what is kept.
+// inputs (about 8 MiB beyond the vertices, docs/performance/scaling.md) fit what is kept.
 constexpr VkDeviceSize kStagingChunkBytes = 1 << 20;
 constexpr VkDeviceSize kStagingKeptBytes = 64 << 20;
 constexpr uint32_t kQueriesPerPool = 512;   // 256 dispatches
