@@ -11,16 +11,16 @@
 
 #include <algorithm>
 #include <cctype>
-#include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <map>
 #include <memory>
 #include <unordered_map>
 #include <utility>
 
 #include <sffd/error.h>
+#include "backends/opengl/gl_check.h"
 #include "backends/opengl/gl_es_limits.h"
+#include "backends/opengl/gl_programs.h"
 #include "backends/opengl/gl_state.h"
 #include "core/device_timeout.h"
 #include "core/kernel_registry.h"
@@ -40,89 +40,7 @@ std::string glString(GLenum which) {
   return s ? reinterpret_cast<const char*>(s) : "";
 }
 
-std::string hex(unsigned v) {
-  char buf[16];
-  std::snprintf(buf, sizeof buf, "0x%04x", v);
-  return buf;
-}
-
 uint64_t alignUp(uint64_t v, uint64_t a) { return a <= 1 ? v : (v + a - 1) / a * a; }
-
-// Throws an internal Error naming the operation when GL reports an error (all pending ones are drained).
-void checkGl(const char* what) {
-  GLenum first = glGetError();
-  if (first == GL_NO_ERROR) return;
-  for (int i = 0; i < 16 && glGetError() != GL_NO_ERROR; ++i) {}
-  if (first == GL_OUT_OF_MEMORY) throw deviceError(std::string("gl: out of memory in ") + what);
-  throw Error(ErrorKind::Internal, std::string("gl: error ") + hex(first) + " in " + what);
-}
-
-// Lowers "#version 450" to the context's version (4.3, 4.4): the kernels use nothing past GLSL 4.30.
-// The ES form ("#version 310 es", made at build time) is left as it is.
-void fitVersion(std::string& src, int contextVersion) {
-  if (src.rfind("#version ", 0) != 0 || src.rfind("#version 310 es", 0) == 0) return;
-  int want = std::atoi(src.c_str() + 9);
-  int have = contextVersion * 10;
-  if (want > have && have >= 430) src.replace(9, 3, std::to_string(have));
-}
-
-struct Program {
-  GLuint name = 0;
-  GLint paramsBlockSize = -1;   // GL_UNIFORM_BLOCK_DATA_SIZE of the block at binding 0 (-1: none)
-  ProgramResources resources;
-};
-
-// A program whose compile and link are issued and not yet checked: with KHR_parallel_shader_compile
-// the driver works on it on its own threads until the first dispatch asks for its status. It counts as
-// a compile in flight (and SFFD_TRACE_COMPILE times it) from its issue until a dispatch sees it done
-// (GL_COMPLETION_STATUS_KHR) or it is first used.
-struct ProgramBuild {
-  GLuint shader = 0, program = 0;
-  std::unique_ptr<CompileScope> compiling;
-};
-
-// What a linked compute program uses, as GL reports it.
-ProgramResources queryResources(GLuint prog) {
-  ProgramResources r;
-  GLint blocks = 0;
-  glGetProgramInterfaceiv(prog, GL_SHADER_STORAGE_BLOCK, GL_ACTIVE_RESOURCES, &blocks);
-  r.storageBlocks = blocks;
-  for (GLint i = 0; i < blocks; ++i) {
-    const GLenum prop = GL_BUFFER_BINDING;
-    GLint binding = 0;
-    glGetProgramResourceiv(prog, GL_SHADER_STORAGE_BLOCK, GLuint(i), 1, &prop, 1, nullptr, &binding);
-    r.maxStorageBinding = std::max(r.maxStorageBinding, binding);
-  }
-  glGetProgramInterfaceiv(prog, GL_UNIFORM_BLOCK, GL_ACTIVE_RESOURCES, &blocks);
-  for (GLint i = 0; i < blocks; ++i) {
-    const GLenum prop = GL_BUFFER_DATA_SIZE;
-    GLint size = 0;
-    glGetProgramResourceiv(prog, GL_UNIFORM_BLOCK, GLuint(i), 1, &prop, 1, nullptr, &size);
-    r.maxUniformBlockBytes = std::max(r.maxUniformBlockBytes, size);
-  }
-  glGetProgramiv(prog, GL_COMPUTE_WORK_GROUP_SIZE, r.groupSize);
-  return r;
-}
-
-// The first ES 3.1 minimum limit the program is past, or "" when it fits them all.
-std::string pastEsMinimum(const ProgramResources& r) {
-  auto past = [](const char* what, long long have, long long limit) {
-    return std::string(what) + " " + std::to_string(have) + " (OpenGL ES 3.1 guarantees " + std::to_string(limit) + ")";
-  };
-  if (r.storageBlocks > es31::kMaxComputeStorageBlocks)
-    return past("storage blocks", r.storageBlocks, es31::kMaxComputeStorageBlocks);
-  if (r.maxStorageBinding >= es31::kMaxStorageBindings)
-    return past("storage binding", r.maxStorageBinding, es31::kMaxStorageBindings - 1);
-  if (r.maxUniformBlockBytes > es31::kMaxUniformBlockSize)
-    return past("uniform block bytes", r.maxUniformBlockBytes, es31::kMaxUniformBlockSize);
-  long long invocations = 1;
-  for (int i = 0; i < 3; ++i) {
-    if (r.groupSize[i] > es31::kMaxGroupSize[i]) return past("work-group size", r.groupSize[i], es31::kMaxGroupSize[i]);
-    invocations *= r.groupSize[i];
-  }
-  if (invocations > es31::kMaxInvocations) return past("work-group invocations", invocations, es31::kMaxInvocations);
-  return {};
-}
 
 class GlBackend final : public Backend {
  public:
@@ -132,8 +50,8 @@ class GlBackend final : public Backend {
     heldToEsMinimum_ = es_ && !deviceLimits;
     // As many compiler threads as the driver likes (NVIDIA's, Mesa's radeonsi and iris use them); an
     // adopted context keeps the count its application set (the hint is the context's state).
-    parallelCompile_ = !es_ && (GLAD_GL_KHR_parallel_shader_compile || GLAD_GL_ARB_parallel_shader_compile);
-    if (parallelCompile_ && !ctx_->adopted()) {
+    const bool parallelCompile = !es_ && (GLAD_GL_KHR_parallel_shader_compile || GLAD_GL_ARB_parallel_shader_compile);
+    if (parallelCompile && !ctx_->adopted()) {
       if (GLAD_GL_KHR_parallel_shader_compile)
         glMaxShaderCompilerThreadsKHR(0xffffffffu);
       else
@@ -198,6 +116,7 @@ class GlBackend final : public Backend {
     glBindBuffer(GL_UNIFORM_BUFFER, ubo_);
     glBufferData(GL_UNIFORM_BUFFER, static_cast<GLsizeiptr>(uboSize_), nullptr, GL_STREAM_DRAW);
     checkGl("creating the parameter ring");
+    programs_ = std::make_unique<Programs>(info_, ctx_->glVersion(), es_, heldToEsMinimum_, parallelCompile);
   }
 
   ~GlBackend() override {
@@ -205,11 +124,7 @@ class GlBackend final : public Backend {
     try {
       ctx_->activate();
       glFinish();
-      for (auto& [key, p] : programs_) glDeleteProgram(p.name);
-      for (auto& [key, b] : builds_) {
-        glDeleteShader(b.shader);
-        glDeleteProgram(b.program);
-      }
+      programs_->release();
       for (auto& [id, b] : buffers_) glDeleteBuffers(1, &b.name);
       for (const Pending& p : pending_)
         if (p.begin) {
@@ -229,7 +144,7 @@ class GlBackend final : public Backend {
     ctx_->activate();
     const EmbeddedKernel* kernel = findKernel(kernelName);
     if (!kernel) throw Error(ErrorKind::Internal, "gl: no kernel named '" + std::string(kernelName) + "'");
-    return program(*kernel, variant).resources;
+    return programs_->get(*kernel, variant).resources;
   }
   GLuint bufferObject(BufferId id) const {
     auto it = buffers_.find(id);
@@ -305,26 +220,19 @@ class GlBackend final : public Backend {
     checkGl("download");
   }
 
-  // Issues the compile and link of each variant where the driver compiles on threads of its own
-  // (KHR_parallel_shader_compile); their status is asked for at the first dispatch. Without it a compile
-  // blocks the caller, so each is compiled at its first use as before. NVIDIA's GL otherwise compiles a
-  // job's kernels one after the other: 148 s for strict double (docs/performance/gpu.md, run 4).
+  // NVIDIA's GL otherwise compiles a job's kernels one after the other: 148 s for strict double
+  // (docs/performance/gpu.md, run 4).
   void precompile(const std::vector<KernelUse>& kernels) override {
-    if (!parallelCompile_) return;
     ctx_->activate();
-    for (const KernelUse& use : kernels) {
-      const EmbeddedKernel* kernel = findKernel(use.kernel);
-      // What cannot be built fails at its dispatch, as the interface says.
-      if (kernel && (!use.variant.f64 || info_.limits.float64)) startBuild(*kernel, use.variant);
-    }
+    programs_->precompile(kernels);
   }
 
   void dispatch(const Dispatch& d) override {
     ctx_->activate();
-    settleBuilds();
+    programs_->settle();
     const EmbeddedKernel* kernel = findKernel(d.kernel);
     if (!kernel) throw Error(ErrorKind::Internal, "gl: no kernel named '" + std::string(d.kernel) + "'");
-    const Program& prog = program(*kernel, d.variant);
+    const Program& prog = programs_->get(*kernel, d.variant);
     std::string what = std::string(d.kernel) + " (" + variantName(d.variant) + ")";
 
     const DeviceLimits& L = info_.limits;
@@ -493,118 +401,11 @@ class GlBackend final : public Backend {
     return q;
   }
 
-  using ProgramKey = std::pair<const EmbeddedKernel*, uint64_t>;
-
-  const Program& program(const EmbeddedKernel& kernel, KernelVariant variant) {
-    variant = forDevice(variant, info_);
-    const ProgramKey key(&kernel, variantKey(variant));
-    auto it = programs_.find(key);
-    if (it != programs_.end()) return it->second;
-    startBuild(kernel, variant);
-    auto b = builds_.find(key);
-    ProgramBuild build = std::move(b->second);
-    builds_.erase(b);
-    return programs_.emplace(key, finishBuild(kernel, variant, std::move(build))).first->second;
-  }
-
-  // Issues the compile and link of a variant (forDevice's) not built or building yet.
-  void startBuild(const EmbeddedKernel& kernel, KernelVariant variant) {
-    variant = forDevice(variant, info_);
-    const ProgramKey key(&kernel, variantKey(variant));
-    if (programs_.count(key) || builds_.count(key)) return;
-    if (variant.f64 && !info_.limits.float64)
-      throw deviceError(info_.api + ": the device has no float64 for " + std::string(kernel.name) + " (" +
-                        variantName(variant) + ")");
-    ProgramBuild b;
-    b.compiling = std::make_unique<CompileScope>(info_.api, kernel.name, variant);
-    std::string src = glslForVariant(kernel, variant, es_);
-    fitVersion(src, ctx_->glVersion());
-    b.shader = glCreateShader(GL_COMPUTE_SHADER);
-    const char* text = src.c_str();
-    glShaderSource(b.shader, 1, &text, nullptr);
-    glCompileShader(b.shader);
-    b.program = glCreateProgram();
-    glAttachShader(b.program, b.shader);
-    glLinkProgram(b.program);
-    builds_.emplace(key, std::move(b));
-  }
-
-  // Ends the compile scope of each build issued ahead that the driver has finished, so that an unused
-  // one (a job that failed before its dispatch) is not taken for a compile in flight.
-  void settleBuilds() {
-    for (auto& [key, b] : builds_) {
-      if (!b.compiling) continue;
-      GLint done = GL_FALSE;
-      glGetProgramiv(b.program, GL_COMPLETION_STATUS_KHR, &done);
-      if (done) b.compiling.reset();
-    }
-  }
-
-  // Waits for a build's compile and link (the status queries block until the driver is done).
-  Program finishBuild(const EmbeddedKernel& kernel, KernelVariant variant, ProgramBuild b) {
-    std::string what = std::string(kernel.name) + " (" + variantName(variant) + ")";
-    GLint ok = 0;
-    glGetShaderiv(b.shader, GL_COMPILE_STATUS, &ok);
-    if (!ok) {
-      std::string log = shaderLog(b.shader, false);
-      glDeleteShader(b.shader);
-      glDeleteProgram(b.program);
-      throw Error(ErrorKind::Internal, "gl: compiling kernel " + what + " failed:\n" + log);
-    }
-    glGetProgramiv(b.program, GL_LINK_STATUS, &ok);
-    glDetachShader(b.program, b.shader);
-    glDeleteShader(b.shader);
-    const GLuint prog = b.program;
-    if (!ok) {
-      std::string log = shaderLog(prog, true);
-      glDeleteProgram(prog);
-      throw Error(ErrorKind::Internal, "gl: linking kernel " + what + " failed:\n" + log);
-    }
-    b.compiling.reset();
-    Program p;
-    p.name = prog;
-    p.resources = queryResources(prog);
-    if (heldToEsMinimum_) {
-      std::string past = pastEsMinimum(p.resources);
-      if (!past.empty()) {
-        glDeleteProgram(prog);
-        throw deviceError("gles: kernel " + what + " uses " + past + "; SFFD_GLES_LIMITS=device uses the device's own limits");
-      }
-    }
-    GLint blocks = 0;
-    glGetProgramiv(prog, GL_ACTIVE_UNIFORM_BLOCKS, &blocks);
-    for (GLint i = 0; i < blocks; ++i) {
-      GLint binding = -1, size = 0;
-      glGetActiveUniformBlockiv(prog, static_cast<GLuint>(i), GL_UNIFORM_BLOCK_BINDING, &binding);
-      glGetActiveUniformBlockiv(prog, static_cast<GLuint>(i), GL_UNIFORM_BLOCK_DATA_SIZE, &size);
-      if (binding == SFFD_BINDING_PARAMS) p.paramsBlockSize = size;
-    }
-    checkGl(("building kernel " + what).c_str());
-    return p;
-  }
-
-  static std::string shaderLog(GLuint object, bool isProgram) {
-    GLint len = 0;
-    if (isProgram)
-      glGetProgramiv(object, GL_INFO_LOG_LENGTH, &len);
-    else
-      glGetShaderiv(object, GL_INFO_LOG_LENGTH, &len);
-    std::string log(static_cast<size_t>(std::max(len, 1)), '\0');
-    if (isProgram)
-      glGetProgramInfoLog(object, len, nullptr, log.data());
-    else
-      glGetShaderInfoLog(object, len, nullptr, log.data());
-    log.resize(std::strlen(log.c_str()));
-    return log;
-  }
-
   std::shared_ptr<Context> ctx_;
   DeviceInfo info_;
   std::unordered_map<BufferId, Buf> buffers_;
   BufferId nextId_ = 1;
-  std::map<ProgramKey, Program> programs_;
-  std::map<ProgramKey, ProgramBuild> builds_;   // issued by precompile, not yet asked for
-  bool parallelCompile_ = false;                // the driver compiles on its own threads
+  std::unique_ptr<Programs> programs_;
   GLuint ubo_ = 0;
   uint64_t uboSize_ = 0, uboHead_ = 0, uboAlign_ = 256, maxParams_ = 16384;
   std::vector<Pending> pending_;
