@@ -24,6 +24,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
 
+#include "backends/opengl/gl_check.h"
 #include "io/atomic_file.h"
 #include <sffd/error.h>
 
@@ -114,17 +115,6 @@ glm::dvec3 frontVector(UpAxis a) {
     case UpAxis::NegX: return {0, 0, -1};
   }
   return {0, -1, 0};
-}
-
-void checkGl(const char* what) {
-  GLenum e = glGetError();
-  if (e == GL_NO_ERROR) return;
-  while (glGetError() != GL_NO_ERROR) {
-  }
-  if (e == GL_OUT_OF_MEMORY) throw deviceError(std::string("render: out of GPU memory while ") + what);
-  char buf[96];
-  std::snprintf(buf, sizeof buf, "render: GL error 0x%04x while %s", e, what);
-  throw Error(ErrorKind::Internal, buf);
 }
 
 }  // namespace
@@ -247,7 +237,7 @@ Renderer::Renderer(std::shared_ptr<Context> context) : context_(std::move(contex
   glEnableVertexAttribArray(1);
   glVertexAttribPointer(1, 4, GL_FLOAT, GL_FALSE, sizeof(OverlayVertex), reinterpret_cast<void*>(2 * sizeof(float)));
   glBindVertexArray(0);
-  checkGl("setting up the renderer");
+  checkGlErrors("render", "setting up the renderer");
 }
 
 Renderer::~Renderer() {
@@ -349,7 +339,7 @@ void Renderer::setItems(const std::vector<RenderItem>& items) {
     glVertexAttribPointer(2, 1, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(6 * sizeof(float)));
     glBindVertexArray(0);
     meshes_.push_back(std::move(g));
-    checkGl("uploading a mesh");
+    checkGlErrors("render", "uploading a mesh");
   }
 }
 
@@ -387,7 +377,7 @@ void Renderer::setBufferItem(const BufferItem& item) {
     g->external.push_back({vao, static_cast<GLsizei>(d.indexCount)});
   }
   meshes_.push_back(std::move(g));
-  checkGl("setting up a buffer item");
+  checkGlErrors("render", "setting up a buffer item");
 }
 
 namespace {
@@ -663,7 +653,7 @@ std::vector<SlotCamera> Renderer::draw(const RenderOptions& o, int width, int he
   }
   glBindVertexArray(0);
   glUseProgram(0);
-  checkGl("drawing");
+  checkGlErrors("render", "drawing");
   return cams;
 }
 
@@ -693,7 +683,7 @@ int Renderer::drawText(const std::vector<std::string>& lines, int x, int y, int 
   glDisable(GL_BLEND);
   glBindVertexArray(0);
   glUseProgram(0);
-  checkGl("drawing text");
+  checkGlErrors("render", "drawing text");
   return scale;
 }
 
@@ -756,7 +746,7 @@ void Renderer::ensureTarget(int width, int height, int samples) {
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   targetWidth_ = width;
   targetHeight_ = height;
-  checkGl("creating the offscreen framebuffer");
+  checkGlErrors("render", "creating the offscreen framebuffer");
 }
 
 Image Renderer::render(const RenderOptions& o) {
@@ -782,7 +772,7 @@ Image Renderer::render(const RenderOptions& o) {
   std::vector<uint8_t> raw(static_cast<size_t>(o.width) * o.height * 4);
   glReadPixels(0, 0, o.width, o.height, GL_RGBA, GL_UNSIGNED_BYTE, raw.data());
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
-  checkGl("reading the picture back");
+  checkGlErrors("render", "reading the picture back");
   // GL rows start at the bottom; images at the top.
   img.rgba.resize(raw.size());
   const size_t row = static_cast<size_t>(o.width) * 4;

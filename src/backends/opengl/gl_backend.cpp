@@ -307,7 +307,7 @@ class GlBackend final : public Backend {
     if (rec.end) glQueryCounter(rec.end, GL_TIMESTAMP);
     pending_.push_back(std::move(rec));
     dirty_ = true;
-    checkGl(("dispatch of " + what).c_str());
+    checkGl("dispatch of " + what);
   }
 
   void barrier() override {

@@ -189,7 +189,7 @@ Program Programs::finish(const EmbeddedKernel& kernel, KernelVariant variant, Bu
     glGetActiveUniformBlockiv(prog, static_cast<GLuint>(i), GL_UNIFORM_BLOCK_DATA_SIZE, &size);
     if (binding == SFFD_BINDING_PARAMS) p.paramsBlockSize = size;
   }
-  checkGl(("building kernel " + what).c_str());
+  checkGl("building kernel " + what);
   return p;
 }
 
