@@ -11,11 +11,11 @@
 #include <cstdio>
 #include <map>
 #include <string>
-#include <type_traits>
 #include <vector>
 
 #include <sffd/error.h>
 #include "backends/opengl/gl_context.h"
+#include "backends/opengl/runtime_library.h"
 
 #ifndef EGL_PLATFORM_SURFACELESS_MESA
 #define EGL_PLATFORM_SURFACELESS_MESA 0x31DD
@@ -25,9 +25,7 @@ namespace sffd::gl {
 
 namespace {
 
-struct EglLib {
-  void* handle = nullptr;
-  std::string loadError;
+struct EglLib : RuntimeLibrary {
   PFNEGLGETPROCADDRESSPROC GetProcAddress = nullptr;
   PFNEGLGETERRORPROC GetError = nullptr;
   PFNEGLQUERYSTRINGPROC QueryString = nullptr;
@@ -44,41 +42,25 @@ struct EglLib {
   PFNEGLGETPLATFORMDISPLAYPROC GetPlatformDisplay = nullptr;         // EGL 1.5 core
   PFNEGLQUERYDEVICESEXTPROC QueryDevicesEXT = nullptr;
 
-  EglLib() {
-    for (const char* name : {"libEGL.so.1", "libEGL.so"}) {
-      handle = dlopen(name, RTLD_NOW | RTLD_LOCAL);
-      if (handle) break;
-      const char* e = dlerror();
-      if (loadError.empty()) loadError = e ? e : name;
-    }
-    if (!handle) return;   // kept open for the life of the process: unloading Mesa is never safe
-    loadError.clear();
-    auto sym = [&](auto& fn, const char* name) {
-      fn = reinterpret_cast<std::remove_reference_t<decltype(fn)>>(dlsym(handle, name));
-      if (!fn && loadError.empty()) loadError = std::string("libEGL has no ") + name;
-    };
-    sym(GetProcAddress, "eglGetProcAddress");
-    sym(GetError, "eglGetError");
-    sym(QueryString, "eglQueryString");
-    sym(Initialize, "eglInitialize");
-    sym(Terminate, "eglTerminate");
-    sym(BindAPI, "eglBindAPI");
-    sym(ChooseConfig, "eglChooseConfig");
-    sym(CreateContext, "eglCreateContext");
-    sym(DestroyContext, "eglDestroyContext");
-    sym(MakeCurrent, "eglMakeCurrent");
-    sym(GetCurrentContext, "eglGetCurrentContext");
-    sym(ReleaseThread, "eglReleaseThread");
-    if (!loadError.empty()) {
-      handle = nullptr;
-      return;
-    }
+  EglLib() : RuntimeLibrary("libEGL", {"libEGL.so.1", "libEGL.so"}) {
+    require(GetProcAddress, "eglGetProcAddress");
+    require(GetError, "eglGetError");
+    require(QueryString, "eglQueryString");
+    require(Initialize, "eglInitialize");
+    require(Terminate, "eglTerminate");
+    require(BindAPI, "eglBindAPI");
+    require(ChooseConfig, "eglChooseConfig");
+    require(CreateContext, "eglCreateContext");
+    require(DestroyContext, "eglDestroyContext");
+    require(MakeCurrent, "eglMakeCurrent");
+    require(GetCurrentContext, "eglGetCurrentContext");
+    require(ReleaseThread, "eglReleaseThread");
+    if (!finishRequired()) return;
     GetPlatformDisplay = reinterpret_cast<PFNEGLGETPLATFORMDISPLAYPROC>(dlsym(handle, "eglGetPlatformDisplay"));
     GetPlatformDisplayEXT =
         reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(GetProcAddress("eglGetPlatformDisplayEXT"));
     QueryDevicesEXT = reinterpret_cast<PFNEGLQUERYDEVICESEXTPROC>(GetProcAddress("eglQueryDevicesEXT"));
   }
-  bool ok() const { return handle != nullptr; }
 };
 
 EglLib& lib() {

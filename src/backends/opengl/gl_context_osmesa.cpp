@@ -2,55 +2,39 @@
 // libOSMesa.so.8 is opened at run time: OSMesa was removed from Mesa 25.1, so it is optional and
 // never the only headless path. The header is used for types and constants only.
 #include <GL/osmesa.h>
-#include <dlfcn.h>
 
 #include <string>
-#include <type_traits>
 #include <vector>
 
 #include <sffd/error.h>
 #include "backends/opengl/gl_context.h"
+#include "backends/opengl/runtime_library.h"
 
 namespace sffd::gl {
 
 namespace {
 
-struct OSMesaLib {
+struct OSMesaLib : RuntimeLibrary {
   using CreateContextAttribsFn = OSMesaContext (*)(const int* attribList, OSMesaContext sharelist);
   using DestroyContextFn = void (*)(OSMesaContext ctx);
   using MakeCurrentFn = GLboolean (*)(OSMesaContext ctx, void* buffer, GLenum type, GLsizei width, GLsizei height);
   using GetCurrentContextFn = OSMesaContext (*)();
   using GetProcAddressFn = OSMESAproc (*)(const char* funcName);
 
-  void* handle = nullptr;
-  std::string loadError;
   CreateContextAttribsFn CreateContextAttribs = nullptr;
   DestroyContextFn DestroyContext = nullptr;
   MakeCurrentFn MakeCurrent = nullptr;
   GetCurrentContextFn GetCurrentContext = nullptr;
   GetProcAddressFn GetProcAddress = nullptr;
 
-  OSMesaLib() {
-    for (const char* name : {"libOSMesa.so.8", "libOSMesa.so.6", "libOSMesa.so"}) {
-      handle = dlopen(name, RTLD_NOW | RTLD_LOCAL);
-      if (handle) break;
-      const char* e = dlerror();
-      if (loadError.empty()) loadError = e ? e : name;
-    }
-    if (!handle) return;   // kept open for the life of the process: unloading Mesa is never safe
-    loadError.clear();
-    auto sym = [&](auto& fn, const char* name) {
-      fn = reinterpret_cast<std::remove_reference_t<decltype(fn)>>(dlsym(handle, name));
-      if (!fn && loadError.empty()) loadError = std::string("libOSMesa has no ") + name;
-    };
-    sym(CreateContextAttribs, "OSMesaCreateContextAttribs");
-    sym(DestroyContext, "OSMesaDestroyContext");
-    sym(MakeCurrent, "OSMesaMakeCurrent");
-    sym(GetCurrentContext, "OSMesaGetCurrentContext");
-    sym(GetProcAddress, "OSMesaGetProcAddress");
-    if (!loadError.empty()) handle = nullptr;
+  OSMesaLib() : RuntimeLibrary("libOSMesa", {"libOSMesa.so.8", "libOSMesa.so.6", "libOSMesa.so"}) {
+    require(CreateContextAttribs, "OSMesaCreateContextAttribs");
+    require(DestroyContext, "OSMesaDestroyContext");
+    require(MakeCurrent, "OSMesaMakeCurrent");
+    require(GetCurrentContext, "OSMesaGetCurrentContext");
+    require(GetProcAddress, "OSMesaGetProcAddress");
+    finishRequired();
   }
-  bool ok() const { return handle != nullptr; }
 };
 
 OSMesaLib& lib() {
