@@ -79,13 +79,7 @@ void Recorder::destroy() {
   for (VkQueryPool q : queryPools_) api.vkDestroyQueryPool(dev, q, nullptr);
   if (fence_) api.vkDestroyFence(dev, fence_, nullptr);
   if (commandPool_) api.vkDestroyCommandPool(dev, commandPool_, nullptr);   // frees the command buffer
-  releases_.clear();
-  params_.chunks.clear();
-  staging_.chunks.clear();
-  descriptorPools_.clear();
-  queryPools_.clear();
-  fence_ = VK_NULL_HANDLE;
-  commandPool_ = VK_NULL_HANDLE;
+  abandon();   // forgets the handles just destroyed
 }
 
 VkCommandBuffer Recorder::commands() {
