@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include <sffd/error.h>
+#include "tests/support/temp_folder_test.h"
 #include "io/lattice_io.h"
 
 using namespace sffd;
@@ -23,39 +24,12 @@ namespace {
 
 const std::string kData = SFFD_TEST_DATA;
 
-class LatticeIo : public ::testing::Test {
+class LatticeIo : public sffd::test::TempFolderTest {
  protected:
-  void SetUp() override {
-    std::string name = std::string("sffd_lattice_io_") + ::testing::UnitTest::GetInstance()->current_test_info()->name() + "_" +
-                       std::to_string(std::random_device{}());
-    dir_ = fs::temp_directory_path() / name;
-    fs::create_directories(dir_);
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
-  std::string write(const std::string& name, const std::string& bytes) const {
-    std::string p = path(name);
-    std::ofstream(p, std::ios::binary) << bytes;
-    return p;
-  }
   size_t fileCount() const { return size_t(std::distance(fs::directory_iterator(dir_), fs::directory_iterator())); }
-  fs::path dir_;
 };
 
-void expectInputError(const std::function<void()>& f, const std::string& file, size_t line, const std::string& part) {
-  try {
-    f();
-    ADD_FAILURE() << "no error for " << file << " (expected '" << part << "')";
-  } catch (const Error& e) {
-    EXPECT_EQ(e.kind(), ErrorKind::Input) << e.what();
-    std::string prefix = file + (line ? ":" + std::to_string(line) : std::string()) + ": ";
-    EXPECT_EQ(std::string(e.what()).rfind(prefix, 0), 0u) << "message '" << e.what() << "' should start with '" << prefix << "'";
-    EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << "message '" << e.what() << "' should mention '" << part << "'";
-  }
-}
+using sffd::test::expectInputError;
 
 // ---------------------------------------------------------------------------------------------------
 // PyGeM .prm

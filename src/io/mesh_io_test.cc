@@ -16,6 +16,7 @@
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
 
 #include <sffd/error.h>
+#include "tests/support/temp_folder_test.h"
 #include "model/mesh.h"
 
 using namespace sffd;
@@ -34,48 +35,17 @@ namespace {
 
 const std::string kData = SFFD_TEST_DATA;
 
-// A fresh folder per test, removed afterwards.
-class MeshIo : public ::testing::Test {
+// The names of the files in the test's folder, besides what TempFolderTest gives.
+class MeshIo : public sffd::test::TempFolderTest {
  protected:
-  void SetUp() override {
-    std::string name = std::string("sffd_mesh_io_") + ::testing::UnitTest::GetInstance()->current_test_info()->name() + "_" +
-                       std::to_string(std::random_device{}());
-    dir_ = fs::temp_directory_path() / name;
-    fs::create_directories(dir_);
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
-  std::string write(const std::string& name, const std::string& bytes) const {
-    std::string p = path(name);
-    std::ofstream(p, std::ios::binary) << bytes;
-    return p;
-  }
   std::vector<std::string> files() const {
     std::vector<std::string> r;
     for (const auto& e : fs::directory_iterator(dir_)) r.push_back(e.path().filename().string());
     return r;
   }
-  fs::path dir_;
 };
 
-// Runs f, expects an input Error whose message starts with "file:line: " (or "file: " for line 0) and
-// contains `part`.
-void expectInputError(const std::function<void()>& f, const std::string& file, size_t line, const std::string& part) {
-  try {
-    f();
-    ADD_FAILURE() << "no error for " << file << " (expected '" << part << "')";
-  } catch (const Error& e) {
-    EXPECT_EQ(e.kind(), ErrorKind::Input) << e.what();
-    std::string prefix = file + (line ? ":" + std::to_string(line) : std::string()) + ": ";
-    EXPECT_EQ(std::string(e.what()).rfind(prefix, 0), 0u) << "message '" << e.what() << "' should start with '" << prefix << "'";
-    EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << "message '" << e.what() << "' should mention '" << part << "'";
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "unexpected exception type: " << e.what();
-  }
-}
+using sffd::test::expectInputError;
 
 size_t distinctWelds(const Mesh& m) { return std::set<uint32_t>(m.weldId.begin(), m.weldId.end()).size(); }
 
