@@ -15,6 +15,7 @@
 #include "analysis/error_metrics.h"
 #include "kernels/clip/knot_box_clip.h"
 #include "kernels/common/lattice_eval.h"
+#include "tests/support/test_lattices.h"
 
 using namespace sffd;
 
@@ -24,17 +25,8 @@ const std::string kData = SFFD_TEST_DATA;
 
 Mesh load(const std::string& name) { return readMesh(kData + "/" + name); }
 
-Lattice boxLattice(const Mesh& m, std::array<int, 3> counts, std::array<int, 3> degree, double margin = 0.0) {
-  glm::dvec3 lo = m.positions[0], hi = lo;
-  for (const auto& p : m.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
-  return makeIdentityLattice(lo - margin, hi + margin, counts, degree);
-}
-
-void perturb(Lattice& L, double amount, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> u(-amount, amount);
-  for (auto& p : L.controlPoints) p += glm::dvec3(u(rng), u(rng), u(rng));
-}
+using sffd::test::boxLattice;
+using sffd::test::perturb;
 
 struct Accurate {
   PatchVertices pv;

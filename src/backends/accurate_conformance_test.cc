@@ -15,6 +15,7 @@
 #include "analysis/buffer_compare.h"
 #include "kernels/clip/knot_box_clip.h"
 #include "backends/vulkan/vk_backend.h"
+#include "tests/support/test_lattices.h"
 
 using namespace sffd;
 
@@ -24,12 +25,8 @@ const std::string kData = SFFD_TEST_DATA;
 
 Lattice latticeFor(const Mesh& m, std::array<int, 3> counts, std::array<int, 3> degree, double amount, OutsideMode outside,
                    double margin) {
-  glm::dvec3 lo = m.positions[0], hi = lo;
-  for (const auto& p : m.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
-  Lattice L = makeIdentityLattice(lo - margin, hi + margin, counts, degree);
-  std::mt19937 rng(17);
-  std::uniform_real_distribution<double> u(-amount, amount);
-  for (auto& p : L.controlPoints) p += glm::dvec3(u(rng), u(rng), u(rng));
+  Lattice L = test::boxLattice(m, counts, degree, margin);
+  test::perturb(L, amount, 17);
   L.outside = outside;
   return L;
 }
