@@ -1,7 +1,9 @@
 // What the backend tests share: which backends every parameterised test runs on, opening one with
-// validation on (or skipping where this machine has none), gtest-safe names for them, and the CPU
-// backend as the reference.
+// validation on (or skipping where this machine has none), gtest-safe names for them, the CPU
+// backend as the reference, the error kind a call throws, and the classic kernel's hand-built inputs.
 #pragma once
+#include <gtest/gtest.h>
+
 #include <cstdio>
 #include <cstdlib>
 #include <map>
@@ -88,6 +90,22 @@ inline std::string backendTestName(std::string n) {
   for (char& c : n)
     if (c == '-') c = '_';
   return n;
+}
+
+// Error kind of what `f` throws; a failure when it throws nothing or something other than an sffd::Error.
+template <class F>
+std::optional<ErrorKind> errorKindOf(F&& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    EXPECT_FALSE(std::string(e.what()).empty());
+    return e.kind();
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "not an sffd::Error: " << e.what();
+    return std::nullopt;
+  }
+  ADD_FAILURE() << "nothing was thrown";
+  return std::nullopt;
 }
 
 }  // namespace sffd::testing

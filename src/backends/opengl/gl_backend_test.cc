@@ -16,6 +16,7 @@
 #include <vector>
 
 #include <sffd/error.h>
+#include "backends/classic_test_inputs.h"
 #include "backends/opengl/gl_backend.h"
 #include "backends/opengl/gl_context.h"
 #include "kernels/common/shader_layout.h"
@@ -42,57 +43,8 @@ std::unique_ptr<Backend> open(Provider p) {
       GTEST_SKIP() << providerName(provider) << " library not installed";                       \
   } while (0)
 
-// A hand-built lattice: one knot box [0,1]^3, degree 1, identity frame; coefficient
-// (p*2+q)*2+r is the corner (p,q,r). `moved` displaces corner 7 (1,1,1) to make it non-trivial.
-template <class Real>
-struct HandLattice {
-  gpu::LatticeParams params;
-  std::vector<Real> frame;
-  std::vector<Real> coeffs;
-  explicit HandLattice(bool moved = false) {
-    params.degree = {1, 1, 1, SFFD_OUTSIDE_EXTRAPOLATE};
-    params.boxes = {1, 1, 1, 8};
-    params.break_offset = {24, 26, 28, 0};
-    frame = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0,    // affine rows
-             1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0,    // cof(A) rows
-             0, 1, 0, 1, 0, 1};                      // breaks u, v, w
-    for (int p = 0; p < 2; ++p)
-      for (int q = 0; q < 2; ++q)
-        for (int r = 0; r < 2; ++r) {
-          coeffs.push_back(Real(p));
-          coeffs.push_back(Real(q));
-          coeffs.push_back(Real(r));
-          coeffs.push_back(Real(0));
-        }
-    if (moved) {
-      coeffs[4 * 7 + 0] = Real(1.3);
-      coeffs[4 * 7 + 1] = Real(0.8);
-      coeffs[4 * 7 + 2] = Real(1.17);
-      coeffs[4 * 2 + 1] = Real(1.25);   // corner (0,1,0) too
-    }
-  }
-};
-
-// Points (w = 1) and unit normals (w = 0) as real4; `inside` of them in [0,1]^3, the rest outside.
-template <class Real>
-void makeVertices(size_t n, size_t inside, std::vector<Real>& pos, std::vector<Real>& nrm, unsigned seed = 7) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> in(0.0, 1.0), out(-0.5, 1.5), dir(-1.0, 1.0);
-  pos.resize(4 * n);
-  nrm.resize(4 * n);
-  for (size_t i = 0; i < n; ++i) {
-    for (int k = 0; k < 3; ++k) pos[4 * i + k] = Real(i < inside ? in(rng) : out(rng));
-    if (i >= inside) pos[4 * i] = Real(1.25 + 0.25 * in(rng));   // surely outside on x
-    pos[4 * i + 3] = 1;
-    double v[3], len = 0;
-    do {
-      for (double& c : v) c = dir(rng);
-      len = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-    } while (len < 0.1);
-    for (int k = 0; k < 3; ++k) nrm[4 * i + k] = Real(v[k] / len);
-    nrm[4 * i + 3] = 0;
-  }
-}
+using sffd::testing::HandLattice;
+using sffd::testing::makeVertices;
 
 template <class Real>
 struct ClassicRun {

@@ -32,21 +32,7 @@ class VkBackendTest : public ::testing::Test {
   void TearDown() override { EXPECT_EQ(vk::validationMessageCount(), 0u); }
 };
 
-// Error kind of what `f` throws; fails the test when it throws nothing or something else.
-template <typename F>
-std::optional<ErrorKind> errorKindOf(F&& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    EXPECT_FALSE(std::string(e.what()).empty());
-    return e.kind();
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "not an sffd::Error: " << e.what();
-    return std::nullopt;
-  }
-  ADD_FAILURE() << "nothing was thrown";
-  return std::nullopt;
-}
+using sffd::testing::errorKindOf;
 
 // ---- the identity lattice: degree 1 on each axis, one knot box over [0,1]^3 ----
 
