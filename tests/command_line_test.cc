@@ -56,7 +56,7 @@ TEST_F(CommandLine, RepeatedSingleValuedOptionsAreRefused) {
 TEST_F(CommandLine, ListOptionsTakeOneValueOrThree) {
   for (const char* counts : {"7", "5,6,7"})
     EXPECT_EQ(runSffd("lattice " + box_ + " -o " + out("x.json") + " --counts " + counts + " --quiet").status, 0) << counts;
-  for (const char* bad : {"5,5", "5,5,5,5", "a", "5,,5"})
+  for (const char* bad : {"5,5", "5,5,5,5", "a", "5,,5", "5,5,5,", "5,", ",5"})
     expectUsageError(runSffd("lattice " + box_ + " -o " + out("x.json") + " --counts " + bad),
                      "option --counts needs one integer for all axes or three (U,V,W) like 5 or 5,6,7, not '" + std::string(bad) + "'");
   expectUsageError(runSffd("lattice " + box_ + " -o " + out("x.json") + " --degree 2,3"), "option --degree needs one integer for all axes or three");
