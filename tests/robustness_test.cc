@@ -392,6 +392,9 @@ TEST_F(Robust, OptionsAndOutputPathsAreChecked) {
       {{"-o", (dir_ / "out").string() + "/"}, ""},
       {{"-o", out("o.xyz")}, out("o.xyz") + ": cannot write mesh format"},
       {{"-o", "/proc/sffd-robustness.obj"}, "/proc/sffd-robustness.obj: cannot write"},
+      // Longer than a file name may be: an exit status 1 and a raw std::filesystem message once.
+      {{"-o", out(std::string(300, 'n') + ".obj")}, out(std::string(300, 'n') + ".obj") + ": cannot write: File name too long"},
+      {{"-o", out(std::string(300, 'n') + ".ply")}, out(std::string(300, 'n') + ".ply") + ": cannot write"},
   };
   for (const Case& c : cases) {
     std::vector<std::string> args = base;
@@ -417,6 +420,13 @@ TEST_F(Robust, OptionsAndOutputPathsAreChecked) {
   r = runSffd({"deform", m, "-l", l, "--method", "classic", "--tess", "64", "--edge-length", "0.5", "-o", out("o.obj"), "--quiet"});
   EXPECT_EQ(r.status, 0) << r.err;
   EXPECT_TRUE(fs::exists(out("o.obj")));
+  // A name of the longest length a file may have (255 bytes) is written: its temporary beside it was longer.
+  for (const char* ext : {".obj", ".ply"}) {
+    const std::string longest = out(std::string(255 - 4, 'n') + ext);
+    r = runSffd({"deform", m, "-l", l, "-o", longest, "--quiet"});
+    EXPECT_EQ(r.status, 0) << ext << "\n" << r.err;
+    EXPECT_TRUE(fs::exists(longest)) << ext;
+  }
 }
 
 // A job above the memory limit is refused before the GPU work, with the numbers.

@@ -138,7 +138,7 @@ void checkOutputPath(const std::string& out, const std::vector<std::string>& inp
   if (fs::is_directory(out, ec)) throw Error(ErrorKind::Input, out + ": cannot write: is a directory");
   for (const std::string& in : inputs) {
     if (in.empty()) continue;
-    if (fs::weakly_canonical(out, ec) == fs::weakly_canonical(in, ec) || (fs::exists(out) && fs::equivalent(out, in, ec)))
+    if (fs::weakly_canonical(out, ec) == fs::weakly_canonical(in, ec) || (fs::exists(out, ec) && fs::equivalent(out, in, ec)))
       throw Error(ErrorKind::Input, out + ": output path is an input file; refusing to overwrite it");
   }
 }
