@@ -246,6 +246,50 @@ TEST(ConformRunner, BadUsageIsExit2) {
   EXPECT_EQ(runSffd("conform " + kCube2 + " --backends cpu,vulkan --require gl-egl").status, 2);
 }
 
+// What conform writes and reads besides the job is checked before the run: the result files never
+// overwrite an input (they did: --junit MESH, --json LATTICE), a --dump that cannot be made and a damaged
+// --against manifest are one input error line (they were std::filesystem's and nlohmann's, exit 1, the
+// latter after every backend had run); and a huge --timeout waits (it was a Timeout at once).
+TEST(ConformRunner, ResultFilesAndFoldersAreCheckedBeforeTheRun) {
+  const fs::path dir = tempDir("conform_paths");
+  fs::copy_file(kData + "/cube2.obj", dir / "m.obj");
+  fs::copy_file(kData + "/lattices/cube2_twist.npy", dir / "l.npy");
+  std::ofstream(dir / "my.cases") << "c m.obj -l l.npy --tess 2\n";
+  std::ofstream(dir / "base.csv") << "c/pn.records cpu vs cpu,Fail\n";
+  std::ofstream(dir / "empty");
+  fs::create_directories(dir / "bad");
+  std::ofstream(dir / "bad" / "manifest.json") << "{\"cases\": 3}\n";
+  const std::string m = (dir / "m.obj").string(), l = (dir / "l.npy").string(), cases = (dir / "my.cases").string(),
+                    base = (dir / "base.csv").string();
+  const std::string before[] = {slurp(m), slurp(l), slurp(cases), slurp(base)};
+  const std::string job = "conform " + m + " -l " + l + " --backends cpu,cpu --tess 2 --quiet";
+  const std::pair<std::string, std::string> refused[] = {
+      {job + " --junit " + m, m + ": output path is an input file"},
+      {job + " --json " + l, l + ": output path is an input file"},
+      {"conform --cases " + cases + " --backends cpu,cpu --quiet --json " + cases, cases + ": output path is an input file"},
+      {job + " --baseline " + base + " --junit " + base, base + ": output path is an input file"},
+      {job + " --dump " + (dir / "empty").string(), (dir / "empty").string() + ": cannot make the dump folder"},
+      {job + " --against " + (dir / "bad").string() + " --dump " + (dir / "d").string(),
+       (dir / "bad" / "manifest.json").string() + ": not a --dump manifest"},
+  };
+  for (const auto& [args, message] : refused) {
+    RunResult r = runSffd(args);
+    EXPECT_EQ(r.status, 2) << args << "\n" << r.err;
+    EXPECT_EQ(r.err.rfind("sffd: error: " + message, 0), 0u) << args << "\n" << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << args << "\n" << r.err;
+    EXPECT_EQ(r.out, "") << args;   // refused before any backend ran
+  }
+  EXPECT_EQ(slurp(m), before[0]);
+  EXPECT_EQ(slurp(l), before[1]);
+  EXPECT_EQ(slurp(cases), before[2]);
+  EXPECT_EQ(slurp(base), before[3]);
+  EXPECT_FALSE(fs::exists(dir / "d"));
+  RunResult r = runSffd(job + " --timeout 1e300");
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(has(r.out, "conform: PASS")) << r.out;
+  fs::remove_all(dir);
+}
+
 TEST(ConformRunner, DevicesJsonHasIdsAndDriverVersion) {
   RunResult r = runSffd("devices --json");
   ASSERT_EQ(r.status, 0) << r.err;

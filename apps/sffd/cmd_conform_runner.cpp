@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <cstdlib>
 #include <cerrno>
@@ -241,13 +242,15 @@ BackendRun runBackend(const std::string& name, const std::vector<Case>& cases, c
     auto deadline = Clock::now() + std::chrono::duration<double>(options.timeoutSeconds);
     std::string pending;
     for (;;) {
-      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now()).count();
+      // In double: a huge --timeout (1e300 s) has no integer count of milliseconds; poll waits a day at most at once.
+      const double left = std::chrono::duration<double, std::milli>(deadline - Clock::now()).count();
       pollfd p{fds[0], POLLIN, 0};
-      if (left <= 0 || ::poll(&p, 1, int(std::max<long long>(left, 0))) == 0) {
+      if (left <= 0) {
         ::kill(pid, SIGKILL);
         timedOut = true;
         break;
       }
+      if (::poll(&p, 1, int(std::ceil(std::min(left, 86400e3)))) == 0) continue;   // the deadline is checked above
       char buf[4096];
       const ssize_t n = ::read(fds[0], buf, sizeof buf);
       if (n < 0 && errno == EINTR) continue;
