@@ -4,6 +4,7 @@
 // numbered mesh files.
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include <sffd/error.h>
 
@@ -55,6 +56,9 @@ int run(const ParsedArgs& args) {
   const double fps = args.getDouble("--fps", 24.0);
   if (!std::isfinite(fps) || !(fps > 0) || fps > 1000) throw Error(ErrorKind::Input, "--fps must be a number in (0, 1000]");
   const bool numbered = isFramePattern(out);
+  // glTF keeps the key times as floats: the last frame's, (N-1)/F seconds, must be one.
+  if (!numbered && !(double(frames - 1) / fps <= std::numeric_limits<float>::max()))
+    throw Error(ErrorKind::Input, "--fps " + args.get("--fps") + " puts the last frame past the seconds a glTF key time (a float) holds");
   const std::string ext = io::lowerExtension(out);
   if (!numbered && ext != ".glb" && ext != ".gltf")
     throw Error(ErrorKind::Input, "-o must name a .glb or .gltf file, or numbered files such as frame_%04d.ply");
@@ -75,13 +79,23 @@ int run(const ParsedArgs& args) {
   DeformRun run = runDeformJob(args, job, device);   // the pre-compute, and frame 0 (the first key)
   const MeshWriteOptions write{.significantDigits = run.deformer.resultDigits(), .binary = args.has("--binary")};
   std::vector<Mesh> meshes;
-  for (int f = 0; f < frames; ++f) {
-    if (f > 0) {
-      run.deformer.deform(frameLattice(keys, f, frames));
-      run.mesh = run.deformer.result();
+  std::vector<std::string> written;   // numbered frames: removed again when a later one fails, as no output is left then
+  try {
+    for (int f = 0; f < frames; ++f) {
+      if (f > 0) {
+        run.deformer.deform(frameLattice(keys, f, frames));
+        run.mesh = run.deformer.result();
+      }
+      if (numbered) {
+        writeMesh(frameName(out, f), run.mesh, write);
+        written.push_back(frameName(out, f));
+      } else {
+        meshes.push_back(std::move(run.mesh));
+      }
     }
-    if (numbered) writeMesh(frameName(out, f), run.mesh, write);
-    else meshes.push_back(std::move(run.mesh));
+  } catch (...) {
+    for (const std::string& w : written) std::remove(w.c_str());
+    throw;
   }
   if (!numbered) meshio::writeGltfAnimation(out, meshes, fps);
   note(args, "wrote " + (numbered ? std::to_string(frames) + " frames " + out : out + " (" + std::to_string(frames) + " frames)") + " (" +
