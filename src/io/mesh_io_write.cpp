@@ -6,6 +6,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <map>
 #include <ostream>
 
 #include <sffd/error.h>
@@ -281,11 +282,41 @@ std::vector<uint32_t> positionIds(const Mesh& mesh, uint32_t& count) {
   return usable ? id : meshio::distinctPositions(mesh.positions, count);
 }
 
+// A `v` line holds one colour: the vertices at one position whose colour differs from its first vertex's (a
+// colour seam) get a line of their own per colour, numbered by first appearance as positionIds numbers.
+std::vector<uint32_t> splitByColour(const std::vector<uint32_t>& pid, const Mesh& mesh, uint32_t& count) {
+  constexpr uint32_t kNone = ~0u;
+  auto bits = [&](size_t v) {
+    const glm::dvec4& c = mesh.colors[v];
+    return std::array<uint64_t, 3>{std::bit_cast<uint64_t>(c.r), std::bit_cast<uint64_t>(c.g), std::bit_cast<uint64_t>(c.b)};
+  };
+  std::vector<uint32_t> first(count, kNone), id(pid.size());
+  std::map<std::pair<uint32_t, std::array<uint64_t, 3>>, uint32_t> more;   // a position's further colours: their ids
+  uint32_t next = 0;
+  for (size_t v = 0; v < pid.size(); ++v) {
+    const uint32_t p = pid[v];
+    if (first[p] == kNone) {
+      first[p] = uint32_t(v);
+      id[v] = next++;
+    } else if (bits(v) == bits(first[p])) {
+      id[v] = id[first[p]];
+    } else {
+      auto [it, fresh] = more.try_emplace({p, bits(v)}, next);
+      next += fresh;
+      id[v] = it->second;
+    }
+  }
+  count = next;
+  return id;
+}
+
 void writeObj(std::ostream& os, const Mesh& mesh, int digits, const Carried& has) {
   // Positions are written once per location or distinct value (so a welded mesh stays welded for every OBJ reader),
-  // texture coordinates and normals once per vertex; a face corner is "position/vertex/vertex".
+  // and per colour there (splitByColour), texture coordinates and normals once per vertex; a face corner is
+  // "position/vertex/vertex".
   uint32_t count = 0;
   std::vector<uint32_t> pid = positionIds(mesh, count);
+  if (has.colors) pid = splitByColour(pid, mesh, count);
   ChunkedWriter w(os);
   std::string& s = w.buf();
   s += "# sffd mesh: " + std::to_string(count) + " positions, " + std::to_string(mesh.positions.size()) + " vertices, " +
