@@ -6,6 +6,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <map>
 #include <ostream>
 
@@ -68,9 +69,15 @@ constexpr size_t kBlock = 4096;   // records writePly and writeStl append betwee
 
 namespace meshio {
 
-void checkFiniteVertex(const std::string& path, size_t v, const glm::dvec3& position, const glm::dvec3* normal) {
+void checkFiniteVertex(const std::string& path, size_t v, const glm::dvec3& position, const glm::dvec3* normal, bool floats) {
   auto finite = [](const glm::dvec3& x) { return std::isfinite(x.x) && std::isfinite(x.y) && std::isfinite(x.z); };
-  if (finite(position) && (!normal || finite(*normal))) return;
+  if (finite(position) && (!normal || finite(*normal))) {
+    // A file of floats would hold a double past their range as an infinity (normals are unit).
+    constexpr double kMax = std::numeric_limits<float>::max();
+    if (!floats || (std::abs(position.x) <= kMax && std::abs(position.y) <= kMax && std::abs(position.z) <= kMax)) return;
+    throw Error(ErrorKind::Input, path + ": not written: vertex " + std::to_string(v) +
+                                      " of the result lies beyond the range of the file's floats (a text file holds it)");
+  }
   throw Error(ErrorKind::Input, path + ": not written: vertex " + std::to_string(v) + " of the result has a " +
                                     (finite(position) ? "non-finite normal" : "non-finite position") +
                                     " (the lattice moves it beyond the floating-point range of the computation)");
@@ -233,7 +240,7 @@ void appendStlFacets(std::string& s, const Mesh& mesh, const std::array<uint32_t
 namespace {
 using namespace meshio;
 
-meshio::Carried checkWritable(const std::string& path, const Mesh& mesh) {
+meshio::Carried checkWritable(const std::string& path, const Mesh& mesh, bool floats) {
   const size_t n = mesh.positions.size();
   auto sized = [&](size_t count, const char* what) {
     if (count != 0 && count != n)
@@ -258,7 +265,7 @@ meshio::Carried checkWritable(const std::string& path, const Mesh& mesh) {
   perTriangle(mesh.triangleGroup, mesh.groups.size(), "groups");
   // A lattice that sends points beyond the floating-point range gives inf or NaN: refuse to write a
   // file of them, and say where (the lattice is the input at fault, so this is an input error).
-  for (size_t v = 0; v < n; ++v) checkFiniteVertex(path, v, mesh.positions[v], c.normals ? &mesh.normals[v] : nullptr);
+  for (size_t v = 0; v < n; ++v) checkFiniteVertex(path, v, mesh.positions[v], c.normals ? &mesh.normals[v] : nullptr, floats);
   return c;
 }
 
@@ -457,7 +464,7 @@ void writeMesh(const std::string& path, const Mesh& mesh, const MeshWriteOptions
   const std::string ext = meshio::checkWriteTarget(path, options);
   const bool gltf = ext == ".gltf" || ext == ".glb";
   const int digits = options.significantDigits;
-  const Carried has = checkWritable(path, mesh);
+  const Carried has = checkWritable(path, mesh, ext == ".stl" && options.binary);
   if (gltf) return meshio::writeGltf(path, mesh);
   writeFileAtomically(
       path,
