@@ -10,6 +10,7 @@
 
 #include "apps/sffd/cli.h"
 #include "apps/sffd/deform_job.h"
+#include "core/job_budget.h"
 #include "io/gltf_io.h"
 #include "io/io_util.h"
 
@@ -78,6 +79,12 @@ int run(const ParsedArgs& args) {
   Device device = openDeviceFromArgs(args);
   DeformRun run = runDeformJob(args, job, device);   // the pre-compute, and frame 0 (the first key)
   const MeshWriteOptions write{.significantDigits = run.deformer.resultDigits(), .binary = args.has("--binary")};
+  // A glTF keeps every frame, and its buffer them again as floats: frame 0's size, `frames` times, must fit
+  // before the others are made (10,000 frames of a smooth cube took 80 GB).
+  if (!numbered)
+    checkKeptFits(run.deformer, uint64_t(frames) * (meshHeldBytes(run.mesh) + 6 * sizeof(float) * run.mesh.positions.size()),
+                  "the " + std::to_string(frames) + " frames of " + out,
+                  "use fewer --frames, or numbered files (frame_%04d.ply), written one at a time");
   std::vector<Mesh> meshes;
   std::vector<std::string> written;   // numbered frames: removed again when a later one fails, as no output is left then
   try {
