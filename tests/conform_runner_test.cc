@@ -290,6 +290,26 @@ TEST(ConformRunner, ResultFilesAndFoldersAreCheckedBeforeTheRun) {
   fs::remove_all(dir);
 }
 
+// Each backend writes a case's buffers to the folder named after the case: "." and ".." were accepted, and
+// ".." put every backend's buffers in one folder, so each backend was compared with the last one run: a
+// PASS whatever they computed. Refused in a case file; a mesh whose stem is one ("...obj") names its case "mesh".
+TEST(ConformRunner, CaseNamesAreFolderNames) {
+  const fs::path dir = tempDir("conform_case_names");
+  fs::copy_file(kData + "/cube2.obj", dir / "...obj");
+  fs::copy_file(kData + "/lattices/cube2_twist.npy", dir / "l.npy");
+  for (const char* name : {".", ".."}) {
+    std::ofstream(dir / "dot.cases") << name << " ...obj -l l.npy --tess 2\n";
+    RunResult r = runSffd("conform --cases " + (dir / "dot.cases").string() + " --backends cpu,cpu --quiet");
+    EXPECT_EQ(r.status, 2) << name << "\n" << r.err;
+    EXPECT_TRUE(has(r.err, "dot.cases:1: a case name has no / , \" < > & or spaces and is not . or ..")) << r.err;
+  }
+  RunResult r = runSffd("conform " + (dir / "...obj").string() + " -l " + (dir / "l.npy").string() +
+                        " --backends cpu,cpu --tess 2 --quiet --json " + (dir / "r.json").string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(json::parse(slurp(dir / "r.json"))["cases"][0]["name"], "mesh");
+  fs::remove_all(dir);
+}
+
 TEST(ConformRunner, DevicesJsonHasIdsAndDriverVersion) {
   RunResult r = runSffd("devices --json");
   ASSERT_EQ(r.status, 0) << r.err;
