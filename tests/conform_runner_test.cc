@@ -163,6 +163,21 @@ TEST(ConformRunner, ChangedDumpFailsNamingTheFirstMismatchingElement) {
       EXPECT_EQ(res["first_mismatch"]["element"], element);
     }
   EXPECT_TRUE(found);
+  // A damaged dump is one input error line naming its file: a count past what the file holds was allocated
+  // ("out of memory", exit 1), a broken index was nlohmann's message (exit 1).
+  const fs::path index = dir / "d/cpu/cube2/buffers.json";
+  json idx = json::parse(slurp(index));
+  idx["buffers"][0]["count"] = uint64_t(1) << 50;
+  std::ofstream(index) << idx.dump();
+  r = runSffd(args + " --backends cpu --against " + (dir / "d").string());
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(r.err, "sffd: error: " + (dir / "d/cpu/cube2" / idx["buffers"][0]["file"].get<std::string>()).string() +
+                       ": shorter than its buffers.json says\n");
+  std::ofstream(index) << "{";
+  r = runSffd(args + " --backends cpu --against " + (dir / "d").string());
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(r.err.rfind("sffd: error: " + index.string() + ": not a --dump buffer index: ", 0), 0u) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   fs::remove_all(dir);
 }
 

@@ -28,6 +28,7 @@
 
 #include "apps/sffd/conform.h"
 #include "core/kernel_registry.h"
+#include "io/io_util.h"
 
 namespace sffd::cli::conform {
 
@@ -49,24 +50,37 @@ void writeCaseOutput(const fs::path& dir, const CaseOutput& out) {
                                               {"buffers", index}, {"parents", "parents.u32"}}.dump(1) << "\n";
 }
 
-CaseOutput readCaseOutput(const fs::path& dir) {
+CaseOutput readCaseOutput(const fs::path& dir) try {
   std::ifstream in(dir / "buffers.json");
   if (!in) throw Error(ErrorKind::Input, (dir / "buffers.json").string() + ": cannot read");
   json index = json::parse(in);
   CaseOutput out;
+  // A count is a claim (a --against folder may be damaged): nothing is allocated before the file holds it.
+  auto sizeOf = [](const fs::path& p, size_t count, size_t unit) {
+    std::error_code ec;
+    const uintmax_t bytes = fs::file_size(p, ec);
+    if (ec || bytes / unit < count) throw Error(ErrorKind::Input, p.string() + ": shorter than its buffers.json says");
+    return count;
+  };
   auto readRaw = [](const fs::path& p, void* data, size_t bytes) {
     std::ifstream f(p, std::ios::binary);
     if (!f.read(static_cast<char*>(data), std::streamsize(bytes)) && bytes)
       throw Error(ErrorKind::Input, p.string() + ": shorter than its buffers.json says");
   };
   for (const json& b : index.at("buffers")) {
-    Buffer buf{b.at("name"), b.at("unit"), b.at("per_unit"), std::vector<double>(b.at("count").get<size_t>())};
-    readRaw(dir / b.at("file").get<std::string>(), buf.values.data(), buf.values.size() * 8);
+    const fs::path file = dir / b.at("file").get<std::string>();
+    Buffer buf{b.at("name"), b.at("unit"), b.at("per_unit"), std::vector<double>(sizeOf(file, b.at("count").get<size_t>(), 8))};
+    readRaw(file, buf.values.data(), buf.values.size() * 8);
     out.buffers.push_back(std::move(buf));
   }
-  out.parents.resize(fs::file_size(dir / "parents.u32") / 4);
+  std::error_code ec;
+  const uintmax_t parentBytes = fs::file_size(dir / "parents.u32", ec);
+  if (ec) throw Error(ErrorKind::Input, (dir / "parents.u32").string() + ": cannot read: " + ec.message());
+  out.parents.resize(parentBytes / 4);
   readRaw(dir / "parents.u32", out.parents.data(), out.parents.size() * 4);
   return out;
+} catch (const json::exception& e) {   // a damaged or foreign index
+  throw Error(ErrorKind::Input, (dir / "buffers.json").string() + ": not a --dump buffer index: " + io::oneLine(e.what()));
 }
 
 namespace {
