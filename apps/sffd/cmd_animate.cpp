@@ -115,7 +115,9 @@ int run(const ParsedArgs& args) {
 CommandSpec animateCommand() {
   CommandSpec c{"animate", "MESH -l L0 -l L1 [-l L2 ...] --frames N -o OUT [options]",
                 "Deforms a mesh by lattices interpolated frame by frame: a glTF animation or numbered mesh files.",
-                jobOptions(), run, 1, 1};
+                {}, run, 1, 1};
+  for (const OptionSpec& o : jobOptions())
+    if (std::string(o.name) != "--stats") c.options.push_back(o);   // no run statistics are written
   for (OptionSpec& o : c.options)
     if (std::string(o.name) == "--lattice|-l") {
       o.help = "a key lattice (give two or more, same structure; .json, .prm or .npy)";
