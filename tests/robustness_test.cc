@@ -387,6 +387,7 @@ TEST_F(Robust, OptionsAndOutputPathsAreChecked) {
       {{"-o", (dir_ / "sym.obj").string()}, (dir_ / "sym.obj").string() + ": output path is an input"},
       {{"-o", l}, l + ": output path is an input"},
       {{"-o", out("o.obj"), "--stats", m}, m + ": output path is an input"},
+      {{"-o", out("o.obj"), "--patches", out("p.txt")}, "--patches needs --method smooth"},   // o.obj was left written
       {{"-o", (dir_ / "file" / "o.obj").string()}, (dir_ / "file" / "o.obj").string() + ": cannot write"},
       {{"-o", (dir_ / "no" / "such" / "o.obj").string()}, (dir_ / "no" / "such" / "o.obj").string() + ": cannot write"},
       {{"-o", (dir_ / "out").string() + "/"}, ""},
