@@ -388,6 +388,9 @@ TEST_F(Robust, OptionsAndOutputPathsAreChecked) {
       {{"-o", l}, l + ": output path is an input"},
       {{"-o", out("o.obj"), "--stats", m}, m + ": output path is an input"},
       {{"-o", out("o.obj"), "--patches", out("p.txt")}, "--patches needs --method smooth"},   // o.obj was left written
+      // A --stats that cannot be written once the output is: the output goes (it stayed), a .gltf's .bin too.
+      {{"-o", out("o.obj"), "--stats", "/proc/sffd-robustness.json"}, "/proc/sffd-robustness.json: cannot write"},
+      {{"-o", out("o.gltf"), "--stats", "/proc/sffd-robustness.json"}, "/proc/sffd-robustness.json: cannot write"},
       {{"-o", (dir_ / "file" / "o.obj").string()}, (dir_ / "file" / "o.obj").string() + ": cannot write"},
       {{"-o", (dir_ / "no" / "such" / "o.obj").string()}, (dir_ / "no" / "such" / "o.obj").string() + ": cannot write"},
       {{"-o", (dir_ / "out").string() + "/"}, ""},
