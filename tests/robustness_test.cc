@@ -411,6 +411,10 @@ TEST_F(Robust, OptionsAndOutputPathsAreChecked) {
     EXPECT_EQ(slurp(m), mBytes) << context;
     EXPECT_EQ(slurp(l), lBytes) << context;
   }
+  // clip likewise: its --stats comes after its output.
+  Result c = runSffd({"clip", m, "-l", l, "--backend", "cpu", "-o", out("c.obj"), "--stats", "/proc/sffd-robustness.json"});
+  expectInputError(c, "/proc/sffd-robustness.json: cannot write", "clip --stats");
+  expectNothingWritten("clip --stats");
   EXPECT_TRUE(fs::is_symlink(dir_ / "sym.obj"));
   EXPECT_FALSE(fs::exists(dir_ / "file" / "o.obj"));
   EXPECT_FALSE(fs::exists("/proc/sffd-robustness.obj"));

@@ -86,25 +86,21 @@ int run(const ParsedArgs& args) {
                   "the " + std::to_string(frames) + " frames of " + out,
                   "use fewer --frames, or numbered files (frame_%04d.ply), written one at a time");
   std::vector<Mesh> meshes;
-  std::vector<std::string> written;   // numbered frames: removed again when a later one fails, as no output is left then
-  try {
-    for (int f = 0; f < frames; ++f) {
-      if (f > 0) {
-        run.deformer.deform(frameLattice(keys, f, frames));
-        run.mesh = run.deformer.result();
-      }
-      if (numbered) {
-        writeMesh(frameName(out, f), run.mesh, write);
-        written.push_back(frameName(out, f));
-      } else {
-        meshes.push_back(std::move(run.mesh));
-      }
+  WrittenFiles written;   // numbered frames: removed again when a later one fails
+  for (int f = 0; f < frames; ++f) {
+    if (f > 0) {
+      run.deformer.deform(frameLattice(keys, f, frames));
+      run.mesh = run.deformer.result();
     }
-  } catch (...) {
-    for (const std::string& w : written) std::remove(w.c_str());
-    throw;
+    if (numbered) {
+      writeMesh(frameName(out, f), run.mesh, write);
+      written.add(frameName(out, f));
+    } else {
+      meshes.push_back(std::move(run.mesh));
+    }
   }
   if (!numbered) meshio::writeGltfAnimation(out, meshes, fps);
+  written.keep();
   note(args, "wrote " + (numbered ? std::to_string(frames) + " frames " + out : out + " (" + std::to_string(frames) + " frames)") + " (" +
                  device.label() + ", " + device.info().name + ")");
   return 0;

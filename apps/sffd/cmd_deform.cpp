@@ -2,11 +2,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <filesystem>
 #include <memory>
 #include <optional>
 #include <utility>
-#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -86,18 +84,11 @@ int run(const ParsedArgs& args) {
   const double writeMs = lap();
   const size_t outVertices = streamed ? writer->vertexCount() : deformed.positions.size();
   const size_t outTriangles = streamed ? writer->triangleCount() : deformed.triangles.size();
-  // The output is in place: a file after it that cannot be written (--patches or --stats where no file can be
-  // made) takes it away again, as a failed command leaves nothing.
-  struct Undo {
-    std::vector<std::string> paths;
-    ~Undo() {
-      for (const std::string& p : paths) std::remove(p.c_str());
-    }
-  } undo{{out}};
-  if (outExt == ".gltf") undo.paths.push_back(std::filesystem::path(out).replace_extension(".bin").string());
+  WrittenFiles written;   // a --patches or --stats that cannot be written takes the output away again
+  written.add(out);
   if (args.has("--patches")) {
     writePatchFile(args.get("--patches"), run, run.deformer.patchControlPoints());
-    undo.paths.push_back(args.get("--patches"));
+    written.add(args.get("--patches"));
   }
   double totalMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 
@@ -142,7 +133,7 @@ int run(const ParsedArgs& args) {
     std::string text = j.dump(1) + "\n";
     writeFileAtomically(args.get("--stats"), [&](std::ostream& o) { o << text; });
   }
-  undo.paths.clear();
+  written.keep();
   note(args, "wrote " + out + " (" + std::to_string(outTriangles) + " triangles, " + device.label() + ", " +
                  device.info().name + ")");
   return 0;

@@ -143,6 +143,15 @@ void checkOutputPath(const std::string& out, const std::vector<std::string>& inp
   }
 }
 
+WrittenFiles::~WrittenFiles() {
+  for (const std::string& p : paths_) std::remove(p.c_str());
+}
+
+void WrittenFiles::add(const std::string& path) {
+  paths_.push_back(path);
+  if (io::lowerExtension(path) == ".gltf") paths_.push_back(fs::path(path).replace_extension(".bin").string());
+}
+
 Device openDeviceFromArgs(const ParsedArgs& args) {
   DeviceRequest r;
   r.name = args.get("--backend", "auto");
