@@ -299,6 +299,11 @@ TEST(ConformRunner, ResultFilesAndFoldersAreCheckedBeforeTheRun) {
   EXPECT_EQ(slurp(cases), before[2]);
   EXPECT_EQ(slurp(base), before[3]);
   EXPECT_FALSE(fs::exists(dir / "d"));
+  // A --json that cannot be written after the --junit was: neither is left.
+  RunResult j = runSffd(job + " --junit " + (dir / "j.xml").string() + " --json /proc/sffd-conform.json");
+  EXPECT_EQ(j.status, 2) << j.err;
+  EXPECT_EQ(j.err, "sffd: error: /proc/sffd-conform.json: cannot write\n");
+  EXPECT_FALSE(fs::exists(dir / "j.xml"));
   RunResult r = runSffd(job + " --timeout 1e300");
   EXPECT_EQ(r.status, 0) << r.err;
   EXPECT_TRUE(has(r.out, "conform: PASS")) << r.out;

@@ -191,8 +191,13 @@ int run(const ParsedArgs& args) {
   std::vector<Result> results = compareRuns(cases, runs, pairs);
   if (args.has("--baseline")) applyBaseline(results, args.get("--baseline"));
   printText(results, fromFile);
-  if (args.has("--junit")) writeJunit(args.get("--junit"), results);
+  WrittenFiles written;   // a --json that cannot be written takes the --junit away again
+  if (args.has("--junit")) {
+    writeJunit(args.get("--junit"), results);
+    written.add(args.get("--junit"));
+  }
   if (args.has("--json")) writeJson(args.get("--json"), cases, runs, results);
+  written.keep();
   bool pass = true;
   for (const Result& r : results) pass = pass && !isFailure(r.status);
   std::printf("conform: %s\n", pass ? "PASS" : "FAIL");
