@@ -203,6 +203,11 @@ TEST(Lattice, FittedBoxIsValidOrRefused) {
   Mesh flat;
   flat.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
   EXPECT_NO_THROW(fitLattice(flat));
+  // A tiny mesh gets a box of its own size and margin, as at any other size (it got 1e-12).
+  Mesh tiny = flat;
+  for (glm::dvec3& p : tiny.positions) p *= 1e-20;
+  const Lattice T = fitLattice(tiny);
+  EXPECT_DOUBLE_EQ(T.domainHi(0) - T.domainLo(0), 1.01e-20);
   Mesh nan = flat;
   nan.positions[0].x = NAN;   // the first vertex starts the box
   for (const auto& [mesh, margin] : {std::pair{&flat, 0.0}, {&flat, 1e308}, {&nan, 0.005}}) {
