@@ -195,6 +195,22 @@ TEST(Formats, AnimateFramesEqualSeparateDeforms) {
   fs::remove_all(dir);
 }
 
+// A .gltf writes NAME.bin beside it: where that is the buffer an input .gltf reads, the output is refused
+// (it overwrote the buffer, and the input could not be read again).
+TEST(Formats, GltfOutputNeverOverwritesAnInputsBuffer) {
+  const fs::path dir = tempDir("formats_gltf_buffer");
+  ASSERT_EQ(runSffd("deform " + kSphere + " --method classic -o " + (dir / "a.gltf").string()).status, 0);
+  fs::copy_file(dir / "a.gltf", dir / "in.gltf");   // reads a.bin
+  const std::string before = slurp(dir / "a.bin");
+  const std::string job = "deform " + (dir / "in.gltf").string() + " -l " + kData + "/lattices/sphere_twist.npy --backend cpu --quiet -o ";
+  RunResult r = runSffd(job + (dir / "a.gltf").string());
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(r.err, "sffd: error: " + (dir / "a.bin").string() + ": output path is an input file; refusing to overwrite it\n");
+  EXPECT_EQ(slurp(dir / "a.bin"), before);
+  EXPECT_EQ(runSffd(job + (dir / "b.gltf").string()).status, 0);
+  fs::remove_all(dir);
+}
+
 // A frame that cannot be written leaves nothing: the numbered frames written before it went too (they were
 // left), and a glTF is never written with values its floats cannot hold (it was, with infinities: Khronos'
 // validator refused it, sffd said nothing), nor with key times past a float (a tiny --fps).

@@ -7,6 +7,8 @@
 #include <future>
 #include <optional>
 
+#include <nlohmann/json.hpp>
+
 #include "apps/sffd/cli.h"
 #include "core/backend.h"
 #include <sffd/error.h>
@@ -129,6 +131,23 @@ Lattice loadJobLattice(const ParsedArgs& args, const Job& job, const std::string
   return withToolLimitName([&] { return readLattice(latticePath, lo); });
 }
 
+namespace {
+
+// The files a .gltf input reads besides itself: its buffers' URIs (not data: URIs), relative to it.
+std::vector<std::string> gltfBufferFiles(const std::string& gltf) {
+  std::vector<std::string> files;
+  try {
+    const nlohmann::json j = nlohmann::json::parse(io::readWholeFile(gltf));
+    for (const nlohmann::json& b : j.value("buffers", nlohmann::json::array()))
+      if (b.is_object() && b.contains("uri") && b["uri"].is_string() && b["uri"].get<std::string>().rfind("data:", 0) != 0)
+        files.push_back((fs::path(gltf).parent_path() / b["uri"].get<std::string>()).string());
+  } catch (...) {   // an input that cannot be read is said by its reader
+  }
+  return files;
+}
+
+}  // namespace
+
 void checkOutputPath(const std::string& out, const std::vector<std::string>& inputs) {
   std::error_code ec;
   // Fail before any work when the output cannot be written where asked.
@@ -140,6 +159,14 @@ void checkOutputPath(const std::string& out, const std::vector<std::string>& inp
     if (in.empty()) continue;
     if (fs::weakly_canonical(out, ec) == fs::weakly_canonical(in, ec) || (fs::exists(out, ec) && fs::equivalent(out, in, ec)))
       throw Error(ErrorKind::Input, out + ": output path is an input file; refusing to overwrite it");
+  }
+  // A .gltf writes NAME.bin beside it, which must not be an input either, nor an input .gltf's buffer.
+  if (io::lowerExtension(out) == ".gltf") {
+    std::vector<std::string> read = inputs;
+    for (const std::string& in : inputs)
+      if (io::lowerExtension(in) == ".gltf")
+        for (const std::string& f : gltfBufferFiles(in)) read.push_back(f);
+    checkOutputPath(fs::path(out).replace_extension(".bin").string(), read);
   }
 }
 
