@@ -207,6 +207,10 @@ TEST(Formats, GltfOutputNeverOverwritesAnInputsBuffer) {
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_EQ(r.err, "sffd: error: " + (dir / "a.bin").string() + ": output path is an input file; refusing to overwrite it\n");
   EXPECT_EQ(slurp(dir / "a.bin"), before);
+  // Nor may a file written after the output be its .bin (--stats overwrote it).
+  r = runSffd(job + (dir / "c.gltf").string() + " --stats " + (dir / "c.bin").string());
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "c.gltf"));
   EXPECT_EQ(runSffd(job + (dir / "b.gltf").string()).status, 0);
   fs::remove_all(dir);
 }

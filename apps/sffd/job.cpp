@@ -155,19 +155,20 @@ void checkOutputPath(const std::string& out, const std::vector<std::string>& inp
   if (dir.empty()) dir = ".";
   if (!fs::is_directory(dir, ec)) throw Error(ErrorKind::Input, out + ": cannot write: no such directory");
   if (fs::is_directory(out, ec)) throw Error(ErrorKind::Input, out + ": cannot write: is a directory");
-  for (const std::string& in : inputs) {
+  // A .gltf's files are its buffers too, and the NAME.bin sffd writes beside it (an output given as an input of
+  // a later file, as deform's --stats is checked against its -o).
+  std::vector<std::string> files = inputs;
+  for (const std::string& in : inputs)
+    if (io::lowerExtension(in) == ".gltf") {
+      files.push_back(fs::path(in).replace_extension(".bin").string());
+      for (const std::string& f : gltfBufferFiles(in)) files.push_back(f);
+    }
+  for (const std::string& in : files) {
     if (in.empty()) continue;
     if (fs::weakly_canonical(out, ec) == fs::weakly_canonical(in, ec) || (fs::exists(out, ec) && fs::equivalent(out, in, ec)))
       throw Error(ErrorKind::Input, out + ": output path is an input file; refusing to overwrite it");
   }
-  // A .gltf writes NAME.bin beside it, which must not be an input either, nor an input .gltf's buffer.
-  if (io::lowerExtension(out) == ".gltf") {
-    std::vector<std::string> read = inputs;
-    for (const std::string& in : inputs)
-      if (io::lowerExtension(in) == ".gltf")
-        for (const std::string& f : gltfBufferFiles(in)) read.push_back(f);
-    checkOutputPath(fs::path(out).replace_extension(".bin").string(), read);
-  }
+  if (io::lowerExtension(out) == ".gltf") checkOutputPath(fs::path(out).replace_extension(".bin").string(), files);
 }
 
 WrittenFiles::~WrittenFiles() {
