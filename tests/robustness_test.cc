@@ -411,6 +411,10 @@ TEST_F(Robust, OptionsAndOutputPathsAreChecked) {
     EXPECT_EQ(slurp(m), mBytes) << context;
     EXPECT_EQ(slurp(l), lBytes) << context;
   }
+  // --stats and --patches at one path: the patches were overwritten by the statistics.
+  Result sp = runSffd({"deform", m, "-l", l, "--tess", "2", "-o", out("o.obj"), "--patches", out("x.txt"), "--stats", out("x.txt")});
+  expectInputError(sp, out("x.txt") + ": output path is an input file", "--stats onto --patches");
+  expectNothingWritten("--stats onto --patches");
   // clip likewise: its --stats comes after its output.
   Result c = runSffd({"clip", m, "-l", l, "--backend", "cpu", "-o", out("c.obj"), "--stats", "/proc/sffd-robustness.json"});
   expectInputError(c, "/proc/sffd-robustness.json: cannot write", "clip --stats");

@@ -47,7 +47,7 @@ int run(const ParsedArgs& args) {
   if (args.has("--binary") && outExt != ".ply" && outExt != ".stl")
     throw Error(ErrorKind::Input, "--binary writes .ply and .stl, not '" + outExt + "'");
   checkOutputPath(out, {args.positional[0], args.get("--lattice")});
-  if (args.has("--stats")) checkOutputPath(args.get("--stats"), {args.positional[0], args.get("--lattice"), out});
+  if (args.has("--stats")) checkOutputPath(args.get("--stats"), {args.positional[0], args.get("--lattice"), out, args.get("--patches")});
   if (args.has("--patches")) {
     // Before any work: refused after it, the output was left written.
     if (methodOf(args.get("--method", "smooth")) != Method::Smooth) throw Error(ErrorKind::Input, "--patches needs --method smooth");
