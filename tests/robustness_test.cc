@@ -17,6 +17,7 @@
 #include <set>
 #include <sstream>
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -415,6 +416,13 @@ TEST_F(Robust, OptionsAndOutputPathsAreChecked) {
   Result sp = runSffd({"deform", m, "-l", l, "--tess", "2", "-o", out("o.obj"), "--patches", out("x.txt"), "--stats", out("x.txt")});
   expectInputError(sp, out("x.txt") + ": output path is an input file", "--stats onto --patches");
   expectNothingWritten("--stats onto --patches");
+  // An output that is no regular file (a FIFO; /dev/stdout through its link) is refused: renamed into place,
+  // the output removed it (as root, /dev/stdout itself) and wrote nothing there.
+  ASSERT_EQ(::mkfifo((dir_ / "fifo.json").c_str(), 0644), 0);
+  Result ff = runSffd({"deform", m, "-l", l, "--method", "classic", "-o", out("o.obj"), "--stats", (dir_ / "fifo.json").string()});
+  expectInputError(ff, (dir_ / "fifo.json").string() + ": cannot write: not a regular file", "FIFO");
+  expectNothingWritten("FIFO");
+  EXPECT_TRUE(fs::is_fifo(dir_ / "fifo.json"));
   // clip likewise: its --stats comes after its output.
   Result c = runSffd({"clip", m, "-l", l, "--backend", "cpu", "-o", out("c.obj"), "--stats", "/proc/sffd-robustness.json"});
   expectInputError(c, "/proc/sffd-robustness.json: cannot write", "clip --stats");

@@ -136,7 +136,7 @@ int run(const ParsedArgs& args) {
   std::vector<std::string> inputs = {args.get("--baseline"), fromFile && args.get("--cases") != "default" ? args.get("--cases") : ""};
   for (const Case& c : cases) inputs.insert(inputs.end(), {c.args.positional.at(0), c.args.get("--lattice")});
   for (const char* opt : {"--junit", "--json"})
-    if (args.has(opt)) checkOutputPath(args.get(opt), inputs);
+    if (args.has(opt)) checkOutputPath(args.get(opt), inputs, /*renamed=*/false);   // --json /dev/stdout is written
 
   // A --against folder is read before any work, so that a wrong one fails at once.
   std::vector<BackendRun> dumped = against ? readDump(args.get("--against"), cases) : std::vector<BackendRun>{};

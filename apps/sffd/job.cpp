@@ -148,13 +148,17 @@ std::vector<std::string> gltfBufferFiles(const std::string& gltf) {
 
 }  // namespace
 
-void checkOutputPath(const std::string& out, const std::vector<std::string>& inputs) {
+void checkOutputPath(const std::string& out, const std::vector<std::string>& inputs, bool renamed) {
   std::error_code ec;
   // Fail before any work when the output cannot be written where asked.
   fs::path dir = fs::path(out).parent_path();
   if (dir.empty()) dir = ".";
   if (!fs::is_directory(dir, ec)) throw Error(ErrorKind::Input, out + ": cannot write: no such directory");
   if (fs::is_directory(out, ec)) throw Error(ErrorKind::Input, out + ": cannot write: is a directory");
+  // Outputs are renamed into place: over a FIFO or a device (/dev/stdout, through its link) that would remove
+  // it, as root /dev's own entry, and write nothing where asked.
+  if (const fs::file_status st = fs::status(out, ec); renamed && fs::exists(st) && !fs::is_regular_file(st))
+    throw Error(ErrorKind::Input, out + ": cannot write: not a regular file (a FIFO or a device); give a file");
   // A .gltf's files are its buffers too, and the NAME.bin sffd writes beside it (an output given as an input of
   // a later file, as deform's --stats is checked against its -o).
   std::vector<std::string> files = inputs;
@@ -168,7 +172,7 @@ void checkOutputPath(const std::string& out, const std::vector<std::string>& inp
     if (fs::weakly_canonical(out, ec) == fs::weakly_canonical(in, ec) || (fs::exists(out, ec) && fs::equivalent(out, in, ec)))
       throw Error(ErrorKind::Input, out + ": output path is an input file; refusing to overwrite it");
   }
-  if (io::lowerExtension(out) == ".gltf") checkOutputPath(fs::path(out).replace_extension(".bin").string(), files);
+  if (io::lowerExtension(out) == ".gltf") checkOutputPath(fs::path(out).replace_extension(".bin").string(), files, renamed);
 }
 
 WrittenFiles::~WrittenFiles() {
@@ -176,6 +180,9 @@ WrittenFiles::~WrittenFiles() {
 }
 
 void WrittenFiles::add(const std::string& path) {
+  // Only a plain file: a report written through /dev/stdout (conform's, in place) is no file of the command's.
+  std::error_code ec;
+  if (!fs::is_regular_file(fs::symlink_status(path, ec))) return;
   paths_.push_back(path);
   if (io::lowerExtension(path) == ".gltf") paths_.push_back(fs::path(path).replace_extension(".bin").string());
 }
