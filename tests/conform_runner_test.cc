@@ -304,6 +304,14 @@ TEST(ConformRunner, ResultFilesAndFoldersAreCheckedBeforeTheRun) {
   EXPECT_EQ(j.status, 2) << j.err;
   EXPECT_EQ(j.err, "sffd: error: /proc/sffd-conform.json: cannot write\n");
   EXPECT_FALSE(fs::exists(dir / "j.xml"));
+  // Reports are written in place (/dev/stdout works); a write that fails is an error (into /dev/full the
+  // report was lost with exit status 0).
+  RunResult full = runSffd(job + " --json /dev/full");
+  EXPECT_EQ(full.status, 2) << full.err;
+  EXPECT_EQ(full.err, "sffd: error: /dev/full: cannot write: write failed (disk full?)\n");
+  RunResult out = runSffd(job + " --json /dev/stdout");
+  EXPECT_EQ(out.status, 0) << out.err;
+  EXPECT_TRUE(has(out.out, "\"format\": \"sffd-conform-results\"")) << out.out;
   RunResult r = runSffd(job + " --timeout 1e300");
   EXPECT_EQ(r.status, 0) << r.err;
   EXPECT_TRUE(has(r.out, "conform: PASS")) << r.out;
