@@ -38,6 +38,10 @@ TEST_F(CommandLine, UnexpectedAndMissingArgumentsAreNamed) {
   expectUsageError(runSffd("deform -l " + lattice_ + " -o " + out("o.obj")), "missing MESH (usage: sffd deform MESH");
   expectUsageError(runSffd("deform " + box_ + " -l -o " + out("o.obj")), "option --lattice needs a value (FILE), not the option '-o'");
   expectUsageError(runSffd("deform " + box_ + " -o " + out("o.obj") + " -l"), "option --lattice needs a value (FILE)");
+  // --stats where nothing writes it (animate) is an unknown option, as for render; it was taken and ignored.
+  expectUsageError(runSffd("animate " + box_ + " -l " + lattice_ + " -l " + lattice_ + " --frames 2 -o " + out("a.glb") + " --stats " +
+                           out("s.json")),
+                   "unknown option '--stats' for 'sffd animate'");
   // A negative number is a value, not an option.
   EXPECT_EQ(runSffd("lattice " + box_ + " -o " + out("x.json") + " --preset twist:-0.5 --margin 0.1 --quiet").status, 0);
   EXPECT_FALSE(fs::exists(dir_ / "o.obj"));
@@ -56,7 +60,7 @@ TEST_F(CommandLine, RepeatedSingleValuedOptionsAreRefused) {
 TEST_F(CommandLine, ListOptionsTakeOneValueOrThree) {
   for (const char* counts : {"7", "5,6,7"})
     EXPECT_EQ(runSffd("lattice " + box_ + " -o " + out("x.json") + " --counts " + counts + " --quiet").status, 0) << counts;
-  for (const char* bad : {"5,5", "5,5,5,5", "a", "5,,5"})
+  for (const char* bad : {"5,5", "5,5,5,5", "a", "5,,5", "5,5,5,", "5,", ",5"})
     expectUsageError(runSffd("lattice " + box_ + " -o " + out("x.json") + " --counts " + bad),
                      "option --counts needs one integer for all axes or three (U,V,W) like 5 or 5,6,7, not '" + std::string(bad) + "'");
   expectUsageError(runSffd("lattice " + box_ + " -o " + out("x.json") + " --degree 2,3"), "option --degree needs one integer for all axes or three");

@@ -163,6 +163,21 @@ TEST(ConformRunner, ChangedDumpFailsNamingTheFirstMismatchingElement) {
       EXPECT_EQ(res["first_mismatch"]["element"], element);
     }
   EXPECT_TRUE(found);
+  // A damaged dump is one input error line naming its file: a count past what the file holds was allocated
+  // ("out of memory", exit 1), a broken index was nlohmann's message (exit 1).
+  const fs::path index = dir / "d/cpu/cube2/buffers.json";
+  json idx = json::parse(slurp(index));
+  idx["buffers"][0]["count"] = uint64_t(1) << 50;
+  std::ofstream(index) << idx.dump();
+  r = runSffd(args + " --backends cpu --against " + (dir / "d").string());
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(r.err, "sffd: error: " + (dir / "d/cpu/cube2" / idx["buffers"][0]["file"].get<std::string>()).string() +
+                       ": shorter than its buffers.json says\n");
+  std::ofstream(index) << "{";
+  r = runSffd(args + " --backends cpu --against " + (dir / "d").string());
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(r.err.rfind("sffd: error: " + index.string() + ": not a --dump buffer index: ", 0), 0u) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   fs::remove_all(dir);
 }
 
@@ -244,6 +259,83 @@ TEST(ConformRunner, BadUsageIsExit2) {
   EXPECT_EQ(runSffd("conform " + kCube2 + " --cases default").status, 2);
   EXPECT_EQ(runSffd("conform " + kCube2 + " --timeout 0").status, 2);
   EXPECT_EQ(runSffd("conform " + kCube2 + " --backends cpu,vulkan --require gl-egl").status, 2);
+}
+
+// What conform writes and reads besides the job is checked before the run: the result files never
+// overwrite an input (they did: --junit MESH, --json LATTICE), a --dump that cannot be made and a damaged
+// --against manifest are one input error line (they were std::filesystem's and nlohmann's, exit 1, the
+// latter after every backend had run); and a huge --timeout waits (it was a Timeout at once).
+TEST(ConformRunner, ResultFilesAndFoldersAreCheckedBeforeTheRun) {
+  const fs::path dir = tempDir("conform_paths");
+  fs::copy_file(kData + "/cube2.obj", dir / "m.obj");
+  fs::copy_file(kData + "/lattices/cube2_twist.npy", dir / "l.npy");
+  std::ofstream(dir / "my.cases") << "c m.obj -l l.npy --tess 2\n";
+  std::ofstream(dir / "base.csv") << "c/pn.records cpu vs cpu,Fail\n";
+  std::ofstream(dir / "empty");
+  fs::create_directories(dir / "bad");
+  std::ofstream(dir / "bad" / "manifest.json") << "{\"cases\": 3}\n";
+  const std::string m = (dir / "m.obj").string(), l = (dir / "l.npy").string(), cases = (dir / "my.cases").string(),
+                    base = (dir / "base.csv").string();
+  const std::string before[] = {slurp(m), slurp(l), slurp(cases), slurp(base)};
+  const std::string job = "conform " + m + " -l " + l + " --backends cpu,cpu --tess 2 --quiet";
+  const std::pair<std::string, std::string> refused[] = {
+      {job + " --junit " + m, m + ": output path is an input file"},
+      {job + " --json " + l, l + ": output path is an input file"},
+      {"conform --cases " + cases + " --backends cpu,cpu --quiet --json " + cases, cases + ": output path is an input file"},
+      {job + " --baseline " + base + " --junit " + base, base + ": output path is an input file"},
+      {job + " --dump " + (dir / "empty").string(), (dir / "empty").string() + ": cannot make the dump folder"},
+      {job + " --against " + (dir / "bad").string() + " --dump " + (dir / "d").string(),
+       (dir / "bad" / "manifest.json").string() + ": not a --dump manifest"},
+  };
+  for (const auto& [args, message] : refused) {
+    RunResult r = runSffd(args);
+    EXPECT_EQ(r.status, 2) << args << "\n" << r.err;
+    EXPECT_EQ(r.err.rfind("sffd: error: " + message, 0), 0u) << args << "\n" << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << args << "\n" << r.err;
+    EXPECT_EQ(r.out, "") << args;   // refused before any backend ran
+  }
+  EXPECT_EQ(slurp(m), before[0]);
+  EXPECT_EQ(slurp(l), before[1]);
+  EXPECT_EQ(slurp(cases), before[2]);
+  EXPECT_EQ(slurp(base), before[3]);
+  EXPECT_FALSE(fs::exists(dir / "d"));
+  // A --json that cannot be written after the --junit was: neither is left.
+  RunResult j = runSffd(job + " --junit " + (dir / "j.xml").string() + " --json /proc/sffd-conform.json");
+  EXPECT_EQ(j.status, 2) << j.err;
+  EXPECT_EQ(j.err, "sffd: error: /proc/sffd-conform.json: cannot write\n");
+  EXPECT_FALSE(fs::exists(dir / "j.xml"));
+  // Reports are written in place (/dev/stdout works); a write that fails is an error (into /dev/full the
+  // report was lost with exit status 0).
+  RunResult full = runSffd(job + " --json /dev/full");
+  EXPECT_EQ(full.status, 2) << full.err;
+  EXPECT_EQ(full.err, "sffd: error: /dev/full: cannot write: write failed (disk full?)\n");
+  RunResult out = runSffd(job + " --json /dev/stdout");
+  EXPECT_EQ(out.status, 0) << out.err;
+  EXPECT_TRUE(has(out.out, "\"format\": \"sffd-conform-results\"")) << out.out;
+  RunResult r = runSffd(job + " --timeout 1e300");
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(has(r.out, "conform: PASS")) << r.out;
+  fs::remove_all(dir);
+}
+
+// Each backend writes a case's buffers to the folder named after the case: "." and ".." were accepted, and
+// ".." put every backend's buffers in one folder, so each backend was compared with the last one run: a
+// PASS whatever they computed. Refused in a case file; a mesh whose stem is one ("...obj") names its case "mesh".
+TEST(ConformRunner, CaseNamesAreFolderNames) {
+  const fs::path dir = tempDir("conform_case_names");
+  fs::copy_file(kData + "/cube2.obj", dir / "...obj");
+  fs::copy_file(kData + "/lattices/cube2_twist.npy", dir / "l.npy");
+  for (const char* name : {".", ".."}) {
+    std::ofstream(dir / "dot.cases") << name << " ...obj -l l.npy --tess 2\n";
+    RunResult r = runSffd("conform --cases " + (dir / "dot.cases").string() + " --backends cpu,cpu --quiet");
+    EXPECT_EQ(r.status, 2) << name << "\n" << r.err;
+    EXPECT_TRUE(has(r.err, "dot.cases:1: a case name has no / , \" < > & or spaces and is not . or ..")) << r.err;
+  }
+  RunResult r = runSffd("conform " + (dir / "...obj").string() + " -l " + (dir / "l.npy").string() +
+                        " --backends cpu,cpu --tess 2 --quiet --json " + (dir / "r.json").string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(json::parse(slurp(dir / "r.json"))["cases"][0]["name"], "mesh");
+  fs::remove_all(dir);
 }
 
 TEST(ConformRunner, DevicesJsonHasIdsAndDriverVersion) {

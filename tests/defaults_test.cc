@@ -36,6 +36,13 @@ TEST(Defaults, EdgeLengthDefaultIsInHelpAndStats) {
   EXPECT_DOUBLE_EQ(nlohmann::json::parse(slurp(dir / "b.json"))["edge_length"].get<double>(), 0.25);
   ASSERT_EQ(runSffd(run + (dir / "c.json").string() + " --method classic").status, 0);
   EXPECT_TRUE(nlohmann::json::parse(slurp(dir / "c.json"))["edge_length"].is_null());
+  // A mesh whose vertices all lie at one point has no extent to take a tenth of: it was refused with
+  // "--edge-length must be a positive number", an option never given.
+  std::ofstream(dir / "point.obj") << "v 1 1 1\nv 1 1 1\nv 1 1 1\nf 1 2 3\n";
+  RunResult point = runSffd("deform " + (dir / "point.obj").string() + " -l " + l + " --backend cpu --quiet -o " +
+                            (dir / "p.obj").string() + " --stats " + (dir / "p.json").string());
+  ASSERT_EQ(point.status, 0) << point.err;
+  EXPECT_DOUBLE_EQ(nlohmann::json::parse(slurp(dir / "p.json"))["edge_length"].get<double>(), 1.0);
   fs::remove_all(dir);
 }
 

@@ -21,6 +21,8 @@ const std::string kData = std::string(SFFD_TEST_DATA) + "/";
 
 using Result = sffd::test::RunResult;
 using sffd::test::runSffd;
+using sffd::test::slurp;
+using sffd::test::tempDir;
 
 void expectStats(const nlohmann::json& s) {
   for (const char* k : {"avg", "max", "std"}) {
@@ -101,4 +103,14 @@ TEST(ErrorCommand, HumanReadableSummaryAndBadOptions) {
   Result help = runSffd("error --help");
   EXPECT_EQ(help.status, 0);
   EXPECT_NE(help.out.find("--json"), std::string::npos);
+  // --stats FILE (a common option) writes --json's object there; it was taken and nothing written.
+  const fs::path dir = tempDir("error_stats");
+  const std::string stats = (dir / "s.json").string();
+  Result summary = runSffd("error " + kCube + " --method accurate --quiet --tess 3 --stats " + stats);
+  ASSERT_EQ(summary.status, 0) << summary.err;
+  EXPECT_EQ(summary.out, r.out);
+  Result json = runSffd("error " + kCube + " --method accurate --quiet --tess 3 --json");
+  ASSERT_EQ(json.status, 0) << json.err;
+  EXPECT_EQ(slurp(stats), json.out);
+  fs::remove_all(dir);
 }

@@ -195,5 +195,58 @@ TEST(Formats, AnimateFramesEqualSeparateDeforms) {
   fs::remove_all(dir);
 }
 
+// A .gltf writes NAME.bin beside it: where that is the buffer an input .gltf reads, the output is refused
+// (it overwrote the buffer, and the input could not be read again).
+TEST(Formats, GltfOutputNeverOverwritesAnInputsBuffer) {
+  const fs::path dir = tempDir("formats_gltf_buffer");
+  ASSERT_EQ(runSffd("deform " + kSphere + " --method classic -o " + (dir / "a.gltf").string()).status, 0);
+  fs::copy_file(dir / "a.gltf", dir / "in.gltf");   // reads a.bin
+  const std::string before = slurp(dir / "a.bin");
+  const std::string job = "deform " + (dir / "in.gltf").string() + " -l " + kData + "/lattices/sphere_twist.npy --backend cpu --quiet -o ";
+  RunResult r = runSffd(job + (dir / "a.gltf").string());
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(r.err, "sffd: error: " + (dir / "a.bin").string() + ": output path is an input file; refusing to overwrite it\n");
+  EXPECT_EQ(slurp(dir / "a.bin"), before);
+  // Nor may a file written after the output be its .bin (--stats overwrote it).
+  r = runSffd(job + (dir / "c.gltf").string() + " --stats " + (dir / "c.bin").string());
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "c.gltf"));
+  EXPECT_EQ(runSffd(job + (dir / "b.gltf").string()).status, 0);
+  fs::remove_all(dir);
+}
+
+// A frame that cannot be written leaves nothing: the numbered frames written before it went too (they were
+// left), and a glTF is never written with values its floats cannot hold (it was, with infinities: Khronos'
+// validator refused it, sffd said nothing), nor with key times past a float (a tiny --fps).
+TEST(Formats, AnimateLeavesNothingWhenAFrameCannotBeWritten) {
+  const fs::path dir = tempDir("formats_animate_fail");
+  writeBoxObj(dir / "box.obj", 0, 0, 0, 1);
+  const std::string box = (dir / "box.obj").string(), l0 = (dir / "l0.json").string(), far = (dir / "far.json").string();
+  ASSERT_EQ(runSffd("lattice " + box + " --quiet -o " + l0).status, 0);
+  ASSERT_EQ(runSffd("lattice " + box + " --quiet -o " + far + " --preset noise:1e300").status, 0);
+  const std::string job = "animate " + box + " -l " + l0 + " -l " + far + " --frames 3 --backend cpu --method classic --quiet -o ";
+  auto expectRefused = [&](const RunResult& r, const std::string& what) {
+    EXPECT_EQ(r.status, 2) << what << "\n" << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << what << "\n" << r.err;
+    for (const auto& f : fs::directory_iterator(dir))
+      if (f.path().extension() != ".obj" && f.path().extension() != ".json") {
+        ADD_FAILURE() << what << ": left " << f.path();
+        fs::remove(f.path());
+      }
+  };
+  expectRefused(runSffd(job + (dir / "f_%d.ply").string()), "numbered frames");   // frame 0 is fine, frame 1 not finite
+  expectRefused(runSffd(job + (dir / "a.glb").string()), "glTF");
+  // A double result past a float's range: finite in the other formats, not in glTF's floats.
+  ASSERT_EQ(runSffd("lattice " + box + " --quiet -o " + far + " --preset bend:1e300").status, 0);
+  RunResult r = runSffd("deform " + box + " -l " + far + " --backend cpu --method classic --precision double --quiet -o " +
+                        (dir / "b.glb").string());
+  EXPECT_NE(r.err.find("b.glb: not written: vertex 0 is not finite or beyond the range of glTF's floats"), std::string::npos) << r.err;
+  expectRefused(r, "double result as glTF");
+  r = runSffd("animate " + box + " -l " + l0 + " -l " + l0 + " --frames 3 --fps 1e-300 --backend cpu --quiet -o " + (dir / "t.glb").string());
+  EXPECT_NE(r.err.find("--fps 1e-300 puts the last frame past the seconds a glTF key time (a float) holds"), std::string::npos) << r.err;
+  expectRefused(r, "tiny --fps");
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace sffd::test

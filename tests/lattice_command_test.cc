@@ -100,6 +100,9 @@ TEST(LatticeCommand, RefusesWithOneLineAndWritesNothing) {
       {"--from " + base.string() + " -o " + (dir / "x.json").string() + " --refine 0", "1..64 parts"},
       {"--from " + base.string() + " -o " + (dir / "x.json").string() + " --refine 2,2", "one integer for all axes or three"},
       {"--from " + base.string() + " -o " + (dir / "x.json").string() + " --counts 3", "with --from the lattice's own is kept"},
+      // Ignored before: the lattice's own degree kept, nothing normalised.
+      {"--from " + base.string() + " -o " + (dir / "x.json").string() + " --degree 3", "keeps its own (--elevate raises it)"},
+      {"--from " + base.string() + " -o " + (dir / "x.json").string() + " --normalize 0.5", "none is given"},
       {"--from " + base.string() + " -o " + (dir / "x.prm").string(), "one Bezier box"},
       {"--from " + npy + " -o " + (dir / "x.json").string(), "give the MESH it belongs to"},
       {"-o " + (dir / "x.json").string(), "needs a MESH"},

@@ -167,6 +167,29 @@ TEST(MemoryLimit, SmoothJobAboveTheLimitIsRefusedWithTheEstimate) {
 // The streamed estimate (--stats host_memory_estimate) bounds the peak RSS: 20,000 triangles in order and
 // shuffled (the weld's front most of the mesh), at levels 3 and 8 and a shorter edge length, and a box whose
 // faces are pre-split, on the CPU device and Vulkan.
+// animate into a glTF keeps every frame: checked against the limit after frame 0 (it was not: 10,000 frames
+// of a small smooth job asked for about 66 GiB, and the estimate's 100 frames peaked at 785 MB under a 300M
+// limit). Numbered files hold one frame at a time and run under the same limit.
+TEST(MemoryLimit, AnimationFramesKeptForGltfAreEstimated) {
+  fs::path dir = tempDir("memory_limit_animate");
+  writeBoxObj(dir / "box.obj", 0, 0, 0, 0.5);
+  const std::string box = (dir / "box.obj").string(), l0 = (dir / "l0.json").string(), l1 = (dir / "l1.json").string();
+  ASSERT_EQ(runSffd("lattice " + box + " -o " + l0 + " --quiet").status, 0);
+  ASSERT_EQ(runSffd("lattice " + box + " -o " + l1 + " --preset twist:0.3 --quiet").status, 0);
+  const std::string job = "animate " + box + " -l " + l0 + " -l " + l1 + " --backend cpu --tess 4 --quiet --frames ";
+  RunResult r = runSffd(job + "2000 -o " + (dir / "a.glb").string(), "SFFD_MEMORY_LIMIT=64M");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(r.err.rfind("sffd: error: the 2000 frames of " + (dir / "a.glb").string() + " need about ", 0), 0u) << r.err;
+  EXPECT_NE(r.err.find("more than the limit of 64.00 MiB (SFFD_MEMORY_LIMIT); use fewer --frames"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "a.glb"));
+  r = runSffd(job + "3 -o " + (dir / "a.glb").string(), "SFFD_MEMORY_LIMIT=64M");
+  EXPECT_EQ(r.status, 0) << r.err;
+  r = runSffd(job + "200 -o " + (dir / "f_%d.ply").string(), "SFFD_MEMORY_LIMIT=64M");
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir / "f_199.ply"));
+  fs::remove_all(dir);
+}
+
 TEST(MemoryLimit, StreamedEstimateBoundsThePeak) {
   fs::path dir = tempDir("memory_limit_streamed_peak");
   writeSphereObj(dir / "s.obj", 71, false);

@@ -29,5 +29,27 @@ TEST(NonFinite, ResultsAreRefusedBeforeWriting) {
   fs::remove_all(dir);
 }
 
+// A result finite in double but past float's range: the text formats hold it, a binary STL (floats) is
+// refused like a non-finite result. It held infinities, which sffd itself refused to read back.
+TEST(NonFinite, DoubleResultsPastFloatAreRefusedByBinaryStl) {
+  fs::path dir = tempDir("nonfinite_stl");
+  const std::string mesh = std::string(SFFD_TEST_DATA) + "/sphere.obj", lattice = (dir / "l.json").string();
+  ASSERT_EQ(runSffd("lattice " + mesh + " -o " + lattice + " --quiet").status, 0);
+  nlohmann::json L = nlohmann::json::parse(slurp(lattice));
+  L["control_points"][62] = {1e300, 0, 0};
+  std::ofstream(dir / "far.json") << L.dump();
+  const std::string job = "deform " + mesh + " -l " + (dir / "far.json").string() + " --backend cpu --precision double --quiet -o ";
+  for (const char* method : {" --method classic", " --method smooth --tess 2"}) {   // gathered, streamed
+    RunResult text = runSffd(job + (dir / "t.stl").string() + method);
+    EXPECT_EQ(text.status, 0) << method << ": " << text.err;
+    const std::string out = (dir / "b.stl").string();
+    RunResult r = runSffd(job + out + " --binary" + method);
+    EXPECT_EQ(r.status, 2) << method << ": " << r.err;
+    EXPECT_EQ(r.err.rfind("sffd: error: " + out + ": not written: vertex ", 0), 0u) << r.err;
+    EXPECT_FALSE(fs::exists(out)) << method;
+  }
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace sffd::test

@@ -17,6 +17,7 @@
 #include <set>
 #include <sstream>
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -387,11 +388,18 @@ TEST_F(Robust, OptionsAndOutputPathsAreChecked) {
       {{"-o", (dir_ / "sym.obj").string()}, (dir_ / "sym.obj").string() + ": output path is an input"},
       {{"-o", l}, l + ": output path is an input"},
       {{"-o", out("o.obj"), "--stats", m}, m + ": output path is an input"},
+      {{"-o", out("o.obj"), "--patches", out("p.txt")}, "--patches needs --method smooth"},   // o.obj was left written
+      // A --stats that cannot be written once the output is: the output goes (it stayed), a .gltf's .bin too.
+      {{"-o", out("o.obj"), "--stats", "/proc/sffd-robustness.json"}, "/proc/sffd-robustness.json: cannot write"},
+      {{"-o", out("o.gltf"), "--stats", "/proc/sffd-robustness.json"}, "/proc/sffd-robustness.json: cannot write"},
       {{"-o", (dir_ / "file" / "o.obj").string()}, (dir_ / "file" / "o.obj").string() + ": cannot write"},
       {{"-o", (dir_ / "no" / "such" / "o.obj").string()}, (dir_ / "no" / "such" / "o.obj").string() + ": cannot write"},
       {{"-o", (dir_ / "out").string() + "/"}, ""},
       {{"-o", out("o.xyz")}, out("o.xyz") + ": cannot write mesh format"},
       {{"-o", "/proc/sffd-robustness.obj"}, "/proc/sffd-robustness.obj: cannot write"},
+      // Longer than a file name may be: an exit status 1 and a raw std::filesystem message once.
+      {{"-o", out(std::string(300, 'n') + ".obj")}, out(std::string(300, 'n') + ".obj") + ": cannot write: File name too long"},
+      {{"-o", out(std::string(300, 'n') + ".ply")}, out(std::string(300, 'n') + ".ply") + ": cannot write"},
   };
   for (const Case& c : cases) {
     std::vector<std::string> args = base;
@@ -404,6 +412,21 @@ TEST_F(Robust, OptionsAndOutputPathsAreChecked) {
     EXPECT_EQ(slurp(m), mBytes) << context;
     EXPECT_EQ(slurp(l), lBytes) << context;
   }
+  // --stats and --patches at one path: the patches were overwritten by the statistics.
+  Result sp = runSffd({"deform", m, "-l", l, "--tess", "2", "-o", out("o.obj"), "--patches", out("x.txt"), "--stats", out("x.txt")});
+  expectInputError(sp, out("x.txt") + ": output path is an input file", "--stats onto --patches");
+  expectNothingWritten("--stats onto --patches");
+  // An output that is no regular file (a FIFO; /dev/stdout through its link) is refused: renamed into place,
+  // the output removed it (as root, /dev/stdout itself) and wrote nothing there.
+  ASSERT_EQ(::mkfifo((dir_ / "fifo.json").c_str(), 0644), 0);
+  Result ff = runSffd({"deform", m, "-l", l, "--method", "classic", "-o", out("o.obj"), "--stats", (dir_ / "fifo.json").string()});
+  expectInputError(ff, (dir_ / "fifo.json").string() + ": cannot write: not a regular file", "FIFO");
+  expectNothingWritten("FIFO");
+  EXPECT_TRUE(fs::is_fifo(dir_ / "fifo.json"));
+  // clip likewise: its --stats comes after its output.
+  Result c = runSffd({"clip", m, "-l", l, "--backend", "cpu", "-o", out("c.obj"), "--stats", "/proc/sffd-robustness.json"});
+  expectInputError(c, "/proc/sffd-robustness.json: cannot write", "clip --stats");
+  expectNothingWritten("clip --stats");
   EXPECT_TRUE(fs::is_symlink(dir_ / "sym.obj"));
   EXPECT_FALSE(fs::exists(dir_ / "file" / "o.obj"));
   EXPECT_FALSE(fs::exists("/proc/sffd-robustness.obj"));
@@ -417,6 +440,13 @@ TEST_F(Robust, OptionsAndOutputPathsAreChecked) {
   r = runSffd({"deform", m, "-l", l, "--method", "classic", "--tess", "64", "--edge-length", "0.5", "-o", out("o.obj"), "--quiet"});
   EXPECT_EQ(r.status, 0) << r.err;
   EXPECT_TRUE(fs::exists(out("o.obj")));
+  // A name of the longest length a file may have (255 bytes) is written: its temporary beside it was longer.
+  for (const char* ext : {".obj", ".ply"}) {
+    const std::string longest = out(std::string(255 - 4, 'n') + ext);
+    r = runSffd({"deform", m, "-l", l, "-o", longest, "--quiet"});
+    EXPECT_EQ(r.status, 0) << ext << "\n" << r.err;
+    EXPECT_TRUE(fs::exists(longest)) << ext;
+  }
 }
 
 // A job above the memory limit is refused before the GPU work, with the numbers.

@@ -13,10 +13,15 @@ TEST(Usage, VersionIsTheLibrarysVersion) {
   EXPECT_EQ(r.status, 0);
   EXPECT_EQ(r.out, "sffd " + std::to_string(SFFD_VERSION_MAJOR) + "." + std::to_string(SFFD_VERSION_MINOR) + "." +
                        std::to_string(SFFD_VERSION_PATCH) + "\n");
+  // An argument it does not take is named, as every command's is (it was ignored).
+  RunResult extra = runSffd("--version extra");
+  EXPECT_EQ(extra.status, 2);
+  EXPECT_EQ(extra.out, "");
+  EXPECT_EQ(extra.err, "sffd: error: unexpected argument 'extra' (usage: sffd --version)\n");
 }
 
 TEST(Usage, HelpCommandEqualsTheCommandsHelpOption) {
-  for (const char* c : {"deform", "lattice", "devices", "conform", "clip", "error", "render", "bench", "view"}) {
+  for (const char* c : {"deform", "lattice", "devices", "conform", "clip", "error", "render", "bench", "animate", "view"}) {
     RunResult a = runSffd(std::string("help ") + c), b = runSffd(std::string(c) + " --help");
     EXPECT_EQ(a.status, 0) << c;
     EXPECT_FALSE(a.out.empty()) << c;
@@ -25,6 +30,7 @@ TEST(Usage, HelpCommandEqualsTheCommandsHelpOption) {
   RunResult all = runSffd("help");
   EXPECT_EQ(all.status, 0);
   EXPECT_EQ(all.out, runSffd("--help").out);
+  EXPECT_EQ(runSffd("help help").out, all.out);   // help's own help (it was "unknown command 'help'")
   RunResult bad = runSffd("help nosuch");
   EXPECT_EQ(bad.status, 2);
   EXPECT_EQ(bad.err, "sffd: error: unknown command 'nosuch' (sffd --help lists them)\n");

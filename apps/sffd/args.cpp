@@ -158,15 +158,20 @@ std::array<int, 3> ParsedArgs::getTriple(const std::string& name, std::array<int
   auto it = values.find(name);
   if (it == values.end()) return fallback;
   std::array<int, 3> r{};
-  std::stringstream ss(it->second);
-  std::string part;
+  const std::string& s = it->second;
   int n = 0;
-  while (std::getline(ss, part, ',')) {
+  // Every part between commas must be an integer, an empty last one too ("5,5,5," and "5," are refused).
+  for (size_t start = 0;;) {
+    const size_t comma = s.find(',', start), end = comma == std::string::npos ? s.size() : comma;
     int v = 0;
-    auto [p, ec] = std::from_chars(part.data(), part.data() + part.size(), v);
-    if (n >= 3 || ec != std::errc() || p != part.data() + part.size()) n = 4;
-    if (n >= 3) break;
+    auto [p, ec] = std::from_chars(s.data() + start, s.data() + end, v);
+    if (n >= 3 || ec != std::errc() || p != s.data() + end) {
+      n = 4;
+      break;
+    }
     r[n++] = v;
+    if (comma == std::string::npos) break;
+    start = comma + 1;
   }
   // The one rule of list options (docs/CLI.md): one value for every axis, or exactly three.
   if (n == 1) r = {r[0], r[0], r[0]};

@@ -72,8 +72,25 @@ std::string normalsAgainstWindingWarning(const Mesh& mesh, const std::string& pa
 void normalizeMesh(Mesh& mesh, double scale);
 void meshBounds(const Mesh& mesh, glm::dvec3& lo, glm::dvec3& hi);
 
-// Refuses an output path that is one of the inputs (nothing is ever written over an input).
-void checkOutputPath(const std::string& out, const std::vector<std::string>& inputs);
+// Refuses an output path that is one of the inputs (nothing is ever written over an input), and, for an
+// output `renamed` into place (every writer's but conform's reports, written in place), an existing one that
+// is no regular file.
+void checkOutputPath(const std::string& out, const std::vector<std::string>& inputs, bool renamed = true);
+
+// The files a command has written so far, removed again when it fails before keep() (a later file that
+// cannot be written, a later frame that fails): a failed command leaves nothing, not even whole files.
+class WrittenFiles {
+ public:
+  WrittenFiles() = default;
+  WrittenFiles(const WrittenFiles&) = delete;
+  WrittenFiles& operator=(const WrittenFiles&) = delete;
+  ~WrittenFiles();
+  void add(const std::string& path);   // a .gltf's .bin beside it too
+  void keep() { paths_.clear(); }
+
+ private:
+  std::vector<std::string> paths_;
+};
 
 // Opens the device the options ask for (--backend, --device), printing fallback notes unless --quiet.
 Device openDeviceFromArgs(const ParsedArgs& args);

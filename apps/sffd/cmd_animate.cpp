@@ -4,11 +4,13 @@
 // numbered mesh files.
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include <sffd/error.h>
 
 #include "apps/sffd/cli.h"
 #include "apps/sffd/deform_job.h"
+#include "core/job_budget.h"
 #include "io/gltf_io.h"
 #include "io/io_util.h"
 
@@ -55,6 +57,9 @@ int run(const ParsedArgs& args) {
   const double fps = args.getDouble("--fps", 24.0);
   if (!std::isfinite(fps) || !(fps > 0) || fps > 1000) throw Error(ErrorKind::Input, "--fps must be a number in (0, 1000]");
   const bool numbered = isFramePattern(out);
+  // glTF keeps the key times as floats: the last frame's, (N-1)/F seconds, must be one.
+  if (!numbered && !(double(frames - 1) / fps <= std::numeric_limits<float>::max()))
+    throw Error(ErrorKind::Input, "--fps " + args.get("--fps") + " puts the last frame past the seconds a glTF key time (a float) holds");
   const std::string ext = io::lowerExtension(out);
   if (!numbered && ext != ".glb" && ext != ".gltf")
     throw Error(ErrorKind::Input, "-o must name a .glb or .gltf file, or numbered files such as frame_%04d.ply");
@@ -74,16 +79,28 @@ int run(const ParsedArgs& args) {
   Device device = openDeviceFromArgs(args);
   DeformRun run = runDeformJob(args, job, device);   // the pre-compute, and frame 0 (the first key)
   const MeshWriteOptions write{.significantDigits = run.deformer.resultDigits(), .binary = args.has("--binary")};
+  // A glTF keeps every frame, and its buffer them again as floats: frame 0's size, `frames` times, must fit
+  // before the others are made (10,000 frames of a smooth cube took 80 GB).
+  if (!numbered)
+    checkKeptFits(run.deformer, uint64_t(frames) * (meshHeldBytes(run.mesh) + 6 * sizeof(float) * run.mesh.positions.size()),
+                  "the " + std::to_string(frames) + " frames of " + out,
+                  "use fewer --frames, or numbered files (frame_%04d.ply), written one at a time");
   std::vector<Mesh> meshes;
+  WrittenFiles written;   // numbered frames: removed again when a later one fails
   for (int f = 0; f < frames; ++f) {
     if (f > 0) {
       run.deformer.deform(frameLattice(keys, f, frames));
       run.mesh = run.deformer.result();
     }
-    if (numbered) writeMesh(frameName(out, f), run.mesh, write);
-    else meshes.push_back(std::move(run.mesh));
+    if (numbered) {
+      writeMesh(frameName(out, f), run.mesh, write);
+      written.add(frameName(out, f));
+    } else {
+      meshes.push_back(std::move(run.mesh));
+    }
   }
   if (!numbered) meshio::writeGltfAnimation(out, meshes, fps);
+  written.keep();
   note(args, "wrote " + (numbered ? std::to_string(frames) + " frames " + out : out + " (" + std::to_string(frames) + " frames)") + " (" +
                  device.label() + ", " + device.info().name + ")");
   return 0;
@@ -94,7 +111,9 @@ int run(const ParsedArgs& args) {
 CommandSpec animateCommand() {
   CommandSpec c{"animate", "MESH -l L0 -l L1 [-l L2 ...] --frames N -o OUT [options]",
                 "Deforms a mesh by lattices interpolated frame by frame: a glTF animation or numbered mesh files.",
-                jobOptions(), run, 1, 1};
+                {}, run, 1, 1};
+  for (const OptionSpec& o : jobOptions())
+    if (std::string(o.name) != "--stats") c.options.push_back(o);   // no run statistics are written
   for (OptionSpec& o : c.options)
     if (std::string(o.name) == "--lattice|-l") {
       o.help = "a key lattice (give two or more, same structure; .json, .prm or .npy)";

@@ -97,6 +97,8 @@ int run(const ParsedArgs& args) {
   double clipMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - tc).count();
   Mesh result = subTriangleMesh(subs, args.has("--flat"));
   writeMesh(out, result, variant.f64 ? 17 : 9);
+  WrittenFiles written;   // a --stats that cannot be written takes the output away again
+  written.add(out);
 
   if (args.has("--stats")) {
     std::vector<std::array<glm::dvec3, 3>> flatTris;
@@ -130,6 +132,7 @@ int run(const ParsedArgs& args) {
     std::string text = j.dump(1) + "\n";
     writeFileAtomically(args.get("--stats"), [&](std::ostream& o) { o << text; });
   }
+  written.keep();
   note(args, "wrote " + out + " (" + std::to_string(subs.size()) + " sub-triangles, " + clip + " clipping, " + device.label() + ")");
   return 0;
 }

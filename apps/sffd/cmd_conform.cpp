@@ -16,6 +16,7 @@
 #include <sffd/sffd.h>
 
 #include "apps/sffd/conform.h"
+#include "io/io_util.h"
 
 namespace sffd::cli {
 namespace {
@@ -69,7 +70,7 @@ void writeManifest(const fs::path& dir, const std::vector<Case>& cases, const st
 }
 
 // The dumped backends as runs: the same cases (by name), their inputs checked against the dump's hashes.
-std::vector<BackendRun> readDump(const fs::path& dir, const std::vector<Case>& cases) {
+std::vector<BackendRun> readDump(const fs::path& dir, const std::vector<Case>& cases) try {
   std::ifstream in(dir / "manifest.json");
   if (!in) throw Error(ErrorKind::Input, (dir / "manifest.json").string() + ": cannot read (is it a --dump folder?)");
   json m = json::parse(in);
@@ -106,6 +107,8 @@ std::vector<BackendRun> readDump(const fs::path& dir, const std::vector<Case>& c
   }
   if (runs.empty()) throw Error(ErrorKind::Input, dir.string() + ": the dump holds no backend");
   return runs;
+} catch (const json::exception& e) {   // a damaged or foreign manifest: unreadable JSON, a field missing or of another type
+  throw Error(ErrorKind::Input, (dir / "manifest.json").string() + ": not a --dump manifest: " + io::oneLine(e.what()));
 }
 
 int run(const ParsedArgs& args) {
@@ -129,17 +132,24 @@ int run(const ParsedArgs& args) {
   if (!(options.timeoutSeconds > 0)) throw Error(ErrorKind::Input, "--timeout must be a number of seconds > 0");
   options.deviceSubstring = args.get("--device");
   const std::vector<Case> cases = fromFile ? readCases(args.get("--cases"), dataDir()) : std::vector<Case>{caseFromArgs(args)};
+  // The result files must not overwrite what the run reads.
+  std::vector<std::string> inputs = {args.get("--baseline"), fromFile && args.get("--cases") != "default" ? args.get("--cases") : ""};
+  for (const Case& c : cases) inputs.insert(inputs.end(), {c.args.positional.at(0), c.args.get("--lattice")});
   for (const char* opt : {"--junit", "--json"})
-    if (args.has(opt)) checkOutputPath(args.get(opt), {});
+    if (args.has(opt)) checkOutputPath(args.get(opt), inputs, /*renamed=*/false);   // --json /dev/stdout is written
 
+  // A --against folder is read before any work, so that a wrong one fails at once.
+  std::vector<BackendRun> dumped = against ? readDump(args.get("--against"), cases) : std::vector<BackendRun>{};
   // The children write the buffers under the dump folder, or a temporary one removed at the end.
   fs::path root;
   if (args.has("--dump")) {
     root = args.get("--dump");
-    std::error_code ec;
-    if (fs::exists(root) && !fs::is_empty(root, ec))
+    std::error_code ec, made;
+    if (fs::exists(root, ec) && !fs::is_empty(root, ec))
       throw Error(ErrorKind::Input, root.string() + ": the dump folder exists and is not empty");
-    fs::create_directories(root);
+    fs::create_directories(root, made);
+    if (!fs::is_directory(root, ec))
+      throw Error(ErrorKind::Input, root.string() + ": cannot make the dump folder: " + (made ? made.message() : "not a folder"));
   } else {
     std::string tmpl = (fs::temp_directory_path() / "sffd_conform_XXXXXX").string();
     if (!::mkdtemp(tmpl.data())) throw Error(ErrorKind::Internal, "cannot create a temporary folder");
@@ -166,7 +176,7 @@ int run(const ParsedArgs& args) {
   std::vector<std::pair<size_t, size_t>> pairs;
   const size_t live = runs.size();
   if (against) {
-    for (BackendRun& d : readDump(args.get("--against"), cases)) runs.push_back(std::move(d));
+    for (BackendRun& d : dumped) runs.push_back(std::move(d));
     for (size_t i = 0; i < live; ++i) {
       size_t before = pairs.size();
       for (size_t j = live; j < runs.size(); ++j)
@@ -181,8 +191,13 @@ int run(const ParsedArgs& args) {
   std::vector<Result> results = compareRuns(cases, runs, pairs);
   if (args.has("--baseline")) applyBaseline(results, args.get("--baseline"));
   printText(results, fromFile);
-  if (args.has("--junit")) writeJunit(args.get("--junit"), results);
+  WrittenFiles written;   // a --json that cannot be written takes the --junit away again
+  if (args.has("--junit")) {
+    writeJunit(args.get("--junit"), results);
+    written.add(args.get("--junit"));
+  }
   if (args.has("--json")) writeJson(args.get("--json"), cases, runs, results);
+  written.keep();
   bool pass = true;
   for (const Result& r : results) pass = pass && !isFailure(r.status);
   std::printf("conform: %s\n", pass ? "PASS" : "FAIL");

@@ -87,7 +87,10 @@ Case caseFromArgs(const ParsedArgs& args) {
     argv.push_back(name);
     if (o.value) argv.push_back(args.get(name));
   }
-  return makeCase(fs::path(args.positional[0]).stem().string(), argv);
+  // The mesh's stem names the case, unless it is no folder name ("...obj": "..", whose buffers would land in the
+  // folder above the backend's, where every backend's are the same files).
+  const std::string stem = fs::path(args.positional[0]).stem().string();
+  return makeCase(stem.empty() || stem == "." || stem == ".." ? "mesh" : stem, argv);
 }
 
 std::vector<Case> readCases(const std::string& spec, const std::string& dataDir) {
@@ -105,8 +108,9 @@ std::vector<Case> readCases(const std::string& spec, const std::string& dataDir)
     if (words.size() < 2) throw inputError(file.string(), n, "a case is NAME MESH -l LATTICE [options]");
     for (const Case& c : cases)
       if (c.name == words[0]) throw inputError(file.string(), n, "case '" + words[0] + "' is named twice");
-    if (words[0].find_first_of("/,\"<>& ") != std::string::npos)
-      throw inputError(file.string(), n, "a case name has no / , \" < > & or spaces");
+    // A case's buffers go to the folder named after it in each backend's: "." and ".." would be the same for all.
+    if (words[0].find_first_of("/,\"<>& ") != std::string::npos || words[0] == "." || words[0] == "..")
+      throw inputError(file.string(), n, "a case name has no / , \" < > & or spaces and is not . or ..");
     // Paths are relative to the case file: the mesh and the lattice.
     auto resolve = [&](std::string& p) { if (fs::path(p).is_relative()) p = (file.parent_path() / p).lexically_normal().string(); };
     std::vector<std::string> argv(words.begin() + 1, words.end());

@@ -2,7 +2,9 @@
 // the reports: the contract's text lines, JUnit XML and JSON (docs/CLI.md, docs/CONFORMANCE.md).
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
+#include <functional>
 #include <set>
 #include <sstream>
 
@@ -190,10 +192,18 @@ std::string xml(const std::string& s) {
   return o;
 }
 
-std::ofstream openReport(const std::string& path) {
+// Reports are written in place (--json /dev/stdout works): a write that fails is an error, and a plain file
+// it left half-written goes (into /dev/full the report was lost without a word, exit 0).
+void writeReport(const std::string& path, const std::function<void(std::ostream&)>& write) {
   std::ofstream f(path);
   if (!f) throw Error(ErrorKind::Input, path + ": cannot write");
-  return f;
+  write(f);
+  f.flush();
+  if (f) return;
+  f.close();
+  std::error_code ec;
+  if (fs::is_regular_file(fs::symlink_status(path, ec))) fs::remove(path, ec);
+  throw Error(ErrorKind::Input, path + ": cannot write: write failed (disk full?)");
 }
 
 json numberOrNull(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
@@ -216,30 +226,31 @@ void writeJunit(const std::string& path, const std::vector<Result>& results) {
   auto failure = [](Status s) { return s == Status::Fail || s == Status::UnexpectedPass; };
   auto error = [](Status s) { return s == Status::Crash || s == Status::Timeout; };
   auto skipped = [](Status s) { return s == Status::Skip; };
-  std::ofstream f = openReport(path);
-  f << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<testsuites name=\"sffd conform\" tests=\"" << results.size() << "\">\n";
-  for (const std::string& c : order) {
-    const auto& rs = byCase[c];
-    f << " <testsuite name=\"" << xml(c) << "\" tests=\"" << rs.size() << "\" failures=\"" << count(rs, failure)
-      << "\" errors=\"" << count(rs, error) << "\" skipped=\"" << count(rs, skipped) << "\">\n";
-    for (const Result* r : rs) {
-      f << "  <testcase classname=\"sffd.conform." << xml(c) << "\" name=\"" << xml(r->buffer + "/" + r->a + "-vs-" + r->b)
-        << "\"";
-      const std::string m = xml(r->message);
-      if (failure(r->status))
-        f << ">\n   <failure type=\"" << statusName(r->status) << "\" message=\"" << m << "\">" << m << "</failure>\n  </testcase>\n";
-      else if (error(r->status))
-        f << ">\n   <error type=\"" << statusName(r->status) << "\" message=\"" << m << "\">" << m << "</error>\n  </testcase>\n";
-      else if (skipped(r->status))
-        f << ">\n   <skipped message=\"" << m << "\"/>\n  </testcase>\n";
-      else if (r->status == Status::ExpectedFail)
-        f << ">\n   <system-out>ExpectedFail: " << m << "</system-out>\n  </testcase>\n";
-      else
-        f << "/>\n";
+  writeReport(path, [&](std::ostream& f) {
+    f << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<testsuites name=\"sffd conform\" tests=\"" << results.size() << "\">\n";
+    for (const std::string& c : order) {
+      const auto& rs = byCase[c];
+      f << " <testsuite name=\"" << xml(c) << "\" tests=\"" << rs.size() << "\" failures=\"" << count(rs, failure)
+        << "\" errors=\"" << count(rs, error) << "\" skipped=\"" << count(rs, skipped) << "\">\n";
+      for (const Result* r : rs) {
+        f << "  <testcase classname=\"sffd.conform." << xml(c) << "\" name=\"" << xml(r->buffer + "/" + r->a + "-vs-" + r->b)
+          << "\"";
+        const std::string m = xml(r->message);
+        if (failure(r->status))
+          f << ">\n   <failure type=\"" << statusName(r->status) << "\" message=\"" << m << "\">" << m << "</failure>\n  </testcase>\n";
+        else if (error(r->status))
+          f << ">\n   <error type=\"" << statusName(r->status) << "\" message=\"" << m << "\">" << m << "</error>\n  </testcase>\n";
+        else if (skipped(r->status))
+          f << ">\n   <skipped message=\"" << m << "\"/>\n  </testcase>\n";
+        else if (r->status == Status::ExpectedFail)
+          f << ">\n   <system-out>ExpectedFail: " << m << "</system-out>\n  </testcase>\n";
+        else
+          f << "/>\n";
+      }
+      f << " </testsuite>\n";
     }
-    f << " </testsuite>\n";
-  }
-  f << "</testsuites>\n";
+    f << "</testsuites>\n";
+  });
 }
 
 void writeJson(const std::string& path, const std::vector<Case>& cases, const std::vector<BackendRun>& runs,
@@ -282,7 +293,7 @@ void writeJson(const std::string& path, const std::vector<Case>& cases, const st
     if (!r.message.empty()) o["message"] = r.message;
     j["results"].push_back(o);
   }
-  openReport(path) << j.dump(1) << "\n";
+  writeReport(path, [&](std::ostream& f) { f << j.dump(1) << "\n"; });
 }
 
 }  // namespace sffd::cli::conform

@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <cstdlib>
 #include <cerrno>
@@ -27,6 +28,7 @@
 
 #include "apps/sffd/conform.h"
 #include "core/kernel_registry.h"
+#include "io/io_util.h"
 
 namespace sffd::cli::conform {
 
@@ -48,24 +50,37 @@ void writeCaseOutput(const fs::path& dir, const CaseOutput& out) {
                                               {"buffers", index}, {"parents", "parents.u32"}}.dump(1) << "\n";
 }
 
-CaseOutput readCaseOutput(const fs::path& dir) {
+CaseOutput readCaseOutput(const fs::path& dir) try {
   std::ifstream in(dir / "buffers.json");
   if (!in) throw Error(ErrorKind::Input, (dir / "buffers.json").string() + ": cannot read");
   json index = json::parse(in);
   CaseOutput out;
+  // A count is a claim (a --against folder may be damaged): nothing is allocated before the file holds it.
+  auto sizeOf = [](const fs::path& p, size_t count, size_t unit) {
+    std::error_code ec;
+    const uintmax_t bytes = fs::file_size(p, ec);
+    if (ec || bytes / unit < count) throw Error(ErrorKind::Input, p.string() + ": shorter than its buffers.json says");
+    return count;
+  };
   auto readRaw = [](const fs::path& p, void* data, size_t bytes) {
     std::ifstream f(p, std::ios::binary);
     if (!f.read(static_cast<char*>(data), std::streamsize(bytes)) && bytes)
       throw Error(ErrorKind::Input, p.string() + ": shorter than its buffers.json says");
   };
   for (const json& b : index.at("buffers")) {
-    Buffer buf{b.at("name"), b.at("unit"), b.at("per_unit"), std::vector<double>(b.at("count").get<size_t>())};
-    readRaw(dir / b.at("file").get<std::string>(), buf.values.data(), buf.values.size() * 8);
+    const fs::path file = dir / b.at("file").get<std::string>();
+    Buffer buf{b.at("name"), b.at("unit"), b.at("per_unit"), std::vector<double>(sizeOf(file, b.at("count").get<size_t>(), 8))};
+    readRaw(file, buf.values.data(), buf.values.size() * 8);
     out.buffers.push_back(std::move(buf));
   }
-  out.parents.resize(fs::file_size(dir / "parents.u32") / 4);
+  std::error_code ec;
+  const uintmax_t parentBytes = fs::file_size(dir / "parents.u32", ec);
+  if (ec) throw Error(ErrorKind::Input, (dir / "parents.u32").string() + ": cannot read: " + ec.message());
+  out.parents.resize(parentBytes / 4);
   readRaw(dir / "parents.u32", out.parents.data(), out.parents.size() * 4);
   return out;
+} catch (const json::exception& e) {   // a damaged or foreign index
+  throw Error(ErrorKind::Input, (dir / "buffers.json").string() + ": not a --dump buffer index: " + io::oneLine(e.what()));
 }
 
 namespace {
@@ -241,13 +256,15 @@ BackendRun runBackend(const std::string& name, const std::vector<Case>& cases, c
     auto deadline = Clock::now() + std::chrono::duration<double>(options.timeoutSeconds);
     std::string pending;
     for (;;) {
-      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now()).count();
+      // In double: a huge --timeout (1e300 s) has no integer count of milliseconds; poll waits a day at most at once.
+      const double left = std::chrono::duration<double, std::milli>(deadline - Clock::now()).count();
       pollfd p{fds[0], POLLIN, 0};
-      if (left <= 0 || ::poll(&p, 1, int(std::max<long long>(left, 0))) == 0) {
+      if (left <= 0) {
         ::kill(pid, SIGKILL);
         timedOut = true;
         break;
       }
+      if (::poll(&p, 1, int(std::ceil(std::min(left, 86400e3)))) == 0) continue;   // the deadline is checked above
       char buf[4096];
       const ssize_t n = ::read(fds[0], buf, sizeof buf);
       if (n < 0 && errno == EINTR) continue;

@@ -47,8 +47,12 @@ int run(const ParsedArgs& args) {
   if (args.has("--binary") && outExt != ".ply" && outExt != ".stl")
     throw Error(ErrorKind::Input, "--binary writes .ply and .stl, not '" + outExt + "'");
   checkOutputPath(out, {args.positional[0], args.get("--lattice")});
-  if (args.has("--stats")) checkOutputPath(args.get("--stats"), {args.positional[0], args.get("--lattice"), out});
-  if (args.has("--patches")) checkOutputPath(args.get("--patches"), {args.positional[0], args.get("--lattice"), out});
+  if (args.has("--stats")) checkOutputPath(args.get("--stats"), {args.positional[0], args.get("--lattice"), out, args.get("--patches")});
+  if (args.has("--patches")) {
+    // Before any work: refused after it, the output was left written.
+    if (methodOf(args.get("--method", "smooth")) != Method::Smooth) throw Error(ErrorKind::Input, "--patches needs --method smooth");
+    checkOutputPath(args.get("--patches"), {args.positional[0], args.get("--lattice"), out});
+  }
 
   auto t0 = std::chrono::steady_clock::now(), lapStart = t0;
   auto lap = [&lapStart] {
@@ -80,10 +84,11 @@ int run(const ParsedArgs& args) {
   const double writeMs = lap();
   const size_t outVertices = streamed ? writer->vertexCount() : deformed.positions.size();
   const size_t outTriangles = streamed ? writer->triangleCount() : deformed.triangles.size();
+  WrittenFiles written;   // a --patches or --stats that cannot be written takes the output away again
+  written.add(out);
   if (args.has("--patches")) {
-    std::vector<double> controlPoints = run.deformer.patchControlPoints();
-    if (controlPoints.empty()) throw Error(ErrorKind::Input, "--patches needs --method smooth");
-    writePatchFile(args.get("--patches"), run, controlPoints);
+    writePatchFile(args.get("--patches"), run, run.deformer.patchControlPoints());
+    written.add(args.get("--patches"));
   }
   double totalMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 
@@ -128,6 +133,7 @@ int run(const ParsedArgs& args) {
     std::string text = j.dump(1) + "\n";
     writeFileAtomically(args.get("--stats"), [&](std::ostream& o) { o << text; });
   }
+  written.keep();
   note(args, "wrote " + out + " (" + std::to_string(outTriangles) + " triangles, " + device.label() + ", " +
                  device.info().name + ")");
   return 0;

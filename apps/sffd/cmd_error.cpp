@@ -10,6 +10,7 @@
 #include <sffd/error.h>
 #include "analysis/error_metrics.h"
 #include "core/job_budget.h"
+#include "io/atomic_file.h"
 
 namespace sffd::cli {
 namespace {
@@ -18,6 +19,7 @@ nlohmann::ordered_json statsJson(const ErrorStats& s) { return {{"avg", s.avg}, 
 
 int run(const ParsedArgs& args) {
   checkJobOptions(args);
+  if (args.has("--stats")) checkOutputPath(args.get("--stats"), {args.positional[0], args.get("--lattice")});
 
   JobAndDevice opened = loadJobAndOpenDevice(args);
   Job& job = opened.job;
@@ -31,7 +33,7 @@ int run(const ParsedArgs& args) {
   ErrorReport rep = measureErrors(job.mesh, packed, *samples);
   rep.volume = measureVolume(job.mesh, job.lattice, run.mesh);
 
-  if (args.has("--json")) {
+  if (args.has("--json") || args.has("--stats")) {
     nlohmann::ordered_json j = {
         {"method", run.method},
         {"clip", run.clip},
@@ -46,8 +48,11 @@ int run(const ParsedArgs& args) {
         {"backend", device.label()},
         {"precision", f64 ? "double" : "float"},
     };
-    std::printf("%s\n", j.dump(1).c_str());
-  } else {
+    // --stats: the same object in a file (it was taken and not written).
+    if (args.has("--stats")) writeFileAtomically(args.get("--stats"), [&](std::ostream& o) { o << j.dump(1) << "\n"; });
+    if (args.has("--json")) std::printf("%s\n", j.dump(1).c_str());
+  }
+  if (!args.has("--json")) {
     std::printf("%s FFD (%s clipping) against exact FFD, %zu tessellation vertices (%s, %s)\n", run.method.c_str(),
                 run.method == "classic" ? "no" : run.clip.c_str(), rep.vertices, device.label().c_str(),
                 f64 ? "double" : "float");

@@ -47,6 +47,11 @@ Lattice latticeFrom(const ParsedArgs& args) {
     if (args.has(made))
       throw Error(ErrorKind::Input, std::string(made) + " fits a new lattice; with --from the lattice's own is kept (--refine and --elevate change it)");
   const std::string from = args.get("--from");
+  // Options that would be ignored are refused, as --counts and --margin are.
+  if (args.has("--degree") && io::lowerExtension(from) != ".npy")
+    throw Error(ErrorKind::Input, "--degree is a fitted or .npy lattice's; " + from + " keeps its own (--elevate raises it)");
+  if (args.has("--normalize") && args.positional.empty())
+    throw Error(ErrorKind::Input, "--normalize normalises the MESH, and none is given (sffd lattice MESH --from L --normalize S)");
   if (args.positional.empty()) {
     LatticeReadOptions read;
     read.memoryLimit = memoryLimitFromEnvironment();

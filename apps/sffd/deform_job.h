@@ -50,6 +50,10 @@ DeformRun runMethod(const ParsedArgs& args, Job& job, Device& device, Method met
 // SFFD_MEMORY_LIMIT before the stream starts: the input Error of the limit when it does not fit.
 void checkSinkFits(Deformer& deformer, size_t bytesPerVertex);
 
+// The Deformer's own memory estimate with `keptBytes` more kept beside it (animate's frames for a glTF),
+// checked against SFFD_MEMORY_LIMIT (or the physical memory): the input Error "WHAT need about ...; HINT".
+void checkKeptFits(Deformer& deformer, uint64_t keptBytes, const std::string& what, const std::string& hint);
+
 // runMethod for --method, then the lattice's fold warning (after the work, so a job that fails prints
 // its one error line only; shown even with --quiet: it is about the result).
 DeformRun runDeformJob(const ParsedArgs& args, Job& job, Device& device, const SinkFor& sinkFor = {});

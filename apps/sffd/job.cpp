@@ -7,6 +7,8 @@
 #include <future>
 #include <optional>
 
+#include <nlohmann/json.hpp>
+
 #include "apps/sffd/cli.h"
 #include "core/backend.h"
 #include <sffd/error.h>
@@ -129,18 +131,60 @@ Lattice loadJobLattice(const ParsedArgs& args, const Job& job, const std::string
   return withToolLimitName([&] { return readLattice(latticePath, lo); });
 }
 
-void checkOutputPath(const std::string& out, const std::vector<std::string>& inputs) {
+namespace {
+
+// The files a .gltf input reads besides itself: its buffers' URIs (not data: URIs), relative to it.
+std::vector<std::string> gltfBufferFiles(const std::string& gltf) {
+  std::vector<std::string> files;
+  try {
+    const nlohmann::json j = nlohmann::json::parse(io::readWholeFile(gltf));
+    for (const nlohmann::json& b : j.value("buffers", nlohmann::json::array()))
+      if (b.is_object() && b.contains("uri") && b["uri"].is_string() && b["uri"].get<std::string>().rfind("data:", 0) != 0)
+        files.push_back((fs::path(gltf).parent_path() / b["uri"].get<std::string>()).string());
+  } catch (...) {   // an input that cannot be read is said by its reader
+  }
+  return files;
+}
+
+}  // namespace
+
+void checkOutputPath(const std::string& out, const std::vector<std::string>& inputs, bool renamed) {
   std::error_code ec;
   // Fail before any work when the output cannot be written where asked.
   fs::path dir = fs::path(out).parent_path();
   if (dir.empty()) dir = ".";
   if (!fs::is_directory(dir, ec)) throw Error(ErrorKind::Input, out + ": cannot write: no such directory");
   if (fs::is_directory(out, ec)) throw Error(ErrorKind::Input, out + ": cannot write: is a directory");
-  for (const std::string& in : inputs) {
+  // Outputs are renamed into place: over a FIFO or a device (/dev/stdout, through its link) that would remove
+  // it, as root /dev's own entry, and write nothing where asked.
+  if (const fs::file_status st = fs::status(out, ec); renamed && fs::exists(st) && !fs::is_regular_file(st))
+    throw Error(ErrorKind::Input, out + ": cannot write: not a regular file (a FIFO or a device); give a file");
+  // A .gltf's files are its buffers too, and the NAME.bin sffd writes beside it (an output given as an input of
+  // a later file, as deform's --stats is checked against its -o).
+  std::vector<std::string> files = inputs;
+  for (const std::string& in : inputs)
+    if (io::lowerExtension(in) == ".gltf") {
+      files.push_back(fs::path(in).replace_extension(".bin").string());
+      for (const std::string& f : gltfBufferFiles(in)) files.push_back(f);
+    }
+  for (const std::string& in : files) {
     if (in.empty()) continue;
-    if (fs::weakly_canonical(out, ec) == fs::weakly_canonical(in, ec) || (fs::exists(out) && fs::equivalent(out, in, ec)))
+    if (fs::weakly_canonical(out, ec) == fs::weakly_canonical(in, ec) || (fs::exists(out, ec) && fs::equivalent(out, in, ec)))
       throw Error(ErrorKind::Input, out + ": output path is an input file; refusing to overwrite it");
   }
+  if (io::lowerExtension(out) == ".gltf") checkOutputPath(fs::path(out).replace_extension(".bin").string(), files, renamed);
+}
+
+WrittenFiles::~WrittenFiles() {
+  for (const std::string& p : paths_) std::remove(p.c_str());
+}
+
+void WrittenFiles::add(const std::string& path) {
+  // Only a plain file: a report written through /dev/stdout (conform's, in place) is no file of the command's.
+  std::error_code ec;
+  if (!fs::is_regular_file(fs::symlink_status(path, ec))) return;
+  paths_.push_back(path);
+  if (io::lowerExtension(path) == ".gltf") paths_.push_back(fs::path(path).replace_extension(".bin").string());
 }
 
 Device openDeviceFromArgs(const ParsedArgs& args) {

@@ -39,11 +39,13 @@ int main(int argc, char** argv) {
   sffd::restartWithHugePages(argv);   // docs/performance/whole_run.md "Huge pages for the whole process"
   try {
     if (argc < 2) throw Error(ErrorKind::Input, "no command given (sffd --help lists them)");
-    if (!std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h") || (!std::strcmp(argv[1], "help") && argc == 2)) {
+    if (!std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h") ||
+        (!std::strcmp(argv[1], "help") && (argc == 2 || (argc == 3 && !std::strcmp(argv[2], "help"))))) {
       usage(stdout);
       return 0;
     }
     if (!std::strcmp(argv[1], "--version")) {
+      if (argc > 2) throw Error(ErrorKind::Input, std::string("unexpected argument '") + argv[2] + "' (usage: sffd --version)");
       std::printf("sffd %d.%d.%d\n", SFFD_VERSION_MAJOR, SFFD_VERSION_MINOR, SFFD_VERSION_PATCH);
       return 0;
     }

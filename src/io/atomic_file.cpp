@@ -1,6 +1,7 @@
 #include "io/atomic_file.h"
 
 #include <atomic>
+#include <climits>
 #include <csignal>
 #include <cerrno>
 #include <cstdio>
@@ -87,11 +88,15 @@ std::string temporaryBeside(const std::string& path) {
   std::random_device rd;
   // The count keeps several temporaries of one target apart within a process (MeshFileWriter's scratch files).
   static std::atomic<unsigned> count{0};
-  std::string name = "." + p.filename().string() + ".tmp" + std::to_string(::getpid()) + "_" + std::to_string(rd() % 1000000) +
-                     "_" + std::to_string(count++);
+  const std::string tag = ".tmp" + std::to_string(::getpid()) + "_" + std::to_string(rd() % 1000000) + "_" + std::to_string(count++);
   // Keep the extension last: writers that dispatch on it (OpenMesh) still see it.
-  name += p.extension().string();
-  return (p.parent_path() / name).string();
+  const std::string ext = p.extension().string();
+  // A name has at most NAME_MAX bytes: the temporary keeps as much of the target's as fits, so that every
+  // name that can be written can be written through it.
+  std::string stem = p.filename().string();
+  const size_t fixed = 1 + tag.size() + ext.size();
+  if (fixed < NAME_MAX && stem.size() > NAME_MAX - fixed) stem.resize(NAME_MAX - fixed);
+  return (p.parent_path() / ("." + stem + tag + ext)).string();
 }
 
 // A rename over an existing file makes ext4 (auto_da_alloc) flush the new file's delayed allocation first:
@@ -122,7 +127,8 @@ void renameInto(const std::string& tmp, const std::string& path) {
 }  // namespace
 
 void writePathAtomically(const std::string& path, const std::function<void(const std::string&)>& write) {
-  if (fs::is_directory(path)) throw inputError(path, 0, "cannot write: is a directory");
+  std::error_code ec;   // a path the system refuses (a name too long) is found by the open below, with its reason
+  if (fs::is_directory(path, ec)) throw inputError(path, 0, "cannot write: is a directory");
   std::string tmp = temporaryBeside(path);
   TemporaryGuard guard(tmp);   // registered before the file exists, released after rename or removal
   {
@@ -138,7 +144,6 @@ void writePathAtomically(const std::string& path, const std::function<void(const
     std::remove(tmp.c_str());
     throw;
   }
-  std::error_code ec;
   if (!fs::exists(tmp, ec) || fs::file_size(tmp, ec) == 0) {
     std::remove(tmp.c_str());
     throw Error(ErrorKind::Internal, path + ": writer produced no data");
@@ -165,7 +170,8 @@ struct AtomicFile::Impl {
 };
 
 AtomicFile::AtomicFile(const std::string& path, bool binary) {
-  if (fs::is_directory(path)) throw inputError(path, 0, "cannot write: is a directory");
+  std::error_code ec;   // as in writePathAtomically
+  if (fs::is_directory(path, ec)) throw inputError(path, 0, "cannot write: is a directory");
   impl_ = std::make_unique<Impl>(path, temporaryBeside(path));
   impl_->out.open(impl_->tmp, binary ? std::ios::binary | std::ios::trunc : std::ios::trunc);
   if (!impl_->out) throw inputError(path, 0, std::string("cannot write: ") + std::strerror(errno));

@@ -4,8 +4,10 @@
 // container (JSON and BIN chunks, 4-byte aligned).
 #include <algorithm>
 #include <bit>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <map>
 
 #include <nlohmann/json.hpp>
@@ -97,11 +99,20 @@ void writeGltfAnimation(const std::string& path, const std::vector<Mesh>& frames
   const size_t n = mesh.positions.size();
   Builder b;
   nlohmann::ordered_json attributes;
+  size_t frame = 0;   // the frame `flat` reads, for its message
   auto flat = [&](auto get, int components) {
     std::vector<float> out;
     out.reserve(n * size_t(components));
     for (size_t v = 0; v < n; ++v)
-      for (int c = 0; c < components; ++c) out.push_back(float(get(v, c)));
+      for (int c = 0; c < components; ++c) {
+        // glTF holds floats: a value past their range (a double result, a difference of two) would be an infinity.
+        const double x = get(v, c);
+        if (!(std::abs(x) <= std::numeric_limits<float>::max()))
+          throw Error(ErrorKind::Input, path + ": not written: vertex " + std::to_string(v) +
+                                            (frames.size() > 1 ? " of frame " + std::to_string(frame) : std::string()) +
+                                            " is not finite or beyond the range of glTF's floats (the lattice moves it that far)");
+        out.push_back(float(x));
+      }
     return out;
   };
   attributes["POSITION"] = b.floats(flat([&](size_t v, int c) { return mesh.positions[v][c]; }, 3), 3, "VEC3", true);
@@ -126,6 +137,7 @@ void writeGltfAnimation(const std::string& path, const std::vector<Mesh>& frames
   nlohmann::ordered_json targets = nlohmann::ordered_json::array();
   for (size_t f = 1; f < frames.size(); ++f) {
     const Mesh& k = frames[f];
+    frame = f;
     if (k.positions.size() != n || k.triangles != mesh.triangles || k.normals.size() != mesh.normals.size())
       throw Error(ErrorKind::Internal, path + ": animation frame " + std::to_string(f) + " has other vertices or triangles than frame 0");
     nlohmann::ordered_json t;

@@ -6,6 +6,8 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <limits>
+#include <map>
 #include <ostream>
 
 #include <sffd/error.h>
@@ -67,9 +69,15 @@ constexpr size_t kBlock = 4096;   // records writePly and writeStl append betwee
 
 namespace meshio {
 
-void checkFiniteVertex(const std::string& path, size_t v, const glm::dvec3& position, const glm::dvec3* normal) {
+void checkFiniteVertex(const std::string& path, size_t v, const glm::dvec3& position, const glm::dvec3* normal, bool floats) {
   auto finite = [](const glm::dvec3& x) { return std::isfinite(x.x) && std::isfinite(x.y) && std::isfinite(x.z); };
-  if (finite(position) && (!normal || finite(*normal))) return;
+  if (finite(position) && (!normal || finite(*normal))) {
+    // A file of floats would hold a double past their range as an infinity (normals are unit).
+    constexpr double kMax = std::numeric_limits<float>::max();
+    if (!floats || (std::abs(position.x) <= kMax && std::abs(position.y) <= kMax && std::abs(position.z) <= kMax)) return;
+    throw Error(ErrorKind::Input, path + ": not written: vertex " + std::to_string(v) +
+                                      " of the result lies beyond the range of the file's floats (a text file holds it)");
+  }
   throw Error(ErrorKind::Input, path + ": not written: vertex " + std::to_string(v) + " of the result has a " +
                                     (finite(position) ? "non-finite normal" : "non-finite position") +
                                     " (the lattice moves it beyond the floating-point range of the computation)");
@@ -232,7 +240,7 @@ void appendStlFacets(std::string& s, const Mesh& mesh, const std::array<uint32_t
 namespace {
 using namespace meshio;
 
-meshio::Carried checkWritable(const std::string& path, const Mesh& mesh) {
+meshio::Carried checkWritable(const std::string& path, const Mesh& mesh, bool floats) {
   const size_t n = mesh.positions.size();
   auto sized = [&](size_t count, const char* what) {
     if (count != 0 && count != n)
@@ -257,7 +265,7 @@ meshio::Carried checkWritable(const std::string& path, const Mesh& mesh) {
   perTriangle(mesh.triangleGroup, mesh.groups.size(), "groups");
   // A lattice that sends points beyond the floating-point range gives inf or NaN: refuse to write a
   // file of them, and say where (the lattice is the input at fault, so this is an input error).
-  for (size_t v = 0; v < n; ++v) checkFiniteVertex(path, v, mesh.positions[v], c.normals ? &mesh.normals[v] : nullptr);
+  for (size_t v = 0; v < n; ++v) checkFiniteVertex(path, v, mesh.positions[v], c.normals ? &mesh.normals[v] : nullptr, floats);
   return c;
 }
 
@@ -281,11 +289,41 @@ std::vector<uint32_t> positionIds(const Mesh& mesh, uint32_t& count) {
   return usable ? id : meshio::distinctPositions(mesh.positions, count);
 }
 
+// A `v` line holds one colour: the vertices at one position whose colour differs from its first vertex's (a
+// colour seam) get a line of their own per colour, numbered by first appearance as positionIds numbers.
+std::vector<uint32_t> splitByColour(const std::vector<uint32_t>& pid, const Mesh& mesh, uint32_t& count) {
+  constexpr uint32_t kNone = ~0u;
+  auto bits = [&](size_t v) {
+    const glm::dvec4& c = mesh.colors[v];
+    return std::array<uint64_t, 3>{std::bit_cast<uint64_t>(c.r), std::bit_cast<uint64_t>(c.g), std::bit_cast<uint64_t>(c.b)};
+  };
+  std::vector<uint32_t> first(count, kNone), id(pid.size());
+  std::map<std::pair<uint32_t, std::array<uint64_t, 3>>, uint32_t> more;   // a position's further colours: their ids
+  uint32_t next = 0;
+  for (size_t v = 0; v < pid.size(); ++v) {
+    const uint32_t p = pid[v];
+    if (first[p] == kNone) {
+      first[p] = uint32_t(v);
+      id[v] = next++;
+    } else if (bits(v) == bits(first[p])) {
+      id[v] = id[first[p]];
+    } else {
+      auto [it, fresh] = more.try_emplace({p, bits(v)}, next);
+      next += fresh;
+      id[v] = it->second;
+    }
+  }
+  count = next;
+  return id;
+}
+
 void writeObj(std::ostream& os, const Mesh& mesh, int digits, const Carried& has) {
   // Positions are written once per location or distinct value (so a welded mesh stays welded for every OBJ reader),
-  // texture coordinates and normals once per vertex; a face corner is "position/vertex/vertex".
+  // and per colour there (splitByColour), texture coordinates and normals once per vertex; a face corner is
+  // "position/vertex/vertex".
   uint32_t count = 0;
   std::vector<uint32_t> pid = positionIds(mesh, count);
+  if (has.colors) pid = splitByColour(pid, mesh, count);
   ChunkedWriter w(os);
   std::string& s = w.buf();
   s += "# sffd mesh: " + std::to_string(count) + " positions, " + std::to_string(mesh.positions.size()) + " vertices, " +
@@ -426,7 +464,7 @@ void writeMesh(const std::string& path, const Mesh& mesh, const MeshWriteOptions
   const std::string ext = meshio::checkWriteTarget(path, options);
   const bool gltf = ext == ".gltf" || ext == ".glb";
   const int digits = options.significantDigits;
-  const Carried has = checkWritable(path, mesh);
+  const Carried has = checkWritable(path, mesh, ext == ".stl" && options.binary);
   if (gltf) return meshio::writeGltf(path, mesh);
   writeFileAtomically(
       path,

@@ -102,7 +102,8 @@ struct MeshFileWriter::Impl {
     perTriangle(piece.triangleMaterial, held.materials.size(), "materials");
     perTriangle(piece.triangleGroup, held.groups.size(), "groups");
     for (size_t v = 0; v < n; ++v)
-      meshio::checkFiniteVertex(path, vertices + v, piece.positions[v], has.normals ? &piece.normals[v] : nullptr);
+      meshio::checkFiniteVertex(path, vertices + v, piece.positions[v], has.normals ? &piece.normals[v] : nullptr,
+                                mode == Mode::Stl && options.binary);
   }
 
   void add(const Mesh& piece) {

@@ -18,8 +18,10 @@ struct Carried {
 // naming what is wrong; an internal one for digits outside 1..17).
 std::string checkWriteTarget(const std::string& path, const MeshWriteOptions& options);
 
-// An input Error naming vertex `v` when its position or its normal (null: none) is not finite.
-void checkFiniteVertex(const std::string& path, size_t v, const glm::dvec3& position, const glm::dvec3* normal);
+// An input Error naming vertex `v` when its position or its normal (null: none) is not finite, or, for a
+// file of floats (binary STL), its position is past their range.
+void checkFiniteVertex(const std::string& path, size_t v, const glm::dvec3& position, const glm::dvec3* normal,
+                       bool floats = false);
 
 // PLY: float properties for `digits` <= 9, double above (the text header's rule too).
 std::string plyHeader(size_t vertices, size_t faces, int digits, const Carried& has, bool binary);

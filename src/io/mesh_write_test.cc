@@ -122,6 +122,28 @@ TEST(MeshWrite, AttributesRoundTrip) {
   fs::remove_all(dir);
 }
 
+// An OBJ `v` line holds one colour: two vertices at one position with two colours (a colour seam, as
+// at a UV sphere's pole) are two lines, which read back as one location. One line with the first
+// vertex's colour gave the other corners a colour they never had.
+TEST(MeshWrite, ObjKeepsTwoColoursAtOnePosition) {
+  const fs::path dir = tempDir("mesh_write_colour_seam");
+  std::ofstream(dir / "in.obj") << "v 0 0 0 1 0 0\nv 1 0 0 1 0 0\nv 0 1 0 1 0 0\nv 0 0 0 0 1 0\nv -1 0 0 0 1 0\n"
+                                   "f 1 2 3\nf 4 3 5\n";
+  const Mesh m = readMesh((dir / "in.obj").string());
+  const std::string p = (dir / "out.obj").string();
+  writeMesh(p, m, 17);
+  const Mesh r = readMesh(p);
+  ASSERT_EQ(r.triangles.size(), 2u);
+  for (size_t f = 0; f < 2; ++f)
+    for (int c = 0; c < 3; ++c) EXPECT_EQ(r.colors[r.triangles[f][c]], m.colors[m.triangles[f][c]]) << f << " " << c;
+  EXPECT_EQ(r.weldId[r.triangles[0][0]], r.weldId[r.triangles[1][0]]);   // still one location
+  const std::string text = slurp(p);
+  size_t lines = 0;
+  for (size_t at = text.find("\nv "); at != std::string::npos; at = text.find("\nv ", at + 1)) ++lines;
+  EXPECT_EQ(lines, 5u);
+  fs::remove_all(dir);
+}
+
 // The OBJ and OFF writers write one position per location when the mesh names its locations
 // (Mesh::weldIdIsLocation, the smooth and accurate output): two locations at one position stay two
 // vertices. Otherwise (a mesh read from a file, or a location whose vertices were moved apart) one per

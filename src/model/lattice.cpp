@@ -63,11 +63,20 @@ Lattice fitLattice(const Mesh& mesh, std::array<int, 3> counts, std::array<int, 
   }
   glm::dvec3 lo = mesh.positions[0], hi = lo;
   for (const glm::dvec3& p : mesh.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
-  // A margin keeps every vertex strictly inside and gives a flat mesh a non-empty box.
-  const double extent = std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z, 1e-12});
+  // A margin keeps every vertex strictly inside and gives a flat mesh a non-empty box; a mesh at one point
+  // gets a box of 1e-12 of its distance from the origin (at least 1e-12), so that its sides stay apart
+  // there too. Only such a mesh: a mesh smaller than 1e-12 got that box too, and a preset on it was
+  // another deformation than on the mesh at any other size.
+  const double far = std::max({1.0, std::abs(lo.x), std::abs(lo.y), std::abs(lo.z), std::abs(hi.x), std::abs(hi.y), std::abs(hi.z)});
+  const double size = std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
+  const double extent = size > 0 ? size : 1e-12 * far;
   lo -= glm::dvec3(margin * extent);
   hi += glm::dvec3(margin * extent);
-  return makeIdentityLattice(lo, hi, counts, degree);
+  Lattice L = makeIdentityLattice(lo, hi, counts, degree);
+  // Said here, not by the next user of the lattice: a box of a non-finite vertex or past the range of doubles
+  // (a huge margin), or one without size (a flat mesh with no margin).
+  validateLattice(L, "fitLattice");
+  return L;
 }
 
 void validateLattice(const Lattice& L, const std::string& source) {

@@ -4,6 +4,8 @@
 
 #include <random>
 
+#include <sffd/error.h>
+
 #include "model/lattice.h"
 #include "kernels/common/lattice_eval.h"
 #include "model/lattice_pack.h"
@@ -184,4 +186,37 @@ TEST(Lattice, ValidationRefusesBadLattices) {
   EXPECT_THROW(validateLattice(bad, "x"), std::exception);
   bad = makeIdentityLattice({0, 0, 0}, {0, 1, 1}, {4, 4, 4}, {2, 2, 2});
   EXPECT_THROW(validateLattice(bad, "x"), std::exception);
+}
+
+// fitLattice says when it cannot make a box (it returned lattices of infinite or NaN knots, or of no size,
+// which `sffd lattice` reported as a fault of the file it was writing); a mesh at one point far from the
+// origin gets one (its 1e-12 box was lost in the rounding at 1e6).
+TEST(Lattice, FittedBoxIsValidOrRefused) {
+  Mesh point;
+  point.positions.assign(3, glm::dvec3(1e6, -1e6, 1e6));
+  const Lattice L = fitLattice(point);
+  EXPECT_NO_THROW(validateLattice(L, "x"));
+  for (int a = 0; a < 3; ++a) {
+    EXPECT_LT(L.domainLo(a), point.positions[0][a]);
+    EXPECT_GT(L.domainHi(a), point.positions[0][a]);
+  }
+  Mesh flat;
+  flat.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  EXPECT_NO_THROW(fitLattice(flat));
+  // A tiny mesh gets a box of its own size and margin, as at any other size (it got 1e-12).
+  Mesh tiny = flat;
+  for (glm::dvec3& p : tiny.positions) p *= 1e-20;
+  const Lattice T = fitLattice(tiny);
+  EXPECT_DOUBLE_EQ(T.domainHi(0) - T.domainLo(0), 1.01e-20);
+  Mesh nan = flat;
+  nan.positions[0].x = NAN;   // the first vertex starts the box
+  for (const auto& [mesh, margin] : {std::pair{&flat, 0.0}, {&flat, 1e308}, {&nan, 0.005}}) {
+    try {
+      fitLattice(*mesh, {5, 5, 5}, {2, 2, 2}, margin);
+      ADD_FAILURE() << "margin " << margin;
+    } catch (const Error& e) {
+      EXPECT_EQ(e.kind(), ErrorKind::Input);
+      EXPECT_EQ(std::string(e.what()).rfind("fitLattice: ", 0), 0u) << e.what();
+    }
+  }
 }
