@@ -13,6 +13,7 @@
 #include "core/backend.h"
 #include <sffd/error.h>
 #include "core/job_budget.h"
+#include "io/atomic_file.h"
 #include "io/io_util.h"
 #include "io/lattice_io.h"
 #include "io/mesh_io_internal.h"
@@ -172,7 +173,8 @@ void checkOutputPath(const std::string& out, const std::vector<std::string>& inp
     if (fs::weakly_canonical(out, ec) == fs::weakly_canonical(in, ec) || (fs::exists(out, ec) && fs::equivalent(out, in, ec)))
       throw Error(ErrorKind::Input, out + ": output path is an input file; refusing to overwrite it");
   }
-  if (io::lowerExtension(out) == ".gltf") checkOutputPath(fs::path(out).replace_extension(".bin").string(), files, renamed);
+  if (io::lowerExtension(out) == ".gltf")
+    checkOutputPath(fs::path(replacedFile(out)).replace_extension(".bin").string(), files, renamed);
 }
 
 WrittenFiles::~WrittenFiles() {
@@ -180,11 +182,13 @@ WrittenFiles::~WrittenFiles() {
 }
 
 void WrittenFiles::add(const std::string& path) {
-  // Only a plain file: a report written through /dev/stdout (conform's, in place) is no file of the command's.
+  // The file written, through a link as the writers write (a link stays); only a plain file: a report written
+  // through /dev/stdout (conform's, in place) is no file of the command's.
+  const std::string file = replacedFile(path);
   std::error_code ec;
-  if (!fs::is_regular_file(fs::symlink_status(path, ec))) return;
-  paths_.push_back(path);
-  if (io::lowerExtension(path) == ".gltf") paths_.push_back(fs::path(path).replace_extension(".bin").string());
+  if (!fs::is_regular_file(fs::symlink_status(file, ec))) return;
+  paths_.push_back(file);
+  if (io::lowerExtension(path) == ".gltf") paths_.push_back(fs::path(file).replace_extension(".bin").string());
 }
 
 Device openDeviceFromArgs(const ParsedArgs& args) {

@@ -116,20 +116,35 @@ void allocateBeforeReplacing(const std::string& tmp, const std::string& path) {
 #endif
 }
 
-void renameInto(const std::string& tmp, const std::string& path) {
-  allocateBeforeReplacing(tmp, path);
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+// `tmp` renamed onto `file`, the file that `path` names (replacedFile); errors name `path`.
+void renameInto(const std::string& tmp, const std::string& file, const std::string& path) {
+  allocateBeforeReplacing(tmp, file);
+  if (std::rename(tmp.c_str(), file.c_str()) != 0) {
     int e = errno;
     std::remove(tmp.c_str());
     throw inputError(path, 0, std::string("cannot write: ") + std::strerror(e));
   }
 }
+
 }  // namespace
+
+// A rename onto the link itself would replace the link and leave its target as it was.
+std::string replacedFile(const std::string& path) {
+  std::error_code ec;
+  fs::path p = path;
+  for (int hops = 0; hops < 40 && fs::is_symlink(fs::symlink_status(p, ec)); ++hops) {
+    const fs::path target = fs::read_symlink(p, ec);
+    if (ec) return path;
+    p = target.is_absolute() ? target : p.parent_path() / target;
+  }
+  return p.string();
+}
 
 void writePathAtomically(const std::string& path, const std::function<void(const std::string&)>& write) {
   std::error_code ec;   // a path the system refuses (a name too long) is found by the open below, with its reason
   if (fs::is_directory(path, ec)) throw inputError(path, 0, "cannot write: is a directory");
-  std::string tmp = temporaryBeside(path);
+  const std::string file = replacedFile(path);
+  std::string tmp = temporaryBeside(file);
   TemporaryGuard guard(tmp);   // registered before the file exists, released after rename or removal
   {
     std::ofstream probe(tmp, std::ios::binary);
@@ -148,7 +163,7 @@ void writePathAtomically(const std::string& path, const std::function<void(const
     std::remove(tmp.c_str());
     throw Error(ErrorKind::Internal, path + ": writer produced no data");
   }
-  renameInto(tmp, path);
+  renameInto(tmp, file, path);
 }
 
 void writeFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write, bool binary) {
@@ -162,17 +177,17 @@ void writeFileAtomically(const std::string& path, const std::function<void(std::
 }
 
 struct AtomicFile::Impl {
-  std::string path, tmp;
-  TemporaryGuard guard;   // registered before the file exists, released after rename or removal
+  std::string path, file, tmp;   // as asked for, the file it names (replacedFile), the temporary beside that
+  TemporaryGuard guard;          // registered before the file exists, released after rename or removal
   std::ofstream out;
   bool committed = false;
-  Impl(const std::string& p, std::string t) : path(p), tmp(std::move(t)), guard(tmp) {}
+  Impl(const std::string& p, std::string f) : path(p), file(std::move(f)), tmp(temporaryBeside(file)), guard(tmp) {}
 };
 
 AtomicFile::AtomicFile(const std::string& path, bool binary) {
   std::error_code ec;   // as in writePathAtomically
   if (fs::is_directory(path, ec)) throw inputError(path, 0, "cannot write: is a directory");
-  impl_ = std::make_unique<Impl>(path, temporaryBeside(path));
+  impl_ = std::make_unique<Impl>(path, replacedFile(path));
   impl_->out.open(impl_->tmp, binary ? std::ios::binary | std::ios::trunc : std::ios::trunc);
   if (!impl_->out) throw inputError(path, 0, std::string("cannot write: ") + std::strerror(errno));
 }
@@ -192,7 +207,7 @@ void AtomicFile::commit() {
   impl_->out.close();
   if (!impl_->out) throw inputError(impl_->path, 0, "cannot write: write failed (disk full?)");
   impl_->committed = true;
-  renameInto(impl_->tmp, impl_->path);   // removes the temporary file itself when the rename fails
+  renameInto(impl_->tmp, impl_->file, impl_->path);   // removes the temporary file itself when the rename fails
 }
 
 }  // namespace sffd

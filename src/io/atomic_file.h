@@ -1,4 +1,6 @@
 // Output files appear whole or not at all: written to a temporary file beside the target, then renamed.
+// A target that is a symbolic link is written through: the file at the end of the link gets the new
+// contents (the temporary beside it), and the link stays.
 #pragma once
 #include <functional>
 #include <memory>
@@ -12,6 +14,11 @@ namespace sffd {
 // is thrown (kind Input for an unwritable path).
 void writeFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write,
                          bool binary = false);
+
+// The file a write to `path` replaces: `path`, or where it is a symbolic link the file at the end of its
+// chain (which need not exist yet). A writer whose file names another beside it (a .gltf's NAME.bin) names
+// the one beside this file.
+std::string replacedFile(const std::string& path);
 
 // For writers that need a file name (OpenMesh): the temporary path is passed to write(tmpPath).
 void writePathAtomically(const std::string& path, const std::function<void(const std::string&)>& write);

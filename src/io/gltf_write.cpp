@@ -171,7 +171,8 @@ void writeGltfAnimation(const std::string& path, const std::vector<Mesh>& frames
                            {"channels", {{{"sampler", 0}, {"target", {{"node", 0}, {"path", "weights"}}}}}}}};
   }
   if (!mesh.materials.empty()) gltf["materials"] = materialsOf(mesh, gltf, b);
-  const std::string binName = std::filesystem::path(path).stem().string() + ".bin";
+  const std::string file = replacedFile(path);   // through a link: the .bin goes beside the file it names
+  const std::string binName = std::filesystem::path(file).stem().string() + ".bin";
   nlohmann::ordered_json buffer = {{"byteLength", b.bin.size()}};
   if (!glb) buffer["uri"] = binName;
   gltf["buffers"] = {buffer};
@@ -181,7 +182,7 @@ void writeGltfAnimation(const std::string& path, const std::vector<Mesh>& frames
 
   if (!glb) {
     // The buffer first: a .gltf never names a .bin that is not there.
-    const std::string binPath = (std::filesystem::path(path).parent_path() / binName).string();
+    const std::string binPath = (std::filesystem::path(file).parent_path() / binName).string();
     writeFileAtomically(binPath, [&](std::ostream& os) { os.write(b.bin.data(), std::streamsize(b.bin.size())); }, true);
     writeFileAtomically(path, [&](std::ostream& os) { os << json << '\n'; }, true);
     return;

@@ -249,4 +249,27 @@ TEST(MeshRead, GltfPrimitivesAndTransforms) {
   fs::remove_all(dir);
 }
 
+// An output that is a symbolic link is written through it, whole or streamed: the link stays a link and its
+// target, in another folder, gets the mesh; nothing is left beside either.
+TEST(MeshWrite, ThroughASymbolicLinkTheLinkStays) {
+  const fs::path dir = tempDir("mesh_write_symlink");
+  fs::create_directories(dir / "real");
+  const Mesh teapot = readMesh(kData + "/teapot.bpt");
+  writeMesh((dir / "expected.ply").string(), teapot, MeshWriteOptions{.significantDigits = 9, .binary = true});
+  for (const bool dangling : {true, false}) {
+    SCOPED_TRACE(dangling ? "the target not there yet" : "over an existing target");
+    const fs::path target = dir / "real" / "t.ply", link = dir / "link.ply";
+    if (!dangling) std::ofstream(target) << "old";
+    fs::remove(link);
+    fs::create_symlink(fs::path("real") / "t.ply", link);   // relative, as users make them
+    writeMesh(link.string(), teapot, MeshWriteOptions{.significantDigits = 9, .binary = true});
+    EXPECT_TRUE(fs::is_symlink(link));
+    EXPECT_EQ(slurp(target), slurp(dir / "expected.ply"));
+    size_t files = 0;
+    for (const auto& e : fs::recursive_directory_iterator(dir)) files += e.is_regular_file() && !e.is_symlink();
+    EXPECT_EQ(files, 2u) << "a temporary file is left";
+    fs::remove(target);
+  }
+}
+
 }  // namespace
