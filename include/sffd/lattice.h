@@ -6,6 +6,7 @@
 // for .prm lattices). Edit `controlPoints` and hand the lattice to Deformer::deform().
 #pragma once
 #include <array>
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -15,6 +16,10 @@
 
 namespace sffd {
 
+// The most control points a lattice may have (24 bytes each: 384 MiB), and along one axis: what
+// validateLattice, the lattice readers and every function that makes a lattice hold to.
+inline constexpr size_t kMaxLatticeControlPoints = size_t(1) << 24;
+inline constexpr int kMaxLatticeAxisCount = 4096;
 
 enum class OutsideMode {
   Extrapolate,   // points outside the box follow the nearest knot box's polynomial (continuous)
@@ -43,8 +48,9 @@ struct Lattice {
 // Clamped uniform knot vector over [lo, hi]: (degree+1) copies of each end, uniform interior knots.
 std::vector<double> clampedUniformKnots(int count, int degree, double lo, double hi);
 
-// Checks degrees (1..5), counts > degree, knot vector sizes and monotonicity, a non-empty domain,
-// finite control points and an invertible frame. Throws an input Error naming `source`.
+// Checks degrees (1..5), counts > degree, the counts' limits (kMaxLatticeAxisCount, kMaxLatticeControlPoints),
+// knot vector sizes and monotonicity, a non-empty domain, finite control points and an invertible frame.
+// Throws an input Error naming `source`.
 void validateLattice(const Lattice& lattice, const std::string& source);
 
 // Same degrees, counts, knots, frame and outside rule (only the control points may differ): what a
@@ -54,7 +60,8 @@ bool sameLatticeStructure(const Lattice& a, const Lattice& b);
 // Sets every control point to the world position of its Greville parameter: the identity map.
 void setIdentityControlPoints(Lattice& lattice);
 
-// An axis-aligned lattice over [lo, hi] with clamped uniform knots and identity control points.
+// An axis-aligned lattice over [lo, hi] with clamped uniform knots and identity control points. Counts past
+// the limits above are refused (an input Error) before anything is allocated.
 Lattice makeIdentityLattice(glm::dvec3 lo, glm::dvec3 hi, std::array<int, 3> counts, std::array<int, 3> degree);
 
 // An identity lattice around a mesh: its bounding box grown by `margin` times its largest extent

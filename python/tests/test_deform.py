@@ -69,6 +69,14 @@ def test_control_points_edit_in_place(sphere):
     assert np.abs(a - b).max() < 1e-12   # the same volume
     with pytest.raises(sffd.InputError, match="degrees stay within"):
         lat.elevated(4)
+    # Lattices past the library's limits are refused before anything is allocated (they were made: 300^3 in
+    # 650 MB, 4096^3 a MemoryError).
+    with pytest.raises(sffd.InputError, match="27000000 control points is too large"):
+        sffd.Lattice.box((0, 0, 0), (1, 1, 1), (300, 300, 300))
+    with pytest.raises(sffd.InputError, match="too large"):
+        sffd.Lattice.fitted(v, counts=(4096, 4096, 4096))
+    with pytest.raises(sffd.InputError, match="control points an axis"):
+        sffd.Lattice.fitted(v, counts=(5000, 3, 3))
 
 
 def test_smooth_equals_the_cli(sphere, tmp_path):

@@ -217,11 +217,12 @@ Lattice readJson(const std::string& path, const std::string& text, uint64_t memo
   for (int a = 0; a < 3; ++a) {
     if (L.degree[a] < 1 || L.degree[a] > 5) throw fail("/degree", "degree values must be 1..5");
     if (L.counts[a] <= L.degree[a]) throw fail("/counts", "counts must exceed the degree on every axis (counts >= degree + 1)");
-    if (L.counts[a] > 4096) throw fail("/counts", "counts above 4096 per axis are not supported");
+    if (L.counts[a] > kMaxLatticeAxisCount)
+      throw fail("/counts", "counts above " + std::to_string(kMaxLatticeAxisCount) + " per axis are not supported");
   }
-  if (L.pointCount() > kMaxControlPoints)
+  if (L.pointCount() > kMaxLatticeControlPoints)
     throw fail("/counts", "lattice of " + std::to_string(L.pointCount()) + " control points is too large (at most " +
-                              std::to_string(kMaxControlPoints) + ")");
+                              std::to_string(kMaxLatticeControlPoints) + ")");
 
   const json& box = need("box");
   if (!box.is_object() || !box.contains("min") || !box.contains("max"))

@@ -320,12 +320,12 @@ Lattice readNpy(const std::string& path, const std::string& text, const LatticeR
   }
   Lattice L;
   for (int a = 0; a < 3; ++a) {
-    if (h.shape[a] < 2 || h.shape[a] > 4096)
+    if (h.shape[a] < 2 || h.shape[a] > kMaxLatticeAxisCount)
       throw inputError(path, 0, "array shape has " + std::to_string(h.shape[a]) + " control points on axis " + "uvw"[a] +
-                                    " (2..4096 supported)");
+                                    " (2.." + std::to_string(kMaxLatticeAxisCount) + " supported)");
     L.counts[a] = int(h.shape[a]);
   }
-  if (L.pointCount() > kMaxControlPoints) throw inputError(path, 0, "lattice too large");
+  if (L.pointCount() > kMaxLatticeControlPoints) throw inputError(path, 0, "lattice too large");
   const size_t dataStart = headerStart + headerLen;
   const size_t need = L.pointCount() * 3 * item;
   if (text.size() - dataStart != need)

@@ -24,7 +24,4 @@ void writePrmParameters(const std::string& path, const PygemParameters& paramete
 // The control net as a legacy VTK structured grid (ParaView), with displacements from the identity.
 void writeVtk(const std::string& path, const Lattice& lattice);
 
-// Most control points a lattice file may ask for (checked before anything is allocated).
-constexpr size_t kMaxControlPoints = size_t(1) << 24;
-
 }  // namespace sffd::latticeio

@@ -46,6 +46,16 @@ void setIdentityControlPoints(Lattice& L) {
 }
 
 Lattice makeIdentityLattice(glm::dvec3 lo, glm::dvec3 hi, std::array<int, 3> counts, std::array<int, 3> degree) {
+  size_t points = 1;
+  for (int a = 0; a < 3; ++a) {
+    if (counts[a] < 1 || counts[a] > kMaxLatticeAxisCount)
+      throw Error(ErrorKind::Input, "a lattice has 1.." + std::to_string(kMaxLatticeAxisCount) + " control points an axis, not " +
+                                        std::to_string(counts[a]));
+    points *= size_t(counts[a]);
+  }
+  if (points > kMaxLatticeControlPoints)
+    throw Error(ErrorKind::Input, "a lattice of " + std::to_string(points) + " control points is too large (at most " +
+                                      std::to_string(kMaxLatticeControlPoints) + ")");
   Lattice L;
   L.counts = counts;
   L.degree = degree;
@@ -89,7 +99,8 @@ void validateLattice(const Lattice& L, const std::string& source) {
       throw inputError(source, 0, "axis " + ax + " has " + std::to_string(L.counts[a]) +
                                       " control points; a degree-" + std::to_string(L.degree[a]) + " axis needs at least " +
                                       std::to_string(L.degree[a] + 1));
-    if (L.counts[a] > 4096) throw inputError(source, 0, "axis " + ax + " has more than 4096 control points");
+    if (L.counts[a] > kMaxLatticeAxisCount)
+      throw inputError(source, 0, "axis " + ax + " has more than " + std::to_string(kMaxLatticeAxisCount) + " control points");
     const auto& k = L.knots[a];
     if (k.size() != size_t(L.counts[a] + L.degree[a] + 1))
       throw inputError(source, 0, "knot vector " + ax + " has " + std::to_string(k.size()) + " values; counts+degree+1 = " +
@@ -101,6 +112,9 @@ void validateLattice(const Lattice& L, const std::string& source) {
     if (!(L.domainHi(a) > L.domainLo(a)))
       throw inputError(source, 0, "axis " + ax + " has an empty domain (zero-size box or repeated knots)");
   }
+  if (L.pointCount() > kMaxLatticeControlPoints)
+    throw inputError(source, 0, "lattice of " + std::to_string(L.pointCount()) + " control points is too large (at most " +
+                                    std::to_string(kMaxLatticeControlPoints) + ")");
   if (L.controlPoints.size() != L.pointCount())
     throw inputError(source, 0, "lattice has " + std::to_string(L.controlPoints.size()) + " control points; " +
                                     std::to_string(L.pointCount()) + " expected");

@@ -17,8 +17,6 @@ namespace {
 
 // The most control points along one axis these operations make (their maps are dense: count^2 each).
 constexpr int64_t kMaxAxisCount = 1024;
-// The most control points of a result (24 bytes each).
-constexpr int64_t kMaxPoints = int64_t(1) << 24;
 
 // Rows: new control points, columns: old ones (P_new[r] = sum_c M[r][c] P_old[c]).
 using AxisMap = std::vector<std::vector<double>>;
@@ -129,9 +127,9 @@ AxisMap elevateAxis(std::vector<double>& knots, int& p, int count, int by, const
 // Applies one map per axis to the control net (counts change to the maps' row counts).
 void applyAxisMaps(Lattice& L, const std::array<AxisMap, 3>& maps, const std::string& source) {
   const int64_t points = int64_t(maps[0].size()) * int64_t(maps[1].size()) * int64_t(maps[2].size());
-  if (points > kMaxPoints)
+  if (points > int64_t(kMaxLatticeControlPoints))
     throw inputError(source, 0, "the lattice would have " + std::to_string(points) + " control points; at most " +
-                                    std::to_string(kMaxPoints));
+                                    std::to_string(kMaxLatticeControlPoints));
   std::array<int, 3> n = L.counts;
   std::vector<glm::dvec3> cur = L.controlPoints;
   for (int a = 0; a < 3; ++a) {

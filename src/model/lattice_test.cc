@@ -191,6 +191,25 @@ TEST(Lattice, ValidationRefusesBadLattices) {
 // fitLattice says when it cannot make a box (it returned lattices of infinite or NaN knots, or of no size,
 // which `sffd lattice` reported as a fault of the file it was writing); a mesh at one point far from the
 // origin gets one (its 1e-12 box was lost in the rounding at 1e6).
+// The limits of include/sffd/lattice.h hold for every way of making a lattice: refused before the control
+// points are allocated (makeIdentityLattice, hence fitLattice) or when checked (validateLattice).
+TEST(Lattice, CountsPastTheLimitsAreRefused) {
+  for (const std::array<int, 3> counts : {std::array<int, 3>{300, 300, 300}, {4096, 4096, 4096}, {5000, 3, 3}, {0, 3, 3}}) {
+    try {
+      makeIdentityLattice(glm::dvec3(0), glm::dvec3(1), counts, {2, 2, 2});
+      ADD_FAILURE() << "made a lattice of " << counts[0] << "x" << counts[1] << "x" << counts[2];
+    } catch (const Error& e) {
+      EXPECT_EQ(e.kind(), ErrorKind::Input) << e.what();
+    }
+  }
+  Lattice L = makeIdentityLattice(glm::dvec3(0), glm::dvec3(1), {256, 256, 256}, {2, 2, 2});   // exactly 2^24
+  EXPECT_NO_THROW(validateLattice(L, "L"));
+  L.counts[2] = 257;   // as a hand-edited lattice could claim
+  L.knots[2] = clampedUniformKnots(257, 2, 0, 1);
+  L.controlPoints.resize(L.pointCount());
+  EXPECT_THROW(validateLattice(L, "L"), Error);
+}
+
 TEST(Lattice, FittedBoxIsValidOrRefused) {
   Mesh point;
   point.positions.assign(3, glm::dvec3(1e6, -1e6, 1e6));
