@@ -99,11 +99,8 @@ void checkSinkFits(Deformer& deformer, size_t bytesPerVertex) {
 
 void checkKeptFits(Deformer& deformer, uint64_t keptBytes, const std::string& what, const std::string& hint) {
   const Deformer::Impl& I = deformer.internal();
-  const uint64_t memoryLimit = memoryLimitFromEnvironment(), limit = hostMemoryLimit(memoryLimit);
-  const uint64_t need = (I.estimate ? I.estimate->hostBytes : 0) + keptBytes;
-  if (limit > 0 && need > limit)
-    throw Error(ErrorKind::Input, what + " need about " + formatBytes(need) + " of host memory, more than the limit of " +
-                                      formatBytes(limit) + (memoryLimit ? " (SFFD_MEMORY_LIMIT); " : " (physical memory); ") + hint);
+  checkHostBytesFit((I.estimate ? I.estimate->hostBytes : 0) + keptBytes, memoryLimitFromEnvironment(), "SFFD_MEMORY_LIMIT",
+                    what + " need", hint);
 }
 
 DeformRun runDeformJob(const ParsedArgs& args, Job& job, Device& device, const SinkFor& sinkFor) {

@@ -215,21 +215,22 @@ JobEstimate estimateSmoothJob(const Mesh& mesh, double S, int level, size_t real
   return e;
 }
 
-void checkHostFits(const JobEstimate& e, uint64_t memoryLimit, const char* limitName, const char* what) {
+void checkHostBytesFit(uint64_t bytes, uint64_t memoryLimit, const char* limitName, const std::string& subject,
+                       const std::string& hint) {
   const uint64_t limit = hostMemoryLimit(memoryLimit);
-  if (limit > 0 && e.hostBytes > limit)
-    throw Error(ErrorKind::Input, std::string("the ") + what + " needs about " + formatBytes(e.hostBytes) +
-                                      " of host memory, more than the limit of " + limitText(limit, memoryLimit, limitName) +
-                                      "; use a smaller mesh, a longer --edge-length or a lower --tess");
+  if (limit > 0 && bytes > limit)
+    throw Error(ErrorKind::Input, subject + " about " + formatBytes(bytes) + " of host memory, more than the limit of " +
+                                      limitText(limit, memoryLimit, limitName) + "; " + hint);
+}
+
+void checkHostFits(const JobEstimate& e, uint64_t memoryLimit, const char* limitName, const char* what) {
+  checkHostBytesFit(e.hostBytes, memoryLimit, limitName, std::string("the ") + what + " needs",
+                    "use a smaller mesh, a longer --edge-length or a lower --tess");
 }
 
 void checkJobFits(const JobEstimate& e, const PackedLattice& P, size_t realBytes, const DeviceLimits* limits,
                   uint64_t memoryLimit, const char* limitName) {
-  const uint64_t limit = hostMemoryLimit(memoryLimit);
-  if (limit > 0 && e.hostBytes > limit)
-    throw Error(ErrorKind::Input, "the job needs about " + formatBytes(e.hostBytes) + " of host memory, more than the limit of " +
-                                      formatBytes(limit) + (memoryLimit ? " (" + std::string(limitName) + ")" : std::string(" (physical memory)")) +
-                                      "; use a smaller mesh or split it");
+  checkHostBytesFit(e.hostBytes, memoryLimit, limitName, "the job needs", "use a smaller mesh or split it");
   if (limits) {
     uint64_t coeffBytes = P.coeffs.size() * uint64_t(realBytes);
     if (coeffBytes > limits->maxStorageBufferRange)

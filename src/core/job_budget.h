@@ -81,6 +81,10 @@ JobEstimate estimateSmoothJob(const Mesh& mesh, double subTriangles, int level, 
 
 // Throws the input Error of checkJobFits for host bytes above the limit (no device-range check).
 void checkHostFits(const JobEstimate& estimate, uint64_t memoryLimit, const char* limitName, const char* what);
+// Throws an input Error "SUBJECT about X of host memory, more than the limit of Y (LIMIT NAME); HINT" when `bytes`
+// exceed hostMemoryLimit(memoryLimit): the one form of every host-memory refusal.
+void checkHostBytesFit(uint64_t bytes, uint64_t memoryLimit, const char* limitName, const std::string& subject,
+                       const std::string& hint);
 
 // "1.50 GiB" style.
 std::string formatBytes(uint64_t bytes);

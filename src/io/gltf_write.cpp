@@ -7,7 +7,6 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
-#include <limits>
 #include <map>
 
 #include <nlohmann/json.hpp>
@@ -107,7 +106,7 @@ void writeGltfAnimation(const std::string& path, const std::vector<Mesh>& frames
       for (int c = 0; c < components; ++c) {
         // glTF holds floats: a value past their range (a double result, a difference of two) would be an infinity.
         const double x = get(v, c);
-        if (!(std::abs(x) <= std::numeric_limits<float>::max()))
+        if (!io::withinFloatRange(x))
           throw Error(ErrorKind::Input, path + ": not written: vertex " + std::to_string(v) +
                                             (frames.size() > 1 ? " of frame " + std::to_string(frame) : std::string()) +
                                             " is not finite or beyond the range of glTF's floats (the lattice moves it that far)");

@@ -1,8 +1,10 @@
 // Small helpers shared by the mesh and lattice readers/writers: whole-file reading with input errors,
 // strict number parsing, shortest/fixed-precision number formatting, and line-aware tokenising.
 #pragma once
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -81,5 +83,9 @@ constexpr bool isSpace(char c) { return c == ' ' || c == '\t' || c == '\n' || c 
 // Splits on ASCII white space (isSpace).
 void splitTokens(std::string_view line, std::vector<std::string_view>& out);
 std::string_view trim(std::string_view s);
+
+// Whether `x` is finite and within float's range: what a file of floats (binary STL, glTF) can hold of a
+// double result, which a float would otherwise turn into an infinity.
+inline bool withinFloatRange(double x) { return std::abs(x) <= double(std::numeric_limits<float>::max()); }
 
 }  // namespace sffd::io

@@ -6,7 +6,6 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
-#include <limits>
 #include <map>
 #include <ostream>
 
@@ -73,8 +72,7 @@ void checkFiniteVertex(const std::string& path, size_t v, const glm::dvec3& posi
   auto finite = [](const glm::dvec3& x) { return std::isfinite(x.x) && std::isfinite(x.y) && std::isfinite(x.z); };
   if (finite(position) && (!normal || finite(*normal))) {
     // A file of floats would hold a double past their range as an infinity (normals are unit).
-    constexpr double kMax = std::numeric_limits<float>::max();
-    if (!floats || (std::abs(position.x) <= kMax && std::abs(position.y) <= kMax && std::abs(position.z) <= kMax)) return;
+    if (!floats || (io::withinFloatRange(position.x) && io::withinFloatRange(position.y) && io::withinFloatRange(position.z))) return;
     throw Error(ErrorKind::Input, path + ": not written: vertex " + std::to_string(v) +
                                       " of the result lies beyond the range of the file's floats (a text file holds it)");
   }
