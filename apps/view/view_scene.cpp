@@ -92,9 +92,10 @@ void Scene::update(const Lattice& lattice, const SceneSettings& settings,
   times_.clipMs = t.clipMs;
   times_.deformMs = t.deformMs;
   subTriangles_ = deformer.subTriangles();
-  // The device buffers hold positions relative to the Deformer's local origin (a model far from the
-  // world origin): those are drawn from the host copy, moved back, and the rest straight from the buffers.
-  if (smooth && zeroCopy_ && !settings.heatmap && deformer.localOrigin() == glm::dvec3(0.0)) {
+  // The device buffers hold positions in the Deformer's local frame (a model far from the world origin,
+  // or of an unusual size): those are drawn from the host copy, moved back, and the rest straight from
+  // the buffers.
+  if (smooth && zeroCopy_ && !settings.heatmap && deformer.localOrigin() == glm::dvec3(0.0) && deformer.localScale() == 1) {
     drawSession({});
     path_ = "zero-copy";
   } else {

@@ -126,14 +126,18 @@ class Deformer {
   //             from offset + bytes / 2 their normals.
   //   Classic   per vertex a position (w: 1 inside the lattice box, 0 outside), then from
   //             offset + bytes / 2 the normals.
-  // Empty on a device that keeps nothing (the CPU reference). Positions there are relative to
-  // localOrigin(): add it to place them in the world.
+  // Empty on a device that keeps nothing (the CPU reference). Positions there are local: a world
+  // position is local / localScale() + localOrigin().
   std::vector<OutputChunk> deviceOutput() const;
-  // The point the devices compute around: the lattice box's centre rounded to a power of two 8 to 16
-  // times the box's size, so 0 unless the box lies several times its size away from the world origin.
-  // Mesh and lattice are moved by -localOrigin() in double before any device sees them and every
-  // result but deviceOutput() is moved back, so float precision does not depend on where a model sits.
+  // The frame the devices compute in: local = (world - localOrigin()) * localScale(), on the host in
+  // double before any device sees mesh or lattice, and every result but deviceOutput() moved back, so
+  // float precision does not depend on where a model sits nor its thresholds on its size.
+  // localOrigin(): the lattice box's centre rounded to a power of two 8 to 16 times the box's size, so 0
+  // unless the box lies several times its size away from the world origin. localScale(): a power of two
+  // (exact), 1 unless the box is smaller than 2^-8 or at least 2^12 across, else the one that makes it 1
+  // to 2 across.
   glm::dvec3 localOrigin() const;
+  double localScale() const;
   bool doublePrecision() const;   // whether the reals above are doubles
   // Significant digits that keep every value of result() in a text file (MeshWriteOptions, as `sffd
   // deform` writes): 17 for double results, or float ones computed around a localOrigin() away from 0

@@ -71,10 +71,14 @@ uint64_t parseByteSize(const char* s) {
 }
 
 double estimateSubTriangles(const Mesh& mesh, double l) {
+  // The area in units of l^2, the edges divided by l first: the products of a mesh 1e-200 or 1e200 across
+  // stay within double's range, and the estimate does not depend on the model's size.
   double area = 0;
-  for (const auto& t : mesh.triangles)
-    area += 0.5 * glm::length(glm::cross(mesh.positions[t[1]] - mesh.positions[t[0]], mesh.positions[t[2]] - mesh.positions[t[0]]));
-  return area / (std::sqrt(3.0) / 4 * l * l) + double(mesh.triangles.size());
+  for (const auto& t : mesh.triangles) {
+    const glm::dvec3 c = glm::cross((mesh.positions[t[1]] - mesh.positions[t[0]]) / l, (mesh.positions[t[2]] - mesh.positions[t[0]]) / l);
+    area += 0.5 * std::hypot(c.x, c.y, c.z);
+  }
+  return area / (std::sqrt(3.0) / 4) + double(mesh.triangles.size());
 }
 
 double defaultEdgeLength(const Mesh& mesh) {

@@ -480,7 +480,7 @@ void applyLatticePreset(Lattice& lattice, const std::string& name, double amount
     glm::dvec3 e(0.0);
     e[a] = ph[a];
     glm::dvec3 E = inv * e;
-    h[a] = glm::length(E);
+    h[a] = std::hypot(E.x, E.y, E.z);   // glm::length's square leaves double's range for a box 1e-160 or 1e160 across
     if (!(h[a] > 0) || !std::isfinite(h[a])) throw Error(ErrorKind::Internal, "lattice preset: degenerate box");
     d[a] = E / h[a];
   }

@@ -124,7 +124,7 @@ Deformer::Deformer(Device& device, const Mesh& mesh, const Lattice& lattice, con
     const DeformSessionOptions session = sessionOptionsOf(r);
     if (session.streamed() && !session.knotBoxClip) {   // stream_budget.h bounds the regular clipping's sub-triangles
       // The caller's mesh and, where the lattice box is away from the origin, the local-frame copy.
-      const uint64_t others = meshHeldBytes(mesh) + (latticeLocalOrigin(lattice) != glm::dvec3(0.0) ? meshHeldBytes(I.input) : 0);
+      const uint64_t others = meshHeldBytes(mesh) + (latticeLocalFrame(lattice).isWorld() ? 0 : meshHeldBytes(I.input));
       I.estimate = estimateStreamedSmoothJob(I.input, session, info, others);
       I.estimate->hostBytes += latticeBytes;
       I.wholeEstimate = whole;
@@ -133,23 +133,26 @@ Deformer::Deformer(Device& device, const Mesh& mesh, const Lattice& lattice, con
     }
     checkHostFits(*I.estimate, options.memoryLimit, kLimitName, "smooth job");
   }
-  // The devices see the mesh and the lattice relative to the lattice box (deformer_local_frame.cpp).
-  I.origin = latticeLocalOrigin(lattice);
-  const bool moved = I.origin != glm::dvec3(0.0);
-  if (moved) I.localInput = translatedMesh(I.input, -I.origin);
-  const Lattice movedLattice = moved ? localLattice(lattice, I.origin) : Lattice{};
+  // The devices see the mesh and the lattice in the lattice box's frame (deformer_local_frame.cpp), and
+  // the edge length in its units.
+  I.frame = latticeLocalFrame(lattice);
+  const bool moved = !I.frame.isWorld();
+  if (moved) I.localInput = sffd::localMesh(I.input, I.frame);
+  const Lattice movedLattice = moved ? sffd::localLattice(lattice, I.frame) : Lattice{};
   const Mesh& localMesh = moved ? I.localInput : I.input;
   const Lattice& localLattice = moved ? movedLattice : lattice;
+  ResolvedOptions localOptions = r;
+  localOptions.edgeLength *= I.frame.scale;
   std::unique_ptr<MethodRun> local;
-  if (r.method == Method::Smooth) local = makeSmoothRun(backend, localMesh, localLattice, r, I.timings, progress);
-  else if (r.method == Method::Classic) local = makeClassicRun(backend, localMesh, localLattice, r, I.timings, progress);
+  if (r.method == Method::Smooth) local = makeSmoothRun(backend, localMesh, localLattice, localOptions, I.timings, progress);
+  else if (r.method == Method::Classic) local = makeClassicRun(backend, localMesh, localLattice, localOptions, I.timings, progress);
   else {
     // Held throughout besides the run's mesh: the caller's, the Deformer's where the run has the local-frame
     // copy, the lattice.
     const uint64_t held = meshHeldBytes(mesh) + (moved ? meshHeldBytes(I.input) : 0) + estimateLatticeBytes(lattice);
-    local = makeAccurateRun(backend, localMesh, localLattice, r, I.timings, progress, held, I.estimate, I.wholeEstimate);
+    local = makeAccurateRun(backend, localMesh, localLattice, localOptions, I.timings, progress, held, I.estimate, I.wholeEstimate);
   }
-  I.run = inLocalFrame(std::move(local), I.origin);
+  I.run = inLocalFrame(std::move(local), I.frame);
   progress("prepare", 1);
   I.timings.wallMs = msSince(t0);
 }
@@ -212,7 +215,8 @@ void MethodRun::streamResult(MeshSink& sink, const ProgressReporter& progress) c
 std::vector<double> Deformer::patchControlPoints() const { return impl_->run->patchControlPoints(); }
 size_t Deformer::subTriangles() const { return impl_->run->subTriangles(); }
 std::vector<OutputChunk> Deformer::deviceOutput() const { return impl_->run->deviceOutput(); }
-glm::dvec3 Deformer::localOrigin() const { return impl_->origin; }
+glm::dvec3 Deformer::localOrigin() const { return impl_->frame.origin; }
+double Deformer::localScale() const { return impl_->frame.scale; }
 bool Deformer::doublePrecision() const { return impl_->resolved.variant.f64; }
 int Deformer::resultDigits() const { return doublePrecision() || localOrigin() != glm::dvec3(0.0) ? 17 : 9; }
 const DeformOptions& Deformer::options() const { return impl_->options; }

@@ -104,14 +104,25 @@ std::unique_ptr<MethodRun> makeAccurateRun(Backend& backend, const Mesh& input, 
                                            uint64_t heldBytes, std::optional<JobEstimate>& estimate,
                                            std::optional<JobEstimate>& whole);
 
-// Computing in coordinates local to the lattice box (deformer_local_frame.cpp): the origin of a
-// lattice's local frame (0 for a box near the world origin); a mesh moved by `by`; the lattice as the
-// devices see it around `origin` (control points and frame moved, its parameter space centred); and
-// a run on those local inputs whose results come out in world coordinates (deviceOutput() stays local).
-glm::dvec3 latticeLocalOrigin(const Lattice& lattice);
-Mesh translatedMesh(Mesh mesh, glm::dvec3 by);
-Lattice localLattice(Lattice lattice, glm::dvec3 origin);
-std::unique_ptr<MethodRun> inLocalFrame(std::unique_ptr<MethodRun> local, glm::dvec3 origin);
+// Computing in coordinates local to the lattice box (deformer_local_frame.cpp): the devices see
+// local = (world - origin) * scale. The origin is 0 for a box near the world origin; the scale a power of
+// two, 1 for a box from 2^kLocalScaleMinExponent to 2^kLocalScaleMaxExponent across, else the one that
+// brings the box to a size from 1 to 2.
+constexpr int kLocalScaleMinExponent = -8, kLocalScaleMaxExponent = 12;
+struct LocalFrame {
+  glm::dvec3 origin{0.0};
+  double scale = 1;
+  bool isWorld() const { return origin == glm::dvec3(0.0) && scale == 1; }
+  glm::dvec3 toWorld(glm::dvec3 local) const { return local / scale + origin; }
+};
+// The frame of a lattice; a mesh in it and back; the lattice as the devices see it (control points and
+// frame moved and scaled, its parameter space centred and of size 1); and a run on those local inputs
+// whose results come out in world coordinates (deviceOutput() stays local).
+LocalFrame latticeLocalFrame(const Lattice& lattice);
+Mesh localMesh(Mesh mesh, const LocalFrame& frame);
+Mesh worldMesh(Mesh mesh, const LocalFrame& frame);
+Lattice localLattice(Lattice lattice, const LocalFrame& frame);
+std::unique_ptr<MethodRun> inLocalFrame(std::unique_ptr<MethodRun> local, const LocalFrame& frame);
 
 struct Deformer::Impl {
   Device* device = nullptr;
@@ -119,8 +130,8 @@ struct Deformer::Impl {
   ResolvedOptions resolved;
   Mesh input;           // the mesh as the method uses it (smooth: creases applied); pre-images index its triangles
   Lattice structure;    // the lattice the Deformer was made for (its structure is what deform() checks)
-  glm::dvec3 origin{0.0};   // latticeLocalOrigin(structure): the devices compute relative to it
-  // `input` moved by -origin when the origin is not 0 (else empty): the runs keep a reference to the
+  LocalFrame frame;     // latticeLocalFrame(structure): the devices compute in it
+  // `input` in that frame when it is not the world's (else empty): the runs keep a reference to the
   // mesh they were made with (for its texture coordinates, colours and materials), so it lives here.
   Mesh localInput;
   Timings timings;

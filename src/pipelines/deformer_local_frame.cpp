@@ -1,8 +1,11 @@
 // Deformer: every method computes in coordinates local to the lattice box (docs/ROBUSTNESS.md
-// "Models far from the origin"). The mesh and the lattice are translated on the host in double before
-// anything reaches a device, and the results translated back in double, so float kernels keep their
-// precision relative to the model's size wherever the model sits, on every backend alike (strict
-// results stay identical across backends: they all see the same local inputs).
+// "Models far from the origin" and "Models of any size"). The mesh and the lattice are moved, and scaled by
+// a power of two, on the host in double before anything reaches a device, and the results moved back in
+// double, so float kernels keep their precision relative to the model's size wherever the model sits,
+// and their thresholds (a squared length below float's smallest normal number has no direction, as do
+// products of six lengths past float's range) meet every size as they meet size 1. A scale by a power of
+// two is exact, so a model 2^k times as large gives 2^k times the result, bit for bit. Strict results stay
+// identical across backends: they all see the same local inputs.
 #include <algorithm>
 #include <cmath>
 
@@ -17,9 +20,19 @@ double roundedOrigin(double centre, double extent) {
   const double step = std::ldexp(1.0, std::ilogb(extent) + 4);
   return std::round(centre / step) * step;
 }
+
+// The power of two that brings `extent` into [1, 2), or 1 for an extent of a usual size: the kernels'
+// thresholds are met from about 1e-6 (squared lengths of the sub-triangles' derivatives' cross products
+// below float's smallest normal number) and 1e6 units (products of six lengths past float's largest), and
+// a sub-triangle may be 1/1000 of the box, so the band keeps a margin of 2^7 below and 2^4 above.
+double unitScale(double extent) {
+  if (!(extent > 0) || !std::isfinite(extent)) return 1;
+  const int e = std::ilogb(extent);
+  return e >= kLocalScaleMinExponent && e < kLocalScaleMaxExponent ? 1 : std::ldexp(1.0, -e);
+}
 }  // namespace
 
-glm::dvec3 latticeLocalOrigin(const Lattice& lattice) {
+LocalFrame latticeLocalFrame(const Lattice& lattice) {
   // The box's corners in world coordinates: x = frameLinear^-1 (p - frameOffset).
   const glm::dmat3 toWorld = glm::inverse(lattice.frameLinear);
   glm::dvec3 lo(INFINITY), hi(-INFINITY);
@@ -30,78 +43,97 @@ glm::dvec3 latticeLocalOrigin(const Lattice& lattice) {
     lo = glm::min(lo, x), hi = glm::max(hi, x);
   }
   const double extent = std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
-  glm::dvec3 origin;
-  for (int a = 0; a < 3; ++a) origin[a] = roundedOrigin(0.5 * (lo[a] + hi[a]), extent);
-  return origin;
+  LocalFrame frame;
+  for (int a = 0; a < 3; ++a) frame.origin[a] = roundedOrigin(0.5 * (lo[a] + hi[a]), extent);
+  frame.scale = unitScale(extent);
+  return frame;
 }
 
-Lattice localLattice(Lattice lattice, glm::dvec3 origin) {
-  // World: x = x' + origin, so p = F x + o = F x' + (o + F origin). Parameters too (a native lattice's
-  // knots are world coordinates): p = p' + q with q the domain's centre rounded, so the kernels'
-  // parameters are as small as the box; knots - q is exact (Sterbenz) for a box far from 0.
-  glm::dvec3 q;
+Lattice localLattice(Lattice lattice, const LocalFrame& frame) {
+  // World: x = x' / s + origin, so p = F x + o = (F / s) x' + (o + F origin). Parameters too (a native
+  // lattice's knots are world coordinates, as small or large as the model): p' = (p - q) t, with q the
+  // domain's centre rounded and t the power of two that brings the domain to a usual size, so the
+  // kernels' parameters are as small as the box and of size 1; knots - q is exact (Sterbenz) for a box
+  // far from 0, and the scales are exact.
+  const double s = frame.scale;
+  glm::dvec3 q(0.0), t(1.0);
+  for (int a = 0; a < 3; ++a) {
+    const double extent = lattice.domainHi(a) - lattice.domainLo(a);
+    q[a] = roundedOrigin(0.5 * (lattice.domainLo(a) + lattice.domainHi(a)), extent);
+    t[a] = unitScale(extent);
+  }
+  for (glm::dvec3& p : lattice.controlPoints) p = (p - frame.origin) * s;
+  lattice.frameOffset = (lattice.frameOffset + lattice.frameLinear * frame.origin - q) * t;
+  for (int c = 0; c < 3; ++c)
+    for (int a = 0; a < 3; ++a) lattice.frameLinear[c][a] *= t[a] / s;   // glm: [column][row]; row a is axis a
   for (int a = 0; a < 3; ++a)
-    q[a] = roundedOrigin(0.5 * (lattice.domainLo(a) + lattice.domainHi(a)), lattice.domainHi(a) - lattice.domainLo(a));
-  for (glm::dvec3& p : lattice.controlPoints) p -= origin;
-  lattice.frameOffset += lattice.frameLinear * origin - q;
-  for (int a = 0; a < 3; ++a)
-    for (double& k : lattice.knots[a]) k -= q[a];
+    for (double& k : lattice.knots[a]) k = (k - q[a]) * t[a];
   return lattice;
 }
 
-Mesh translatedMesh(Mesh mesh, glm::dvec3 by) {
-  for (glm::dvec3& p : mesh.positions) p += by;
+Mesh localMesh(Mesh mesh, const LocalFrame& frame) {
+  for (glm::dvec3& p : mesh.positions) p = (p - frame.origin) * frame.scale;
+  return mesh;
+}
+
+Mesh worldMesh(Mesh mesh, const LocalFrame& frame) {
+  for (glm::dvec3& p : mesh.positions) p = frame.toWorld(p);
   return mesh;
 }
 
 namespace {
 
-// Hands each piece to `to` with its positions moved by `by` (as translatedMesh).
-class TranslatingSink final : public MeshSink {
+// Hands each piece to `to` with its positions in world coordinates (as worldMesh).
+class WorldSink final : public MeshSink {
  public:
-  TranslatingSink(MeshSink& to, glm::dvec3 by) : to_(to), by_(by) {}
+  WorldSink(MeshSink& to, const LocalFrame& frame) : to_(to), frame_(frame) {}
   void begin(const Mesh& tables) override { to_.begin(tables); }
   void add(const Mesh& piece, size_t firstVertex) override {
     moved_ = piece;
-    for (glm::dvec3& p : moved_.positions) p += by_;
+    for (glm::dvec3& p : moved_.positions) p = frame_.toWorld(p);
     to_.add(moved_, firstVertex);
   }
   void end() override { to_.end(); }
 
  private:
   MeshSink& to_;
-  glm::dvec3 by_;
+  LocalFrame frame_;
   Mesh moved_;
 };
 
 // A method run on local inputs whose results are handed out in world coordinates (except
-// deviceOutput(), which stays on the device in local coordinates: Deformer::localOrigin()).
+// deviceOutput(), which stays on the device in local coordinates: Deformer::localOrigin(), localScale()).
+// Normals and the normal patches are directions, the same in both frames.
 class LocalFrameRun final : public MethodRun {
  public:
-  LocalFrameRun(std::unique_ptr<MethodRun> local, glm::dvec3 origin) : local_(std::move(local)), origin_(origin) {}
+  LocalFrameRun(std::unique_ptr<MethodRun> local, const LocalFrame& frame) : local_(std::move(local)), frame_(frame) {}
 
   void deform(const Lattice& lattice, Timings& timings, const ProgressReporter& progress) override {
-    local_->deform(localLattice(lattice, origin_), timings, progress);
+    local_->deform(localLattice(lattice, frame_), timings, progress);
   }
-  Mesh result(const ProgressReporter& progress) const override { return translatedMesh(local_->result(progress), origin_); }
+  Mesh result(const ProgressReporter& progress) const override { return worldMesh(local_->result(progress), frame_); }
   void streamResult(MeshSink& sink, const ProgressReporter& progress) const override {
-    TranslatingSink moved(sink, origin_);
+    WorldSink moved(sink, frame_);
     local_->streamResult(moved, progress);
   }
   std::vector<OutputChunk> deviceOutput() const override { return local_->deviceOutput(); }
   size_t subTriangles() const override { return local_->subTriangles(); }
   std::vector<double> patchControlPoints() const override {
-    // 20 points (x, y, z, 0) a sub-triangle: 10 of the geometry patch (translated), 10 of the normals.
+    // 20 points (x, y, z, 0) a sub-triangle: 10 of the geometry patch (moved), 10 of the normals.
     std::vector<double> points = local_->patchControlPoints();
     for (size_t i = 0; i + 80 <= points.size(); i += 80)
-      for (size_t k = 0; k < 10; ++k)
-        for (int a = 0; a < 3; ++a) points[i + 4 * k + a] += origin_[a];
+      for (size_t k = 0; k < 10; ++k) {
+        double* p = &points[i + 4 * k];
+        const glm::dvec3 world = frame_.toWorld({p[0], p[1], p[2]});
+        for (int a = 0; a < 3; ++a) p[a] = world[a];
+      }
     return points;
   }
   std::optional<PatchVertices> patchVertices() const override {
     std::optional<PatchVertices> patches = local_->patchVertices();
     if (patches)
-      for (size_t i = 0; i < patches->position.size(); ++i) patches->position[i] += origin_[i % 3];
+      for (size_t i = 0; i < patches->position.size(); ++i)
+        patches->position[i] = patches->position[i] / frame_.scale + frame_.origin[i % 3];
     return patches;
   }
   void precompute(Timings& timings) override { local_->precompute(timings); }
@@ -109,14 +141,14 @@ class LocalFrameRun final : public MethodRun {
 
  private:
   std::unique_ptr<MethodRun> local_;
-  glm::dvec3 origin_;
+  LocalFrame frame_;
 };
 
 }  // namespace
 
-std::unique_ptr<MethodRun> inLocalFrame(std::unique_ptr<MethodRun> local, glm::dvec3 origin) {
-  if (origin == glm::dvec3(0.0)) return local;
-  return std::make_unique<LocalFrameRun>(std::move(local), origin);
+std::unique_ptr<MethodRun> inLocalFrame(std::unique_ptr<MethodRun> local, const LocalFrame& frame) {
+  if (frame.isWorld()) return local;
+  return std::make_unique<LocalFrameRun>(std::move(local), frame);
 }
 
 }  // namespace sffd
