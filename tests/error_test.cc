@@ -114,3 +114,33 @@ TEST(ErrorCommand, HumanReadableSummaryAndBadOptions) {
   EXPECT_EQ(slurp(stats), json.out);
   fs::remove_all(dir);
 }
+
+// The analysis computes in the Deformer's frame (docs/ROBUSTNESS.md "Models of any size"): a model 1e-100 or
+// 1e100 across has the errors of size 1, scaled (before, its normal error was 0 or 2 degrees and its reference
+// volume 0 or NaN: squared lengths and volumes in world units left double's range).
+TEST(ErrorCommand, EverySizeHasTheErrorsOfSizeOne) {
+  const fs::path dir = tempDir("error_sizes");
+  nlohmann::json unit;
+  for (const char* size : {"1", "1e-100", "1e100"}) {
+    const std::string lattice = (dir / (std::string(size) + ".json")).string(), mesh = kData + "cube2.obj --normalize " + size;
+    ASSERT_EQ(runSffd("lattice " + mesh + " -o " + lattice + " --preset twist:0.4 --quiet").status, 0);
+    Result r = runSffd("error " + mesh + " -l " + lattice + " --json --quiet --backend cpu --tess 3 --method classic");
+    ASSERT_EQ(r.status, 0) << size << r.err;
+    const nlohmann::json j = nlohmann::json::parse(r.out);
+    if (unit.is_null()) {
+      unit = j;
+      ASSERT_GT(unit["geometry"]["avg"].get<double>(), 0);
+      ASSERT_GT(unit["normal_deg"]["avg"].get<double>(), 0);
+      continue;
+    }
+    const double s = std::stod(size);
+    auto near = [&](double value, double reference, const char* what) {
+      EXPECT_NEAR(value, reference, 1e-3 * std::abs(reference)) << size << " " << what;
+    };
+    near(j["geometry"]["avg"].get<double>() / s, unit["geometry"]["avg"].get<double>(), "geometry avg");
+    near(j["geometry"]["max"].get<double>() / s, unit["geometry"]["max"].get<double>(), "geometry max");
+    near(j["normal_deg"]["avg"].get<double>(), unit["normal_deg"]["avg"].get<double>(), "normal avg");
+    near(j["volume"]["reference"].get<double>() / (s * s * s), unit["volume"]["reference"].get<double>(), "volume");
+    EXPECT_NEAR(j["volume"]["rel_error"].get<double>(), unit["volume"]["rel_error"].get<double>(), 1e-5) << size;
+  }
+}

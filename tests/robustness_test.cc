@@ -661,6 +661,22 @@ TEST(RobustFold, IdentityAndPresetsAreCleanFoldsAreSeen) {
   R.frameLinear = glm::dmat3(0, 1, 0, 1, 0, 0, 0, 0, 2);   // swaps x and y: det < 0
   setIdentityControlPoints(R);
   EXPECT_TRUE(checkLatticeFold(packLattice(R)).clean());
+  // Boxes 2^-400 and 2^400 across, native and framed: the ratio is parameters per parameter, the same at
+  // every size (det J_R and det A alone, cubes of lengths, left double's range: "collapses" below about
+  // 1e-100, NaN above 1e100).
+  for (int k : {-400, 400}) {
+    const double size = std::ldexp(1.0, k);
+    Lattice native = makeIdentityLattice({-size, -size, -size}, {size, size, size}, {5, 5, 5}, {2, 2, 2});
+    applyLatticePreset(native, "twist", 0.5);
+    Lattice framed = makeIdentityLattice({0, 0, 0}, {1, 1, 1}, {5, 5, 5}, {2, 2, 2});
+    framed.frameLinear = glm::dmat3(1 / size);
+    setIdentityControlPoints(framed);
+    for (const Lattice* lattice : {&native, &framed}) {
+      const FoldCheck c = checkLatticeFold(packLattice(*lattice));
+      EXPECT_TRUE(c.clean()) << k << foldWarning(c, "x");
+      EXPECT_GT(c.minRatio, 0.1) << k;
+    }
+  }
   // A small budget: every box's 27 samples, on an even stride of boxes.
   Lattice B = makeIdentityLattice({0, 0, 0}, {1, 1, 1}, {16, 16, 16}, {2, 2, 2});
   FoldCheck s = checkLatticeFold(packLattice(B), 10000);

@@ -26,12 +26,12 @@ int run(const ParsedArgs& args) {
   Device& device = opened.device;
   DeformRun run = runDeformJob(args, job, device);
   const bool f64 = run.deformer.doublePrecision();
-  // job.mesh as the method used it (its triangles are the patches' parents).
-  PackedLattice packed = packLattice(job.lattice);
+  // job.mesh as the method used it (its triangles are the patches' parents), measured in the frame the
+  // devices computed in (a model far from the origin, or of any size).
   std::optional<PatchVertices> samples = run.patches();
   if (!samples) samples = linearPatchVertices(run.mesh, args.getInt("--tess", 10));
-  ErrorReport rep = measureErrors(job.mesh, packed, *samples);
-  rep.volume = measureVolume(job.mesh, job.lattice, run.mesh);
+  const LocalFrame frame{run.deformer.localOrigin(), run.deformer.localScale()};
+  const ErrorReport rep = measureErrorsInFrame(job.mesh, job.lattice, std::move(*samples), run.mesh, frame);
 
   if (args.has("--json") || args.has("--stats")) {
     nlohmann::ordered_json j = {

@@ -232,4 +232,25 @@ std::optional<VolumeError> measureVolume(const Mesh& input, const Lattice& latti
   return v;
 }
 
+ErrorReport measureErrorsInFrame(const Mesh& input, const Lattice& lattice, PatchVertices result, const Mesh& output,
+                                 const LocalFrame& frame) {
+  if (frame.isWorld()) {
+    ErrorReport report = measureErrors(input, packLattice(lattice), result);
+    report.volume = measureVolume(input, lattice, output);
+    return report;
+  }
+  const Mesh localInput = localMesh(input, frame);
+  const Lattice local = localLattice(lattice, frame);
+  for (size_t i = 0; i < result.position.size(); ++i) result.position[i] = (result.position[i] - frame.origin[i % 3]) * frame.scale;
+  ErrorReport report = measureErrors(localInput, packLattice(local), result);
+  for (double* length : {&report.geometry.avg, &report.geometry.max, &report.geometry.std}) *length /= frame.scale;
+  report.volume = measureVolume(localInput, local, localMesh(output, frame));
+  if (report.volume) {
+    const double cube = frame.scale * frame.scale * frame.scale;   // a power of two: exact
+    report.volume->reference /= cube;
+    report.volume->result /= cube;
+  }
+  return report;
+}
+
 }  // namespace sffd

@@ -24,6 +24,7 @@
 #include "model/lattice.h"
 #include "model/lattice_pack.h"
 #include "model/mesh.h"
+#include "pipelines/local_frame.h"
 #include "pipelines/patch_output.h"
 
 namespace sffd {
@@ -77,6 +78,12 @@ bool isClosed(const Mesh& mesh);
 double exactDeformedVolume(const Mesh& input, const Lattice& lattice, int quadraturePoints = 0);
 // Volume error of `output`, absent when the input is open.
 std::optional<VolumeError> measureVolume(const Mesh& input, const Lattice& lattice, const Mesh& output);
+
+// measureErrors and measureVolume computed in `frame` (the Deformer's: Deformer::localOrigin(),
+// localScale()) and given in world units: the squared lengths and the volumes of a model 1e-100 or 1e100
+// across stay in double's range there, as the devices' computation does.
+ErrorReport measureErrorsInFrame(const Mesh& input, const Lattice& lattice, PatchVertices result, const Mesh& output,
+                                 const LocalFrame& frame);
 
 // Gauss-Legendre nodes and weights on [0, 1], q points (exact to degree 2q-1).
 void gaussLegendre01(int q, std::vector<double>& nodes, std::vector<double>& weights);

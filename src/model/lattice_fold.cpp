@@ -60,8 +60,10 @@ FoldCheck checkLatticeFold(const PackedLattice& P, size_t maxCoefficientVisits) 
                 Rv += cp * (b[0][su][i] * db[1][sv][j] * b[2][sw][k]);
                 Rw += cp * (b[0][su][i] * b[1][sv][j] * db[2][sw][k]);
               }
-          // d/dp = (1/h) d/ds on each axis; ratio = det J_R / det(A^-1) = det J_R * det(A).
-          double ratio = glm::dot(Ru, glm::cross(Rv, Rw)) / (h[0] * h[1] * h[2]) * detA;
+          // d/dp = (1/h) d/ds on each axis; ratio = det J_R / det(A^-1) = det(A J_R): the product first,
+          // parameters per parameter, so the cubes of lengths that det J_R and det A are stay in double's
+          // range for a lattice of any size.
+          const double ratio = glm::determinant(A * glm::dmat3(Ru / h[0], Rv / h[1], Rw / h[2]));
           ++r.samples;
           if (!std::isfinite(ratio) || std::abs(ratio) <= FoldCheck::kCollapse) ++r.degenerate;
           else if (ratio > 0) ++r.positive;

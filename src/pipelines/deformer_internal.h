@@ -15,6 +15,7 @@
 
 #include "core/backend.h"
 #include "core/job_budget.h"
+#include "pipelines/local_frame.h"
 #include "pipelines/patch_output.h"
 
 namespace sffd {
@@ -104,24 +105,8 @@ std::unique_ptr<MethodRun> makeAccurateRun(Backend& backend, const Mesh& input, 
                                            uint64_t heldBytes, std::optional<JobEstimate>& estimate,
                                            std::optional<JobEstimate>& whole);
 
-// Computing in coordinates local to the lattice box (deformer_local_frame.cpp): the devices see
-// local = (world - origin) * scale. The origin is 0 for a box near the world origin; the scale a power of
-// two, 1 for a box from 2^kLocalScaleMinExponent to 2^kLocalScaleMaxExponent across, else the one that
-// brings the box to a size from 1 to 2.
-constexpr int kLocalScaleMinExponent = -8, kLocalScaleMaxExponent = 12;
-struct LocalFrame {
-  glm::dvec3 origin{0.0};
-  double scale = 1;
-  bool isWorld() const { return origin == glm::dvec3(0.0) && scale == 1; }
-  glm::dvec3 toWorld(glm::dvec3 local) const { return local / scale + origin; }
-};
-// The frame of a lattice; a mesh in it and back; the lattice as the devices see it (control points and
-// frame moved and scaled, its parameter space centred and of size 1); and a run on those local inputs
-// whose results come out in world coordinates (deviceOutput() stays local).
-LocalFrame latticeLocalFrame(const Lattice& lattice);
-Mesh localMesh(Mesh mesh, const LocalFrame& frame);
-Mesh worldMesh(Mesh mesh, const LocalFrame& frame);
-Lattice localLattice(Lattice lattice, const LocalFrame& frame);
+// A run on inputs in `frame` (local_frame.h) whose results come out in world coordinates
+// (deviceOutput() stays local).
 std::unique_ptr<MethodRun> inLocalFrame(std::unique_ptr<MethodRun> local, const LocalFrame& frame);
 
 struct Deformer::Impl {

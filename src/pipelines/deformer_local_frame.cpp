@@ -62,7 +62,7 @@ Lattice localLattice(Lattice lattice, const LocalFrame& frame) {
     q[a] = roundedOrigin(0.5 * (lattice.domainLo(a) + lattice.domainHi(a)), extent);
     t[a] = unitScale(extent);
   }
-  for (glm::dvec3& p : lattice.controlPoints) p = (p - frame.origin) * s;
+  for (glm::dvec3& p : lattice.controlPoints) p = frame.toLocal(p);
   lattice.frameOffset = (lattice.frameOffset + lattice.frameLinear * frame.origin - q) * t;
   for (int c = 0; c < 3; ++c)
     for (int a = 0; a < 3; ++a) lattice.frameLinear[c][a] *= t[a] / s;   // glm: [column][row]; row a is axis a
@@ -72,12 +72,16 @@ Lattice localLattice(Lattice lattice, const LocalFrame& frame) {
 }
 
 Mesh localMesh(Mesh mesh, const LocalFrame& frame) {
-  for (glm::dvec3& p : mesh.positions) p = (p - frame.origin) * frame.scale;
+  for (glm::dvec3& p : mesh.positions) p = frame.toLocal(p);
+  for (BicubicPatch& patch : mesh.patches)
+    for (glm::dvec3& p : patch.points) p = frame.toLocal(p);
   return mesh;
 }
 
 Mesh worldMesh(Mesh mesh, const LocalFrame& frame) {
   for (glm::dvec3& p : mesh.positions) p = frame.toWorld(p);
+  for (BicubicPatch& patch : mesh.patches)
+    for (glm::dvec3& p : patch.points) p = frame.toWorld(p);
   return mesh;
 }
 
@@ -133,7 +137,7 @@ class LocalFrameRun final : public MethodRun {
     std::optional<PatchVertices> patches = local_->patchVertices();
     if (patches)
       for (size_t i = 0; i < patches->position.size(); ++i)
-        patches->position[i] = patches->position[i] / frame_.scale + frame_.origin[i % 3];
+        patches->position[i] = patches->position[i] / frame_.scale + frame_.origin[i % 3];   // toWorld, a coordinate at a time
     return patches;
   }
   void precompute(Timings& timings) override { local_->precompute(timings); }
