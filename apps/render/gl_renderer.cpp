@@ -280,10 +280,12 @@ void Renderer::setItems(const std::vector<RenderItem>& items) {
     }
   }
   const glm::dvec3 centre = std::isfinite(lo.x) ? (lo + hi) * 0.5 : glm::dvec3(0);
+  const double extent = std::isfinite(lo.x) ? std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z}) : 0.0;
 
   context_->activate();
   deleteMeshes();
   sceneCentre_ = centre;
+  sceneScale_ = extent > 0 && std::isfinite(extent) ? std::ldexp(1.0, -std::ilogb(extent)) : 1.0;
   for (const RenderItem& it : items) {
     const Mesh& m = *it.mesh;
     auto g = std::make_unique<GpuMesh>();
@@ -303,7 +305,7 @@ void Renderer::setItems(const std::vector<RenderItem>& items) {
     g->scalarMin = std::numeric_limits<float>::infinity();
     g->scalarMax = -std::numeric_limits<float>::infinity();
     for (size_t v = 0; v < n; ++v) {
-      glm::vec3 p(m.positions[v] - centre);
+      glm::vec3 p((m.positions[v] - centre) * sceneScale_);
       glm::vec3 nv(normals[v]);
       float s = g->hasScalars ? it.scalars[v] : 0.0f;
       if (g->hasScalars && std::isfinite(s)) {
@@ -357,6 +359,7 @@ void Renderer::setBufferItem(const BufferItem& item) {
   context_->activate();
   deleteMeshes();
   sceneCentre_ = glm::dvec3(0);   // the buffers hold world positions
+  sceneScale_ = 1;
   auto g = std::make_unique<GpuMesh>();
   g->caption = item.caption;
   g->points = item.fitPoints;
@@ -503,10 +506,10 @@ Renderer::Frame Renderer::frame(const RenderOptions& o, int width, int height) c
     cam.aspect = static_cast<double>(cam.width) / cam.height;
     if (o.placement) {   // placed by the caller: nothing to fit
       Fit f;
-      f.target = o.placement->target - sceneCentre_;
-      f.distance = o.placement->distance;
-      f.zNear = o.placement->zNear;
-      f.zFar = o.placement->zFar;
+      f.target = (o.placement->target - sceneCentre_) * sceneScale_;
+      f.distance = o.placement->distance * sceneScale_;
+      f.zNear = o.placement->zNear * sceneScale_;
+      f.zFar = o.placement->zFar * sceneScale_;
       fits.push_back(f);
     } else {
       fits.push_back(fitPoints({&meshes_[static_cast<size_t>(i)]->points}, right, camUp, front,
@@ -524,11 +527,12 @@ Renderer::Frame Renderer::frame(const RenderOptions& o, int width, int height) c
       f.zNear += extra;
       f.zFar += extra;
     }
-    cam.target = f.target + sceneCentre_;
-    cam.eye = cam.target + front * f.distance;
+    // The fits are in the scene's float coordinates; the cameras in world units.
+    cam.target = f.target / sceneScale_ + sceneCentre_;
+    cam.eye = cam.target + front * (f.distance / sceneScale_);
     cam.up = camUp;
-    cam.zNear = f.zNear;
-    cam.zFar = f.zFar;
+    cam.zNear = f.zNear / sceneScale_;
+    cam.zFar = f.zFar / sceneScale_;
     cam.view = glm::lookAt(cam.eye, cam.target, camUp);
     cam.projection = glm::perspective(fovY, cam.aspect, cam.zNear, cam.zFar);
   }
@@ -592,9 +596,9 @@ std::vector<SlotCamera> Renderer::draw(const RenderOptions& o, int width, int he
     const GpuMesh& m = *meshes_[i];
     const SlotCamera& cam = cams[i];
     glViewport(cam.x, cam.y, cam.width, cam.height);
-    // Positions on the GPU are relative to the scene centre: so is the model-view matrix.
-    glm::mat4 modelView(glm::lookAt(cam.eye - sceneCentre_, cam.target - sceneCentre_, camUp));
-    glm::mat4 projection(cam.projection);
+    // Positions on the GPU are relative to the scene centre and scaled: so are the matrices.
+    glm::mat4 modelView(glm::lookAt((cam.eye - sceneCentre_) * sceneScale_, (cam.target - sceneCentre_) * sceneScale_, camUp));
+    glm::mat4 projection(glm::perspective(glm::radians(cam.fovYDeg), cam.aspect, cam.zNear * sceneScale_, cam.zFar * sceneScale_));
     glUniformMatrix4fv(P.meshModelView, 1, GL_FALSE, glm::value_ptr(modelView));
     glUniformMatrix4fv(P.meshProjection, 1, GL_FALSE, glm::value_ptr(projection));
     glUniform2f(P.meshViewport, static_cast<float>(cam.width), static_cast<float>(cam.height));

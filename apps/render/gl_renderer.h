@@ -147,7 +147,9 @@ class Renderer {
   int maxSize_ = 0, maxSamples_ = 1;
   std::unique_ptr<Programs> programs_;
   std::vector<std::unique_ptr<GpuMesh>> meshes_;
-  glm::dvec3 sceneCentre_{0};   // subtracted from positions before they become float
+  glm::dvec3 sceneCentre_{0};   // subtracted from positions before they become float,
+  double sceneScale_ = 1;       // then multiplied by this power of two that brings the scene to a size of 1
+                                // to 2 (exact): the shaders' squared lengths stay in float's range at any size
   unsigned overlayVao_ = 0, overlayVbo_ = 0, emptyVao_ = 0;
   // offscreen target: multisampled colour + depth, resolved into a single-sample colour buffer
   int targetWidth_ = 0, targetHeight_ = 0, targetSamples_ = 0;

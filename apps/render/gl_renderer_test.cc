@@ -134,6 +134,26 @@ TEST_F(RendererTest, SphereSilhouetteCoversTheExpectedFraction) {
   std::printf("sphere covers %.4f of the picture, expected %.4f\n", fraction, expected);
 }
 
+// A scene of any size gives the picture of size 1: positions become float relative to the scene's centre
+// and scaled by a power of two to a size of 1 to 2 (the shaders' squared lengths left float's range: a
+// sphere 1e-30 across was framed off centre, its highlights lost, as one 1e30 across far from the origin).
+TEST_F(RendererTest, EverySizeAndPlaceGivesThePictureOfSizeOne) {
+  const RenderOptions o = smallOptions();
+  const Mesh unit = makeSphere();
+  const Image reference = renderer->render({{&unit, {}, ""}}, o);
+  for (double size : {1e-30, 1e-12, 1e12, 1e30})
+    for (double away : {0.0, 1e3}) {
+      const Mesh sphere = makeSphere(size, glm::dvec3(away * size, -away * size, 0.5 * away * size));
+      const Image img = renderer->render({{&sphere, {}, ""}}, o);
+      ASSERT_EQ(img.rgba.size(), reference.rgba.size());
+      size_t differ = 0;
+      for (int y = 0; y < img.height; ++y)
+        for (int x = 0; x < img.width; ++x) differ += maxChannelDiff(img, reference, x, y) > 8;
+      EXPECT_LT(differ, 20u) << size << " at " << away;
+      EXPECT_NEAR(img.cameras[0].target.x / size, away, 1e-3 + 1e-9 * away) << size;
+    }
+}
+
 TEST_F(RendererTest, BackgroundIsALightGradient) {
   Image bg = renderer->render({}, smallOptions());
   double top = luminance(bg, 80, 2), bottom = luminance(bg, 80, 117);
