@@ -78,8 +78,11 @@ int run(const ParsedArgs& args) {
     throw Error(ErrorKind::Input, "sffd lattice needs a MESH to fit a lattice to, or --from LATTICE");
   Lattice lattice = args.has("--from") ? latticeFrom(args) : fittedLattice(args);
   const std::string source = args.has("--from") ? args.get("--from") : out;
-  if (args.has("--refine")) lattice = refineLattice(lattice, args.getTriple("--refine", {1, 1, 1}), source);
-  if (args.has("--elevate")) lattice = elevateLattice(lattice, args.getTriple("--elevate", {0, 0, 0}), source);
+  const uint64_t limit = memoryLimitFromEnvironment();
+  if (args.has("--refine"))
+    lattice = withToolLimitName([&] { return refineLattice(lattice, args.getTriple("--refine", {1, 1, 1}), source, limit); });
+  if (args.has("--elevate"))
+    lattice = withToolLimitName([&] { return elevateLattice(lattice, args.getTriple("--elevate", {0, 0, 0}), source, limit); });
   if (args.has("--preset")) applyPreset(lattice, args.get("--preset"));
   writeLattice(out, lattice);
   note(args, "wrote " + out + " (" + std::to_string(lattice.counts[0]) + "x" + std::to_string(lattice.counts[1]) + "x" +

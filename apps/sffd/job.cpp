@@ -251,7 +251,7 @@ uint64_t memoryLimitFromEnvironment() {
 }
 
 std::string toolLimitMessage(std::string what) {
-  for (const char* name : {"(DeformOptions::memoryLimit)", "(LatticeReadOptions::memoryLimit)"})
+  for (const char* name : {"(DeformOptions::memoryLimit)", "(LatticeReadOptions::memoryLimit)", "(the memoryLimit of refineLattice or elevateLattice)"})
     if (size_t at = what.find(name); at != std::string::npos) what.replace(at, std::strlen(name), "(SFFD_MEMORY_LIMIT)");
   return what;
 }

@@ -76,14 +76,18 @@ void applyLatticePreset(Lattice& lattice, const std::string& name, double amount
 
 // Knot insertion (Boehm): every knot span of axis a split into parts[a] equal spans (1: unchanged,
 // up to 64). The volume is the same to rounding (about 1e-15 of the control net's size), with more
-// control points to move. Throws an input Error naming `source` for a bad lattice or part count.
-Lattice refineLattice(const Lattice& lattice, std::array<int, 3> parts, const std::string& source = "refine");
+// control points to move. Throws an input Error naming `source` for a bad lattice or part count, or
+// before anything is allocated when the work would need more than `memoryLimit` bytes of host memory
+// (0: the physical memory; about 56 bytes a new control point), as elevateLattice does.
+Lattice refineLattice(const Lattice& lattice, std::array<int, 3> parts, const std::string& source = "refine",
+                      uint64_t memoryLimit = 0);
 
 // Degree elevation: degree[a] raised by by[a] (the result stays <= 5), every interior knot's
 // multiplicity raised as much, so the continuity and the volume are unchanged (to rounding); the knot
 // vectors come back clamped over the same domain. A discontinuous lattice (an interior knot of
 // multiplicity above the degree) is refused with an input Error naming `source`.
-Lattice elevateLattice(const Lattice& lattice, std::array<int, 3> by, const std::string& source = "elevate");
+Lattice elevateLattice(const Lattice& lattice, std::array<int, 3> by, const std::string& source = "elevate",
+                       uint64_t memoryLimit = 0);
 
 struct LatticeReadOptions {
   std::array<int, 3> npyDegree{2, 2, 2};   // .npy files carry no degree

@@ -436,12 +436,16 @@ void writeLatticeJson(const std::string& path, const Lattice& L) {
   }
   s += std::string("  \"outside\": \"") + (L.outside == OutsideMode::Keep ? "keep" : "extrapolate") + "\",\n";
   s += "  \"control_points\": [";
-  for (size_t i = 0; i < L.controlPoints.size(); ++i) {
-    s += i ? ",\n    " : "\n    ";
-    vec(s, L.controlPoints[i]);
-  }
-  s += "\n  ]\n}\n";
-  writeFileAtomically(path, [&](std::ostream& os) { os.write(s.data(), std::streamsize(s.size())); });
+  // The control points written a block at a time: a lattice of 2^24 points is a 1 GB text.
+  writeFileAtomically(path, [&](std::ostream& os) {
+    for (size_t i = 0; i < L.controlPoints.size(); ++i) {
+      s += i ? ",\n    " : "\n    ";
+      vec(s, L.controlPoints[i]);
+      if (s.size() >= (1u << 20)) os.write(s.data(), std::streamsize(s.size())), s.clear();
+    }
+    s += "\n  ]\n}\n";
+    os.write(s.data(), std::streamsize(s.size()));
+  });
 }
 
 // ---------------------------------------------------------------------------------------------------

@@ -10,6 +10,7 @@
 
 #include <sffd/error.h>
 
+#include "core/job_budget.h"
 #include "model/lattice.h"
 
 namespace sffd {
@@ -17,6 +18,7 @@ namespace {
 
 // The most control points along one axis these operations make (their maps are dense: count^2 each).
 constexpr int64_t kMaxAxisCount = 1024;
+constexpr const char* kRefineLimitName = "the memoryLimit of refineLattice or elevateLattice";
 
 // Rows: new control points, columns: old ones (P_new[r] = sum_c M[r][c] P_old[c]).
 using AxisMap = std::vector<std::vector<double>>;
@@ -124,14 +126,27 @@ AxisMap elevateAxis(std::vector<double>& knots, int& p, int count, int by, const
   return solve(std::move(A), std::move(B));
 }
 
-// Applies one map per axis to the control net (counts change to the maps' row counts).
-void applyAxisMaps(Lattice& L, const std::array<AxisMap, 3>& maps, const std::string& source) {
+// Applies one map per axis to the control net (counts change to the maps' row counts), within
+// `memoryLimit`: the caller's lattice and the nets before and after one axis are alive at once.
+void applyAxisMaps(Lattice& L, const std::array<AxisMap, 3>& maps, const std::string& source, uint64_t memoryLimit) {
   const int64_t points = int64_t(maps[0].size()) * int64_t(maps[1].size()) * int64_t(maps[2].size());
   if (points > int64_t(kMaxLatticeControlPoints))
     throw inputError(source, 0, "the lattice would have " + std::to_string(points) + " control points; at most " +
                                     std::to_string(kMaxLatticeControlPoints));
+  uint64_t net = L.controlPoints.size(), peak = 0;
+  std::array<uint64_t, 3> counts = {uint64_t(L.counts[0]), uint64_t(L.counts[1]), uint64_t(L.counts[2])};
+  for (int a = 0; a < 3; ++a) {
+    counts[a] = maps[a].size();
+    const uint64_t next = counts[0] * counts[1] * counts[2];
+    peak = std::max(peak, net + next);
+    net = next;
+  }
+  const uint64_t bytes = (L.controlPoints.size() + peak) * sizeof(glm::dvec3);
+  checkHostBytesFit(bytes, memoryLimit, kRefineLimitName,
+                    source + ": the lattice of " + std::to_string(points) + " control points needs",
+                    "refine or elevate less");
   std::array<int, 3> n = L.counts;
-  std::vector<glm::dvec3> cur = L.controlPoints;
+  std::vector<glm::dvec3> cur = std::move(L.controlPoints);
   for (int a = 0; a < 3; ++a) {
     std::array<int, 3> m = n;
     m[a] = int(maps[a].size());
@@ -159,7 +174,7 @@ void applyAxisMaps(Lattice& L, const std::array<AxisMap, 3>& maps, const std::st
 
 }  // namespace
 
-Lattice refineLattice(const Lattice& lattice, std::array<int, 3> parts, const std::string& source) {
+Lattice refineLattice(const Lattice& lattice, std::array<int, 3> parts, const std::string& source, uint64_t memoryLimit) {
   validateLattice(lattice, source);
   Lattice L = lattice;
   std::array<AxisMap, 3> maps;
@@ -173,12 +188,12 @@ Lattice refineLattice(const Lattice& lattice, std::array<int, 3> parts, const st
                                       " control points; at most " + std::to_string(kMaxAxisCount));
     maps[a] = refineAxis(L.knots[a], L.degree[a], L.counts[a], parts[a]);
   }
-  applyAxisMaps(L, maps, source);
+  applyAxisMaps(L, maps, source, memoryLimit);
   validateLattice(L, source);
   return L;
 }
 
-Lattice elevateLattice(const Lattice& lattice, std::array<int, 3> by, const std::string& source) {
+Lattice elevateLattice(const Lattice& lattice, std::array<int, 3> by, const std::string& source, uint64_t memoryLimit) {
   validateLattice(lattice, source);
   Lattice L = lattice;
   std::array<AxisMap, 3> maps;
@@ -192,7 +207,7 @@ Lattice elevateLattice(const Lattice& lattice, std::array<int, 3> by, const std:
     }
     maps[a] = elevateAxis(L.knots[a], L.degree[a], L.counts[a], by[a], source, "uvw"[a]);
   }
-  applyAxisMaps(L, maps, source);
+  applyAxisMaps(L, maps, source, memoryLimit);
   validateLattice(L, source);
   return L;
 }

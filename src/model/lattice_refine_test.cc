@@ -91,5 +91,24 @@ TEST(LatticeRefine, RefusesWhatItCannotDoExactly) {
   EXPECT_LT(largestDifference(D, refineLattice(D, {2, 1, 1}), rng), 1e-12);
 }
 
+// The new control net is checked against the memory limit before it is made (it was bounded by the 2^24
+// points of kMaxLatticeControlPoints only: about 1.9 GB for `sffd lattice --refine`): 5^3 points refined
+// to 17^3 take the caller's net and, at the last axis, 17x17x5 and 17^3 points at once.
+TEST(LatticeRefine, TheNewNetIsCheckedAgainstTheMemoryLimit) {
+  std::mt19937 rng(7);
+  const Lattice L = randomLattice(rng, {2, 2, 2}, {5, 5, 5}, false);
+  const uint64_t need = (125 + 17 * 17 * 5 + 17 * 17 * 17) * sizeof(glm::dvec3);
+  EXPECT_EQ(refineLattice(L, {5, 5, 5}, "l.json", need).counts, (std::array<int, 3>{17, 17, 17}));
+  try {
+    refineLattice(L, {5, 5, 5}, "l.json", need - 1);
+    ADD_FAILURE() << "refined past the limit";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Input);
+    EXPECT_NE(std::string(e.what()).find("l.json: the lattice of 4913 control points needs about"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("(the memoryLimit of refineLattice or elevateLattice)"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(elevateLattice(L, {3, 3, 3}, "l.json", 1024), Error);
+}
+
 }  // namespace
 }  // namespace sffd
