@@ -22,9 +22,9 @@ double roundedOrigin(double centre, double extent) {
 }
 
 // The power of two that brings `extent` into [1, 2), or 1 for an extent of a usual size: the kernels'
-// thresholds are met from about 1e-6 (squared lengths of the sub-triangles' derivatives' cross products
-// below float's smallest normal number) and 1e6 units (products of six lengths past float's largest), and
-// a sub-triangle may be 1/1000 of the box, so the band keeps a margin of 2^7 below and 2^4 above.
+// thresholds changed the result of a box below about 1e-6 (2^-20) and above about 1e6 (2^20) units
+// across, whatever the edge length (docs/ROBUSTNESS.md "Models of any size"); the band [2^-8, 2^12)
+// keeps a margin of 2^12 below and 2^8 above, and keeps the results of usual models as they were.
 double unitScale(double extent) {
   if (!(extent > 0) || !std::isfinite(extent)) return 1;
   const int e = std::ilogb(extent);
