@@ -1,5 +1,7 @@
 #include "model/lattice_coverage.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 namespace sffd {
@@ -48,6 +50,36 @@ std::string discontinuityWarning(const Lattice& L, const std::string& name) {
     }
   }
   return {};
+}
+
+std::string floatResolutionWarning(const Mesh& mesh, const Lattice& L, bool doublePrecision, const std::string& name) {
+  if (doublePrecision || mesh.positions.empty()) return {};
+  glm::dvec3 lo(INFINITY), hi(-INFINITY);
+  for (const glm::dvec3& x : mesh.positions) lo = glm::min(lo, x), hi = glm::max(hi, x);
+  const double size = std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
+  // Per axis, the knot span holding the mesh's centre, in world units (the parameter map's inverse's column).
+  const glm::dvec3 centre = L.frameLinear * (0.5 * (lo + hi)) + L.frameOffset;
+  const glm::dmat3 toWorld = glm::inverse(L.frameLinear);
+  double span = 0;
+  for (int a = 0; a < 3; ++a) {
+    const std::vector<double>& k = L.knots[a];
+    const double u = std::clamp(centre[a], L.domainLo(a), L.domainHi(a));
+    double width = L.domainHi(a) - L.domainLo(a);
+    for (size_t i = size_t(L.degree[a]); i < size_t(L.counts[a]); ++i)
+      if (k[i] <= u && u <= k[i + 1] && k[i + 1] > k[i]) width = k[i + 1] - k[i];
+    span = std::max(span, width * glm::length(toWorld[a]));
+  }
+  const double resolution = std::ldexp(span, -24);
+  if (!(size > 0) || !(resolution >= size / 128) || !std::isfinite(resolution)) return {};
+  auto g = [](double v, const char* format) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, format, v);
+    return std::string(buf);
+  };
+  const double share = resolution / size;
+  return "the mesh is " + g(size, "%.3g") + " across, and the knot spans of lattice " + name + " that hold it " + g(span, "%.3g") +
+         ": float kernels resolve the result to about " + g(resolution, "%.2g") + ", " +
+         (share < 1 ? g(100 * share, "%.2g") + "% of the mesh" : g(share, "%.2g") + " times its size") + "; use --precision double";
 }
 
 }  // namespace sffd
