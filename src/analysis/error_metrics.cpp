@@ -122,14 +122,15 @@ PatchVertices linearPatchVertices(const Mesh& output, int level) {
   return pv;
 }
 
-double signedVolume(const Mesh& mesh) {
+double signedVolume(const Mesh& mesh, const LocalFrame& frame) {
   if (mesh.positions.empty()) return 0;
   glm::dvec3 lo(INFINITY), hi(-INFINITY);
   for (const auto& p : mesh.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
+  // About the box's centre, in the frame's units (its origin then plays no part).
   const glm::dvec3 c = 0.5 * (lo + hi);
+  auto at = [&](uint32_t v) { return (mesh.positions[v] - c) * frame.scale; };
   double v = 0;
-  for (const auto& t : mesh.triangles)
-    v += glm::dot(mesh.positions[t[0]] - c, glm::cross(mesh.positions[t[1]] - c, mesh.positions[t[2]] - c));
+  for (const auto& t : mesh.triangles) v += glm::dot(at(t[0]), glm::cross(at(t[1]), at(t[2])));
   return v / 6;
 }
 
@@ -223,13 +224,15 @@ double exactDeformedVolume(const Mesh& input, const Lattice& lattice, int quadra
   return total / 3;
 }
 
+namespace {
+VolumeError volumeError(double reference, double result) {
+  return {reference, result, reference != 0 ? std::abs(result - reference) / std::abs(reference) : std::abs(result)};
+}
+}  // namespace
+
 std::optional<VolumeError> measureVolume(const Mesh& input, const Lattice& lattice, const Mesh& output) {
   if (!isClosed(input)) return std::nullopt;
-  VolumeError v;
-  v.reference = exactDeformedVolume(input, lattice);
-  v.result = signedVolume(output);
-  v.relError = v.reference != 0 ? std::abs(v.result - v.reference) / std::abs(v.reference) : std::abs(v.result);
-  return v;
+  return volumeError(exactDeformedVolume(input, lattice), signedVolume(output));
 }
 
 ErrorReport measureErrorsInFrame(const Mesh& input, const Lattice& lattice, PatchVertices result, const Mesh& output,
@@ -244,8 +247,8 @@ ErrorReport measureErrorsInFrame(const Mesh& input, const Lattice& lattice, Patc
   for (size_t i = 0; i < result.position.size(); ++i) result.position[i] = (result.position[i] - frame.origin[i % 3]) * frame.scale;
   ErrorReport report = measureErrors(localInput, packLattice(local), result);
   for (double* length : {&report.geometry.avg, &report.geometry.max, &report.geometry.std}) *length /= frame.scale;
-  report.volume = measureVolume(localInput, local, localMesh(output, frame));
-  if (report.volume) {
+  if (isClosed(localInput)) {   // the output's volume in the frame's units too, without a copy of it
+    report.volume = volumeError(exactDeformedVolume(localInput, local), signedVolume(output, frame));
     const double cube = frame.scale * frame.scale * frame.scale;   // a power of two: exact
     report.volume->reference /= cube;
     report.volume->result /= cube;

@@ -69,8 +69,9 @@ ErrorReport measureErrors(const Mesh& input, const PackedLattice& lattice, const
 // the pre-image lam in the input triangle of the same index (classic keeps the input's connectivity).
 PatchVertices linearPatchVertices(const Mesh& output, int level);
 
-// Signed volume sum p0.(p1 x p2)/6 of the triangles (about the centre of their box).
-double signedVolume(const Mesh& mesh);
+// Signed volume sum p0.(p1 x p2)/6 of the triangles (about the centre of their box), in the units of
+// `frame` (its scale: a mesh 1e-110 across has a volume in them).
+double signedVolume(const Mesh& mesh, const LocalFrame& frame = {});
 // No boundary and no non-manifold edges (buildTopology, edges by weldId).
 bool isClosed(const Mesh& mesh);
 // The exactly deformed volume of the closed input (see above); `quadraturePoints` overrides the
