@@ -50,12 +50,12 @@ struct DeformOptions {
   Clip clip = Clip::Regular;
   double edgeLength = 0;         // the paper's l, in model units; 0: a tenth of the mesh's largest extent
   int tess = 10;                 // tessellation level of each patch, 1..64 (66 vertices, 100 triangles at 10)
-  int samples = 0;               // smooth: sampling density s of the fit; 0: nu+nv+nw (at least 3)
+  int samples = 0;               // smooth: sampling density s of the fit, 0..15; 0: nu+nv+nw (at least 3, as 1 and 2)
   bool strict = false;           // strict kernels: bit-identical on every device, the CPU included
   Precision precision = Precision::Auto;
   bool split = false;            // smooth: the deform step as four dispatches (per-step timings)
-  double creaseAngleDeg = kCreaseAngleAuto;  // smooth, meshes without normals: dihedral angle above which an
-                                             // edge is a crease, or kCreaseAngleAuto (<sffd/mesh.h>)
+  double creaseAngleDeg = kCreaseAngleAuto;  // smooth, meshes without normals: dihedral angle 0..180 above which
+                                             // an edge is a crease, or kCreaseAngleAuto (<sffd/mesh.h>)
   uint64_t memoryLimit = 0;      // bytes of host memory a job may plan for (every method); 0: physical memory
   size_t maxChunkElements = 0;   // 0: chunks as large as the device allows (smaller only to test chunking)
   ProgressCallback progress;     // called during long work; may be empty
@@ -65,8 +65,8 @@ struct DeformOptions {
   // stage a few parents at a time, each chunk's records and output done with once welded (timings() and
   // subTriangles() are then the run's; deviceOutput() is empty, patchControlPoints() throws). Accurate:
   // deform() only takes the lattice, and the result runs the kernels a chunk at a time in one device buffer
-  // (timings() are then the run's; deviceOutput() is empty). A second deform(), or a second result() or
-  // streamResult(), throws an input Error.
+  // (timings() are then the run's; deviceOutput() is empty). Every method: a second deform(), or a second
+  // result() or streamResult(), throws an input Error.
   bool once = false;
 };
 
@@ -88,7 +88,8 @@ struct OutputChunk {
 class Deformer {
  public:
   // Prepares `mesh` for lattices with the structure of `lattice` (degrees, counts, knots, frame) on
-  // `device`, which must outlive the Deformer. Throws an input Error for bad options or a mesh that
+  // `device`, which must outlive the Deformer (it may be moved meanwhile: the Deformer follows it). A
+  // moved-from Deformer throws an input Error from every call but destruction and assignment. Throws an input Error for bad options or a mesh that
   // cannot be deformed, a device Error when the device refuses the work.
   Deformer(Device& device, const Mesh& mesh, const Lattice& lattice, const DeformOptions& options = {});
   Deformer(Device& device, const MeshView& mesh, const Lattice& lattice, const DeformOptions& options = {});
@@ -97,7 +98,9 @@ class Deformer {
   ~Deformer();
 
   // Deforms with the lattice's current control points; an input Error if its structure differs
-  // from the one the Deformer was made for. The results below are those of the last call.
+  // from the one the Deformer was made for. The results below are those of the last call: before the
+  // first, or after one that was cancelled or threw, result(), streamResult() and patchControlPoints()
+  // throw an input Error and deviceOutput() is empty (the device's outputs would be part old, part new).
   const Timings& deform(const Lattice& lattice);
   // Times of the preparation (pn, clip) and of the last deform().
   const Timings& timings() const;
@@ -151,6 +154,7 @@ class Deformer {
 
  private:
   std::unique_ptr<Impl> impl_;
+  Impl& impl() const;   // an input Error on a moved-from Deformer
 };
 
 // Vertices and triangles of one patch tessellated at level L: (L+1)(L+2)/2 and L^2.

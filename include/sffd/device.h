@@ -72,6 +72,9 @@ class Device {
   // "auto", devices that fail are skipped and `notes` receives one line for each.
   static Device open(const DeviceRequest& request = {}, std::vector<std::string>* notes = nullptr);
 
+  // A Device may be moved while Deformers use it: they follow it to where it was moved. A moved-from
+  // Device throws an input Error from every call but destruction and assignment.
+
   Device(Device&&) noexcept;
   Device& operator=(Device&&) noexcept;
   ~Device();
@@ -82,10 +85,15 @@ class Device {
   // Internal: the compute backend (src/core/backend.h). Not part of the stable API.
   Backend& backend();
   explicit Device(std::string label, std::unique_ptr<Backend> backend);
+  // Internal: what a Deformer holds, which moves with the Device (a Deformer made on a Device keeps working
+  // after the Device is moved, into a std::vector say), and the Device that holds it now.
+  struct Impl;
+  Impl* handle() const;
+  static Device& of(Impl* handle);
 
  private:
-  struct Impl;
   std::unique_ptr<Impl> impl_;
+  Impl& impl() const;   // an input Error on a moved-from Device
 };
 
 // Every device that can be opened here; `problems` receives one line per API that failed.

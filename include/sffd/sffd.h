@@ -36,7 +36,8 @@
 //   }
 //
 // Threads: a Device and the Deformers on it are used from one thread at a time (an adopted GL
-// context: the thread it is current on). Different Devices are independent.
+// context: the thread it is current on; a gl-egl device: the thread that opened it, where EGL keeps its
+// context). Different Devices are independent.
 #pragma once
 #include <sffd/deformer.h>
 #include <sffd/device.h>

@@ -65,13 +65,19 @@ Inputs inputsOf(py::handle vertices, py::handle triangles, py::handle normals) {
   return in;
 }
 
+// A real-number option: any Python or numpy number (numpy's float32 and integer scalars are no Python
+// float or int), else an InputError naming it (pybind11's cast said only "Unable to cast Python instance").
+double numberOf(py::handle a, const char* what, const char* expected) {
+  if (py::isinstance<py::str>(a) || py::isinstance<py::bool_>(a) || !PyNumber_Check(a.ptr()))
+    throw Error(ErrorKind::Input, std::string(what) + ": expected " + expected + ", got " + std::string(py::repr(a)));
+  return py::float_(py::reinterpret_borrow<py::object>(a)).cast<double>();
+}
+
 // crease_angle: None or "auto" (the relative rule, kCreaseAngleAuto) or degrees 0..180, as --crease-angle.
 double creaseAngleOf(py::handle a) {
   if (a.is_none() || (py::isinstance<py::str>(a) && a.cast<std::string>() == "auto")) return kCreaseAngleAuto;
-  if (!py::isinstance<py::float_>(a) && !py::isinstance<py::int_>(a))
-    throw Error(ErrorKind::Input, "crease_angle: expected None, 'auto' or degrees 0..180");
-  const double d = a.cast<double>();
-  if (!(d >= 0 && d <= 180)) throw Error(ErrorKind::Input, "crease_angle: expected degrees 0..180, got " + std::to_string(d));
+  const double d = numberOf(a, "crease_angle", "None, 'auto' or degrees 0..180");
+  if (!(d >= 0 && d <= 180)) throw Error(ErrorKind::Input, "crease_angle: expected degrees 0..180, got " + std::string(py::repr(a)));
   return d;
 }
 
@@ -82,7 +88,7 @@ PyDeformer makeDeformer(py::handle vertices, py::handle triangles, const Lattice
   o.once = once;
   o.creaseAngleDeg = creaseAngleOf(creaseAngle);
   o.method = methodOf(method);
-  o.edgeLength = edgeLength.is_none() ? 0.0 : edgeLength.cast<double>();
+  o.edgeLength = edgeLength.is_none() ? 0.0 : numberOf(edgeLength, "edge_length", "None or a length > 0 in model units");
   o.tess = tess;
   o.strict = strict;
   o.precision = precisionOf(precision);

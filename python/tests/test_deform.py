@@ -261,3 +261,34 @@ def test_deformer_write_streams_the_clis_file(sphere, tmp_path):
     assert (tmp_path / "again.ply").read_bytes() == (tmp_path / "cli_b.ply").read_bytes()
     with pytest.raises(sffd.InputError, match="binary"):
         sffd.write_mesh(str(tmp_path / "x.obj"), v, t, binary=True)
+
+
+def test_number_options_take_numpy_scalars_and_refuse_other_things_with_input_error():
+    # A stranger's adoption test (2026-11-29): crease_angle=np.float32(30) was refused ("expected None,
+    # 'auto' or degrees"), and edge_length="x" raised pybind11's RuntimeError "Unable to cast Python instance".
+    v, t = coarse_torus()
+    lat = sffd.Lattice.fitted(v).preset("bend", 0.5)
+    run = lambda **kw: sffd.deform(v, t, lat, backend="cpu", tess=2, **kw)
+    for a, b in zip(run(crease_angle=40, edge_length=0.5), run(crease_angle=np.float32(40), edge_length=np.float32(0.5))):
+        np.testing.assert_array_equal(a, b)
+    for a, b in zip(run(crease_angle=40), run(crease_angle=np.int64(40))):
+        np.testing.assert_array_equal(a, b)
+    for kw in ({"edge_length": "x"}, {"edge_length": [1.0]}, {"crease_angle": b"40"}, {"crease_angle": True}):
+        with pytest.raises(sffd.InputError, match=next(iter(kw))):
+            run(**kw)
+
+
+def test_deformer_results_need_a_finished_deform_and_finite_control_points(tmp_path):
+    # Deformer.write(path) before any deform wrote whatever the device's buffers held; a control point
+    # set to NaN after the Deformer was made gave a result of NaN.
+    v, t = coarse_torus()
+    lat = sffd.Lattice.fitted(v)
+    d = sffd.Deformer(v, t, lat, backend="cpu", tess=2)
+    with pytest.raises(sffd.InputError, match="deform"):
+        d.write(str(tmp_path / "out.ply"))
+    assert not (tmp_path / "out.ply").exists()
+    bad = lat.copy()
+    bad.control_points[5] = np.nan
+    with pytest.raises(sffd.InputError, match="not finite"):
+        d.deform(bad)
+    assert np.isfinite(d.deform(lat)[0]).all()

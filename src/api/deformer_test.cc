@@ -10,6 +10,8 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
+#include <thread>
 
 #include <sffd/sffd.h>
 
@@ -265,6 +267,182 @@ TEST(Deformer, OptionsAreCheckedAndDefaulted) {
   } catch (const Error& e) {
     EXPECT_EQ(e.kind(), ErrorKind::Input);
     EXPECT_NE(std::string(e.what()).find("(DeformOptions::memoryLimit)"), std::string::npos) << e.what();
+  }
+}
+
+// The kind of the Error `f` throws, or none.
+template <class F>
+std::optional<ErrorKind> errorKindOf(F&& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.kind();
+  }
+  return std::nullopt;
+}
+
+// A stranger's adoption test (2026-11-29): result() before the first deform() handed over whatever the
+// device's fresh buffers held (welded into a different mesh on each device), and after a cancelled
+// deform() a mix of two lattices' outputs.
+TEST(Deformer, ResultsBeforeADeformOrAfterACancelledOneAreRefused) {
+  const Mesh mesh = icosphere(1);
+  const Lattice a = twisted(mesh, 0.3), b = twisted(mesh, -0.4);
+  struct Count : MeshSink {
+    size_t vertices = 0;
+    void add(const Mesh& piece, size_t) override { vertices += piece.positions.size(); }
+  };
+  for (const std::string& name : deviceNames())
+    for (Method method : kMethods) {
+      SCOPED_TRACE(name + " " + nameOf(method));
+      Device device = openDevice(name);
+      bool cancel = false;
+      DeformOptions o = strictOptions(method);
+      o.progress = [&](const Progress& p) { return !(cancel && std::string(p.stage) == "deform" && p.fraction > 0); };
+      Deformer deformer(device, mesh, a, o);
+      Count sink;
+      EXPECT_EQ(errorKindOf([&] { deformer.result(); }), ErrorKind::Input);
+      EXPECT_EQ(errorKindOf([&] { deformer.streamResult(sink); }), ErrorKind::Input);
+      EXPECT_EQ(errorKindOf([&] { deformer.patchControlPoints(); }), ErrorKind::Input);
+      EXPECT_TRUE(deformer.deviceOutput().empty());
+      EXPECT_EQ(sink.vertices, 0u);
+      deformer.deform(a);
+      const Mesh first = deformer.result();
+      cancel = true;
+      EXPECT_EQ(errorKindOf([&] { deformer.deform(b); }), ErrorKind::Cancelled);
+      cancel = false;
+      EXPECT_EQ(errorKindOf([&] { deformer.result(); }), ErrorKind::Input);
+      EXPECT_EQ(errorKindOf([&] { deformer.streamResult(sink); }), ErrorKind::Input);
+      EXPECT_TRUE(deformer.deviceOutput().empty());
+      deformer.deform(a);
+      expectSameBits(deformer.result(), first, "deformed again after the cancelled call");
+      if (name != "cpu") { EXPECT_FALSE(deformer.deviceOutput().empty()); }
+    }
+}
+
+// DeformOptions::once promised a second deform() or result() throws; Classic took both.
+TEST(Deformer, OneShotDeformsOnceAndGivesItsResultOnceForEveryMethod) {
+  const Mesh mesh = icosphere(1);
+  const Lattice lattice = twisted(mesh, 0.3);
+  Device device = openDevice("cpu");
+  for (Method method : kMethods) {
+    SCOPED_TRACE(nameOf(method));
+    DeformOptions o = strictOptions(method);
+    o.once = true;
+    Deformer deformer(device, mesh, lattice, o);
+    deformer.deform(lattice);
+    EXPECT_EQ(errorKindOf([&] { deformer.deform(lattice); }), ErrorKind::Input);
+    EXPECT_GT(deformer.result().triangles.size(), 0u);
+    EXPECT_EQ(errorKindOf([&] { deformer.result(); }), ErrorKind::Input);
+  }
+}
+
+// An out-of-range samples or creaseAngleDeg was taken silently (a negative samples as the default, a NaN
+// or 1000 degrees as some rule), unlike the tool's and Python's; an empty mesh made smooth FFD ask for a
+// positive edge length the caller never gave, where accurate and classic give an empty result.
+TEST(Deformer, OutOfRangeOptionsAreRefusedAndAnEmptyMeshDeforms) {
+  const Mesh mesh = icosphere(1);
+  const Lattice lattice = twisted(mesh, 0.2);
+  Device device = openDevice("cpu");
+  for (Method method : kMethods) {
+    SCOPED_TRACE(nameOf(method));
+    for (int samples : {-1, 16}) {
+      DeformOptions o = strictOptions(method);
+      o.samples = samples;
+      EXPECT_EQ(errorKindOf([&] { Deformer(device, mesh, lattice, o); }), ErrorKind::Input) << samples;
+    }
+    for (double angle : {-0.5, 180.5, 1e9, std::nan("")}) {
+      DeformOptions o = strictOptions(method);
+      o.creaseAngleDeg = angle;
+      EXPECT_EQ(errorKindOf([&] { Deformer(device, mesh, lattice, o); }), ErrorKind::Input) << angle;
+    }
+    for (double angle : {0.0, 180.0, kCreaseAngleAuto}) {
+      DeformOptions o = strictOptions(method);
+      o.creaseAngleDeg = angle;
+      EXPECT_EQ(errorKindOf([&] { Deformer(device, mesh, lattice, o); }), std::nullopt) << angle;
+    }
+    DeformOptions o = strictOptions(method);
+    o.edgeLength = 0;   // the default, a tenth of a size the empty mesh does not have
+    Deformer empty(device, Mesh{}, lattice, o);
+    empty.deform(lattice);
+    EXPECT_TRUE(empty.result().positions.empty());
+  }
+}
+
+// A Deformer held the address of its Device: a Device moved (a std::vector of them growing) left it
+// pointing at the moved-from object, and any call crashed; so did every call on a moved-from Device or
+// Deformer.
+TEST(Deformer, FollowsItsDeviceWhenMovedAndMovedFromObjectsThrow) {
+  const Mesh mesh = icosphere(1);
+  const Lattice lattice = twisted(mesh, 0.3);
+  for (const std::string& name : deviceNames()) {
+    SCOPED_TRACE(name);
+    std::optional<Device> away;   // declared before the Deformers, which must not outlive their Device
+    std::vector<Device> devices;
+    devices.push_back(openDevice(name));
+    Deformer deformer(devices[0], mesh, lattice, strictOptions(Method::Smooth));
+    for (int i = 0; i < 8; ++i) devices.push_back(openDevice("cpu"));   // moves devices[0] at least once
+    EXPECT_EQ(&deformer.device(), &devices[0]);
+    deformer.deform(lattice);
+    const Mesh moved = deformer.result();
+    Deformer fresh(devices[0], mesh, lattice, strictOptions(Method::Smooth));
+    fresh.deform(lattice);
+    expectSameBits(moved, fresh.result(), "after its Device was moved");
+    away.emplace(std::move(devices[0]));
+    EXPECT_EQ(&deformer.device(), &*away);
+    EXPECT_EQ(errorKindOf([&] { (void)devices[0].label(); }), ErrorKind::Input);
+    EXPECT_EQ(errorKindOf([&] { (void)devices[0].info(); }), ErrorKind::Input);
+    EXPECT_EQ(errorKindOf([&] { Deformer(devices[0], mesh, lattice); }), ErrorKind::Input);
+    Deformer taken = std::move(deformer);
+    EXPECT_EQ(errorKindOf([&] { deformer.deform(lattice); }), ErrorKind::Input);
+    EXPECT_EQ(errorKindOf([&] { deformer.result(); }), ErrorKind::Input);
+    EXPECT_EQ(errorKindOf([&] { (void)deformer.subTriangles(); }), ErrorKind::Input);
+    deformer = Deformer(*away, mesh, lattice, strictOptions(Method::Smooth));   // assigned again: usable
+    deformer.deform(lattice);
+    expectSameBits(deformer.result(), moved, "a moved-from Deformer assigned again");
+    taken.deform(lattice);
+  }
+}
+
+// A Device used from one thread at a time, as <sffd/sffd.h> allows, but an EGL device from a thread other
+// than the one that opened it: EGL keeps its context current there, and the message was eglMakeCurrent's
+// bare EGL_BAD_ACCESS.
+TEST(Deformer, AnEglDeviceOnAnotherThreadSaysWhy) {
+  const std::vector<std::string> names = deviceNames();
+  if (std::find(names.begin(), names.end(), "gl-egl") == names.end()) GTEST_SKIP() << "no gl-egl here";
+  const Mesh mesh = icosphere(1);
+  const Lattice lattice = twisted(mesh, 0.3);
+  Device device = openDevice("gl-egl");
+  Deformer deformer(device, mesh, lattice, strictOptions(Method::Classic));
+  deformer.deform(lattice);
+  std::string message;
+  std::thread other([&] {
+    try {
+      deformer.deform(lattice);
+    } catch (const Error& e) {
+      if (e.kind() == ErrorKind::Device) message = e.what();
+    }
+  });
+  other.join();
+  EXPECT_NE(message.find("current on another thread"), std::string::npos) << message;
+  deformer.deform(lattice);   // still usable from its own thread
+}
+
+// The constructor refused a lattice with a non-finite control point, deform() took one (an edited lattice,
+// Python's control_points = P) and gave a result of NaN.
+TEST(Deformer, DeformRefusesANonFiniteControlPoint) {
+  const Mesh mesh = icosphere(1);
+  const Lattice lattice = twisted(mesh, 0.3);
+  Device device = openDevice("cpu");
+  for (Method method : kMethods) {
+    SCOPED_TRACE(nameOf(method));
+    Deformer deformer(device, mesh, lattice, strictOptions(method));
+    for (double bad : {std::nan(""), HUGE_VAL}) {
+      Lattice edited = lattice;
+      edited.controlPoints[17].y = bad;
+      EXPECT_EQ(errorKindOf([&] { deformer.deform(edited); }), ErrorKind::Input) << bad;
+    }
+    deformer.deform(lattice);
+    EXPECT_TRUE(std::isfinite(deformer.result().positions[0].x));
   }
 }
 

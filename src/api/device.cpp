@@ -12,17 +12,32 @@ struct Device::Impl {
   std::string label;
   DeviceInfo info;
   std::unique_ptr<Backend> backend;
+  Device* self = nullptr;   // the Device that holds this now: moves update it, so Deformers follow their Device
 };
 
 Device::Device(std::string label, std::unique_ptr<Backend> backend) : impl_(std::make_unique<Impl>()) {
   impl_->label = std::move(label);
   if (backend) impl_->info = backend->info();
   impl_->backend = std::move(backend);
+  impl_->self = this;
 }
 
-Device::Device(Device&&) noexcept = default;
-Device& Device::operator=(Device&&) noexcept = default;
+Device::Device(Device&& other) noexcept : impl_(std::move(other.impl_)) {
+  if (impl_) impl_->self = this;
+}
+Device& Device::operator=(Device&& other) noexcept {
+  impl_ = std::move(other.impl_);
+  if (impl_) impl_->self = this;
+  return *this;
+}
 Device::~Device() = default;
+
+Device::Impl& Device::impl() const {
+  if (!impl_) throw Error(ErrorKind::Input, "this sffd::Device was moved from; use the Device it was moved to");
+  return *impl_;
+}
+Device::Impl* Device::handle() const { return &impl(); }
+Device& Device::of(Impl* handle) { return *handle->self; }
 
 Device Device::open(const DeviceRequest& request, std::vector<std::string>* notes) {
   BackendRequest r;
@@ -37,12 +52,13 @@ Device Device::open(const DeviceRequest& request, std::vector<std::string>* note
   return d;
 }
 
-const std::string& Device::label() const { return impl_->label; }
-const DeviceInfo& Device::info() const { return impl_->info; }
+const std::string& Device::label() const { return impl().label; }
+const DeviceInfo& Device::info() const { return impl().info; }
 
 Backend& Device::backend() {
-  if (!impl_->backend) throw Error(ErrorKind::Internal, impl_->label + ": no compute backend behind this device");
-  return *impl_->backend;
+  Impl& I = impl();
+  if (!I.backend) throw Error(ErrorKind::Internal, I.label + ": no compute backend behind this device");
+  return *I.backend;
 }
 
 std::vector<DeviceEntry> listDevices(std::vector<std::string>* problems) {

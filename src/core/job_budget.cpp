@@ -85,8 +85,9 @@ double defaultEdgeLength(const Mesh& mesh) {
   glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi = -lo;
   for (const glm::dvec3& p : mesh.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
   const double l = 0.1 * std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
-  // Every vertex at one point: no size to take a tenth of, and no edge to split: any length gives the same result.
-  return mesh.positions.empty() ? 0 : l > 0 ? l : 1.0;
+  // Every vertex at one point, or none (an empty mesh, l = -inf): no size to take a tenth of, and no edge to
+  // split: any length gives the same result (0 made smooth FFD of an empty mesh ask for an --edge-length).
+  return l > 0 ? l : 1.0;
 }
 
 void checkSubTriangleCount(const Mesh& mesh, double l, const std::string& name) {

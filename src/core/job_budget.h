@@ -37,7 +37,7 @@ uint64_t meshHeldBytes(const Mesh& mesh);
 constexpr double kMaxSubTriangles = 50e6;
 double estimateSubTriangles(const Mesh& mesh, double l);
 // The edge length smooth FFD uses when none is given: a tenth of the mesh's largest extent (the
-// reference implementation's l = 0.2 for models in [-1, 1]); 1 for a mesh without extent (one point).
+// reference implementation's l = 0.2 for models in [-1, 1]); 1 for a mesh without extent (one point, or none).
 double defaultEdgeLength(const Mesh& mesh);
 // Refuses (input Error) an edge length that is not a positive number or whose estimate exceeds
 // kMaxSubTriangles, before any work; `name` is how the message calls it ("--edge-length" in the tool).

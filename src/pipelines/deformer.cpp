@@ -77,6 +77,14 @@ ResolvedOptions resolve(const DeformOptions& o, const DeviceInfo& info, const Me
     throw Error(ErrorKind::Input, "the edge length must be a finite number > 0 (or 0: a tenth of the mesh's size)");
   r.edgeLength = o.edgeLength;
   if (r.edgeLength == 0) r.edgeLength = defaultEdgeLength(mesh);
+  // Every option is checked whatever the method, so that a bad value is not found only when the method changes.
+  if (o.samples < 0 || o.samples > 15)
+    throw Error(ErrorKind::Input, "DeformOptions::samples must be 0 (nu+nv+nw) or 1..15 (below 3: 3), not " + std::to_string(o.samples));
+  if (o.creaseAngleDeg != kCreaseAngleAuto && !(o.creaseAngleDeg >= 0 && o.creaseAngleDeg <= 180)) {
+    char angle[32];
+    std::snprintf(angle, sizeof angle, "%g", o.creaseAngleDeg);
+    throw Error(ErrorKind::Input, std::string("DeformOptions::creaseAngleDeg must be 0..180 degrees or kCreaseAngleAuto, not ") + angle);
+  }
   const int degrees = lattice.degree[0] + lattice.degree[1] + lattice.degree[2];
   r.samples = std::max(3, o.samples > 0 ? o.samples : degrees);
   r.knotBoxClip = o.clip == Clip::KnotBox;
@@ -98,7 +106,7 @@ Deformer::Deformer(Device& device, const Mesh& mesh, const Lattice& lattice, con
     : impl_(std::make_unique<Impl>()) {
   const auto t0 = std::chrono::steady_clock::now();
   Impl& I = *impl_;
-  I.device = &device;
+  I.device = device.handle();
   I.options = options;
   validateLattice(lattice, "lattice");
   I.resolved = resolve(options, device.info(), mesh, lattice);
@@ -162,35 +170,59 @@ Deformer& Deformer::operator=(Deformer&&) noexcept = default;
 Deformer::~Deformer() = default;
 
 const Timings& Deformer::deform(const Lattice& lattice) {
-  Impl& I = *impl_;
+  Impl& I = impl();
   if (!sameLatticeStructure(lattice, I.structure))
     throw Error(ErrorKind::Input, "the lattice's degrees, counts, knots, frame or outside rule differ from the Deformer's");
+  // The constructor's validateLattice checked the first lattice's points; an edited one could hold a NaN,
+  // which every method turned silently into a result of NaN.
+  for (size_t i = 0; i < lattice.controlPoints.size(); ++i) {
+    const glm::dvec3& p = lattice.controlPoints[i];
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+      throw Error(ErrorKind::Input, "control point " + std::to_string(i) + " of the lattice is not finite");
+  }
+  if (I.options.once && I.deformed) throw Error(ErrorKind::Input, "a one-shot Deformer deforms once (DeformOptions::once)");
   const auto t0 = std::chrono::steady_clock::now();
-  ProgressReporter progress(I.options.progress, &I.device->backend());
+  ProgressReporter progress(I.options.progress, &I.backend());
+  // The outputs are the last deform()'s only once it has run to its end: a cancelled or failed call leaves
+  // them part old, part new.
+  I.hasResult = false;
   progress("deform", 0);
   I.timings.steps.clear();
+  I.deformed = true;
   I.run->deform(lattice, I.timings, progress);
   progress("deform", 1);
+  I.hasResult = true;
   I.timings.wallMs = msSince(t0);
   return I.timings;
 }
 
-const Timings& Deformer::timings() const { return impl_->timings; }
+const Timings& Deformer::timings() const { return impl().timings; }
+
+void Deformer::Impl::checkResult(const char* call) {
+  if (!hasResult)
+    throw Error(ErrorKind::Input, std::string(call) + (deformed ? ": the last deform() was cancelled or failed; deform() again first"
+                                                                : ": no result yet; call deform() first"));
+  if (options.once && resultTaken) throw Error(ErrorKind::Input, std::string(call) + ": the result was already taken (DeformOptions::once)");
+}
 
 Mesh Deformer::result() const {
+  impl().checkResult("result()");
   // A streamed job's estimate counts a sink's pieces, not the welded mesh that result() holds.
-  if (impl_->wholeEstimate) checkEstimateFits(*impl_, *impl_->wholeEstimate, impl_->options.memoryLimit, kLimitName);
-  ProgressReporter progress(impl_->options.progress, &impl_->device->backend());
+  if (impl().wholeEstimate) checkEstimateFits(impl(), *impl().wholeEstimate, impl().options.memoryLimit, kLimitName);
+  ProgressReporter progress(impl().options.progress, &impl().backend());
   progress("download", 0);
-  Mesh mesh = impl_->run->result(progress);
+  impl().resultTaken = true;
+  Mesh mesh = impl().run->result(progress);
   progress("download", 1);
   return mesh;
 }
 
 void Deformer::streamResult(MeshSink& sink) const {
-  ProgressReporter progress(impl_->options.progress, &impl_->device->backend());
+  impl().checkResult("streamResult()");
+  ProgressReporter progress(impl().options.progress, &impl().backend());
   progress("download", 0);
-  impl_->run->streamResult(sink, progress);
+  impl().resultTaken = true;
+  impl().run->streamResult(sink, progress);
   progress("download", 1);
 }
 
@@ -212,15 +244,26 @@ void MethodRun::streamResult(MeshSink& sink, const ProgressReporter& progress) c
   sink.end();
 }
 
-std::vector<double> Deformer::patchControlPoints() const { return impl_->run->patchControlPoints(); }
-size_t Deformer::subTriangles() const { return impl_->run->subTriangles(); }
-std::vector<OutputChunk> Deformer::deviceOutput() const { return impl_->run->deviceOutput(); }
-glm::dvec3 Deformer::localOrigin() const { return impl_->frame.origin; }
-double Deformer::localScale() const { return impl_->frame.scale; }
-bool Deformer::doublePrecision() const { return impl_->resolved.variant.f64; }
+std::vector<double> Deformer::patchControlPoints() const {
+  impl().checkResult("patchControlPoints()");
+  return impl().run->patchControlPoints();
+}
+size_t Deformer::subTriangles() const { return impl().run->subTriangles(); }
+std::vector<OutputChunk> Deformer::deviceOutput() const {
+  if (!impl().hasResult) return {};   // nothing to draw before the first deform(), nor after a cancelled one
+  return impl().run->deviceOutput();
+}
+glm::dvec3 Deformer::localOrigin() const { return impl().frame.origin; }
+double Deformer::localScale() const { return impl().frame.scale; }
+bool Deformer::doublePrecision() const { return impl().resolved.variant.f64; }
 int Deformer::resultDigits() const { return doublePrecision() || localOrigin() != glm::dvec3(0.0) ? 17 : 9; }
-const DeformOptions& Deformer::options() const { return impl_->options; }
-Device& Deformer::device() const { return *impl_->device; }
-Deformer::Impl& Deformer::internal() { return *impl_; }
+const DeformOptions& Deformer::options() const { return impl().options; }
+Device& Deformer::device() const { return Device::of(impl().device); }
+Deformer::Impl& Deformer::internal() { return impl(); }
+
+Deformer::Impl& Deformer::impl() const {
+  if (!impl_) throw Error(ErrorKind::Input, "this sffd::Deformer was moved from; use the Deformer it was moved to");
+  return *impl_;
+}
 
 }  // namespace sffd

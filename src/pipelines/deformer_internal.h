@@ -110,7 +110,8 @@ std::unique_ptr<MethodRun> makeAccurateRun(Backend& backend, const Mesh& input, 
 std::unique_ptr<MethodRun> inLocalFrame(std::unique_ptr<MethodRun> local, const LocalFrame& frame);
 
 struct Deformer::Impl {
-  Device* device = nullptr;
+  Device::Impl* device = nullptr;   // Device::of(device): the Device, wherever it was moved since
+  Backend& backend() const { return Device::of(device).backend(); }
   DeformOptions options;
   ResolvedOptions resolved;
   Mesh input;           // the mesh as the method uses it (smooth: creases applied); pre-images index its triangles
@@ -124,6 +125,11 @@ struct Deformer::Impl {
   // Smooth and accurate: the host-memory estimate checked against the limit (a streamed job's, stream_budget.h),
   // and for a streamed job the whole job's, which result() checks before it holds the welded mesh.
   std::optional<JobEstimate> estimate, wholeEstimate;
+  // deform() has been called; the last one ran to its end (the outputs are its result); a result was taken
+  // (DeformOptions::once allows one, for every method).
+  bool deformed = false, hasResult = false, resultTaken = false;
+  // The input Error of `call` (result(), ...) where there is no result to give.
+  void checkResult(const char* call);
 };
 
 // The input Error of the memory limit when `estimate` exceeds it, in the words of the Deformer's method

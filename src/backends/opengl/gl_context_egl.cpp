@@ -144,8 +144,15 @@ class EglContext final : public Context {
   void makeCurrent() override {
     EglLib& l = lib();
     l.BindAPI(api_.api());
-    if (!l.MakeCurrent(dpy_, EGL_NO_SURFACE, EGL_NO_SURFACE, ctx_))
-      throw deviceError(std::string(api_.provider()) + ": eglMakeCurrent failed (" + lastError() + ")");
+    if (!l.MakeCurrent(dpy_, EGL_NO_SURFACE, EGL_NO_SURFACE, ctx_)) {
+      const EGLint error = l.GetError();
+      // The context stays current on the thread that opened the device (EGL lets no other thread take it
+      // until that one lets go): say so, rather than the bare EGL_BAD_ACCESS.
+      if (error == EGL_BAD_ACCESS)
+        throw deviceError(std::string(api_.provider()) + ": the device's GL context is current on another thread; use a GL "
+                                                         "device from the thread that opened it (or open one on each thread)");
+      throw deviceError(std::string(api_.provider()) + ": eglMakeCurrent failed (" + errorName(error) + ")");
+    }
   }
   bool providerCurrent() const override {
     lib().BindAPI(api_.api());   // eglGetCurrentContext answers for the bound API
