@@ -5,6 +5,7 @@ goes into the wheel as it is, so an installed wheel needs nothing from the build
 Environment: SFFD_BUILD_DIR (default <repo>/build), SFFD_PYTHON (the interpreter built for)."""
 import os
 import pathlib
+import re
 import shutil
 import subprocess
 import sys
@@ -33,4 +34,11 @@ class BinaryDistribution(Distribution):
         return True
 
 
-setup(packages=["sffd"], cmdclass={"build_py": CMakeBuildPy}, distclass=BinaryDistribution)
+def header_version():
+    """sffd.h's SFFD_VERSION_*: the one place of the version."""
+    text = (ROOT / "include" / "sffd" / "sffd.h").read_text()
+    parts = [re.search(rf"^#define SFFD_VERSION_{p} (\d+)$", text, re.M).group(1) for p in ("MAJOR", "MINOR", "PATCH")]
+    return ".".join(parts)
+
+
+setup(version=header_version(), packages=["sffd"], cmdclass={"build_py": CMakeBuildPy}, distclass=BinaryDistribution)

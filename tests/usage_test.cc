@@ -11,8 +11,11 @@ namespace {
 TEST(Usage, VersionIsTheLibrarysVersion) {
   RunResult r = runSffd("--version");
   EXPECT_EQ(r.status, 0);
-  EXPECT_EQ(r.out, "sffd " + std::to_string(SFFD_VERSION_MAJOR) + "." + std::to_string(SFFD_VERSION_MINOR) + "." +
-                       std::to_string(SFFD_VERSION_PATCH) + "\n");
+  const std::string built = std::to_string(SFFD_VERSION_MAJOR) + "." + std::to_string(SFFD_VERSION_MINOR) + "." +
+                            std::to_string(SFFD_VERSION_PATCH);
+  EXPECT_EQ(r.out, "sffd " + built + "\n");
+  EXPECT_EQ(sffd::version(), built);   // the library's at run time, CMake's package version too (CMakeLists.txt reads sffd.h)
+  EXPECT_EQ(std::string(SFFD_PROJECT_VERSION), built);
   // An argument it does not take is named, as every command's is (it was ignored).
   RunResult extra = runSffd("--version extra");
   EXPECT_EQ(extra.status, 2);

@@ -49,8 +49,7 @@ json optionsOf(const Case& c) {
 
 void writeManifest(const fs::path& dir, const std::vector<Case>& cases, const std::vector<BackendRun>& runs) {
   json m{{"format", "sffd-conform-dump"}, {"version", 1},
-         {"sffd", std::to_string(SFFD_VERSION_MAJOR) + "." + std::to_string(SFFD_VERSION_MINOR) + "." +
-                      std::to_string(SFFD_VERSION_PATCH)}};
+         {"sffd", sffd::version()}};
   m["backends"] = json::array();
   for (const BackendRun& b : runs) {
     json d = b.opened ? json::parse(deviceJson(b.label, b.info)) : json{{"backend", b.label}};

@@ -46,7 +46,7 @@ int main(int argc, char** argv) {
     }
     if (!std::strcmp(argv[1], "--version")) {
       if (argc > 2) throw Error(ErrorKind::Input, std::string("unexpected argument '") + argv[2] + "' (usage: sffd --version)");
-      std::printf("sffd %d.%d.%d\n", SFFD_VERSION_MAJOR, SFFD_VERSION_MINOR, SFFD_VERSION_PATCH);
+      std::printf("sffd %s\n", sffd::version());   // the library's, as loaded
       return 0;
     }
     if (!std::strcmp(argv[1], "help")) {

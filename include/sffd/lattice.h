@@ -38,11 +38,12 @@ struct Lattice {
   glm::dvec3 frameOffset{0.0};
   OutsideMode outside = OutsideMode::Extrapolate;
 
-  size_t pointCount() const { return size_t(counts[0]) * counts[1] * counts[2]; }
-  size_t index(int i, int j, int k) const { return (size_t(i) * counts[1] + j) * counts[2] + k; }
+  // Every int made a size_t first: an application building with -Wsign-conversion -Werror includes this.
+  size_t pointCount() const { return size_t(counts[0]) * size_t(counts[1]) * size_t(counts[2]); }
+  size_t index(int i, int j, int k) const { return (size_t(i) * size_t(counts[1]) + size_t(j)) * size_t(counts[2]) + size_t(k); }
   // Parameter-space domain of axis a: [knots[degree], knots[counts]].
-  double domainLo(int a) const { return knots[a][degree[a]]; }
-  double domainHi(int a) const { return knots[a][counts[a]]; }
+  double domainLo(int a) const { return knots[size_t(a)][size_t(degree[size_t(a)])]; }
+  double domainHi(int a) const { return knots[size_t(a)][size_t(counts[size_t(a)])]; }
 };
 
 // Clamped uniform knot vector over [lo, hi]: (degree+1) copies of each end, uniform interior knots.

@@ -45,6 +45,13 @@
 #include <sffd/lattice.h>
 #include <sffd/mesh.h>
 
+// The one place of sffd's version (CMakeLists.txt and python/setup.py read it from here).
 #define SFFD_VERSION_MAJOR 0
 #define SFFD_VERSION_MINOR 1
 #define SFFD_VERSION_PATCH 0
+
+namespace sffd {
+// The version of the library loaded at run time ("0.1.0"), for an application to compare with the
+// SFFD_VERSION_* it was built against.
+const char* version();
+}  // namespace sffd

@@ -112,8 +112,7 @@ void bindDeform(py::module_& m, std::shared_ptr<Device> (*deviceFor)(py::handle)
 
 PYBIND11_MODULE(_sffd, m) {
   m.doc() = "sffd: smooth free-form deformation of triangle meshes on any GPU (docs/PYTHON.md)";
-  m.attr("__version__") = std::to_string(SFFD_VERSION_MAJOR) + "." + std::to_string(SFFD_VERSION_MINOR) + "." +
-                          std::to_string(SFFD_VERSION_PATCH);
+  m.attr("__version__") = sffd::version();
   sffd::python::registerErrors(m);
   sffd::python::bindDevices(m);
   sffd::python::bindLattice(m);

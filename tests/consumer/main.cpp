@@ -1,7 +1,11 @@
 // Deforms a tetrahedron on the CPU device through the installed package: headers, library, glm.
 #include <cstdio>
+#include <string>
 
+#include <vulkan/vulkan.h>   // before <sffd/vulkan.h>, as it says
+#include <sffd/opengl.h>     // every public header, under the strict warnings of CMakeLists.txt
 #include <sffd/sffd.h>
+#include <sffd/vulkan.h>
 
 int main() try {
   const double xyz[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
@@ -18,9 +22,12 @@ int main() try {
   sffd::Deformer deformer(device, mesh, lattice, {.tess = 2});
   deformer.deform(lattice);
   sffd::Mesh out = deformer.result();
-  std::printf("sffd %d.%d.%d on %s: %zu triangles\n", SFFD_VERSION_MAJOR, SFFD_VERSION_MINOR, SFFD_VERSION_PATCH,
-              device.label().c_str(), out.triangles.size());
-  return out.triangles.size() > mesh.triangles.size() ? 0 : 1;
+  // The library found at run time is the one these headers describe.
+  const std::string built = std::to_string(SFFD_VERSION_MAJOR) + "." + std::to_string(SFFD_VERSION_MINOR) + "." +
+                            std::to_string(SFFD_VERSION_PATCH);
+  std::printf("sffd %s (built against %s) on %s: %zu triangles\n", sffd::version(), built.c_str(), device.label().c_str(),
+              out.triangles.size());
+  return out.triangles.size() > mesh.triangles.size() && built == sffd::version() ? 0 : 1;
 } catch (const sffd::Error& e) {
   std::fprintf(stderr, "consumer: %s\n", e.what());
   return e.exitStatus();

@@ -1,6 +1,7 @@
 # The install test: installs the build tree into a fresh prefix, checks what was installed, then
-# configures, builds and runs tests/consumer against it (find_package) and asks pkg-config.
-# cmake -DBUILD_DIR=... -DWORK_DIR=... -DSOURCE_DIR=... -DGENERATOR=... -DCXX=... [-DSANITIZE=ON] -P run.cmake
+# configures, builds and runs tests/consumer against it (find_package), asks pkg-config, and builds
+# examples/ on their own against it.
+# cmake -DBUILD_DIR=... -DWORK_DIR=... -DSOURCE_DIR=... -DEXAMPLES_DIR=... -DGENERATOR=... -DCXX=... [-DSANITIZE=ON] -P run.cmake
 function(run)
   execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
   if(NOT rc EQUAL 0)
@@ -43,4 +44,10 @@ set(ENV{PKG_CONFIG_PATH} ${prefix}/lib/pkgconfig)
 run(pkg-config --cflags --libs sffd)
 if(NOT out MATCHES "-I[^ ]*/include" OR NOT out MATCHES "-lsffd")
   message(FATAL_ERROR "pkg-config sffd gave: ${out}")
+endif()
+
+if(EXAMPLES_DIR)
+  run(${CMAKE_COMMAND} -S ${EXAMPLES_DIR} -B ${WORK_DIR}/examples -G ${GENERATOR} -DCMAKE_CXX_COMPILER=${CXX}
+      -DCMAKE_PREFIX_PATH=${prefix} -DCMAKE_BUILD_TYPE=Release ${flags})
+  run(${CMAKE_COMMAND} --build ${WORK_DIR}/examples)
 endif()
