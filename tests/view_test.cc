@@ -164,6 +164,43 @@ TEST(View, ReplayScreenshotsMatchRender) {
   EXPECT_GT(compare(sffd::gl::readPng((dir / "smooth.png").string()), sffd::gl::readPng(start.string())).farShare, 0.02);
 }
 
+// A model far from the origin, or 1e-30 or 1e30 across, is drawn straight from the Deformer's buffers too
+// (they hold its local frame: the renderer and the overlays take Deformer::localOrigin() and
+// localScale()); it was drawn from a download every frame. The pictures are those of the model at size 1.
+TEST(View, FarAndOddSizedModelsAreDrawnInPlace) {
+  NEED_X(x);
+  fs::path dir = freshDir("frames");
+  std::ofstream far(dir / "far.obj");
+  far.precision(17);
+  for (std::istringstream in(slurp(kSphere)); in;) {
+    std::string line;
+    std::getline(in, line);
+    double p[3];
+    if (std::sscanf(line.c_str(), "v %lf %lf %lf", &p[0], &p[1], &p[2]) == 3) far << "v " << p[0] + 1e6 << " " << p[1] - 1e6 << " " << p[2] + 1e6 << "\n";
+    else far << line << "\n";
+  }
+  far.close();
+  writeFile(dir / "shots.txt", "resize 320 240\nset hud off\nset lattice off\nset edges on\nset normals on\nfit\nscreenshot shot.png\n");
+  auto shoot = [&](const std::string& mesh, const std::string& normalize) {
+    const fs::path lattice = dir / "l.json";
+    EXPECT_EQ(run("lattice " + mesh + normalize + " -o " + lattice.string() + " --preset twist:0.4 --quiet", dir).status, 0);
+    Result r = run("view " + mesh + normalize + " -l " + lattice.string() + " --tess 3 --replay " + (dir / "shots.txt").string() +
+                       " --out-dir " + dir.string() + " --width 320 --height 240",
+                   dir, x);
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.err.find("shot.png (smooth, zero-copy)"), std::string::npos) << mesh << normalize << "\n" << r.err;
+    return sffd::gl::readPng((dir / "shot.png").string());
+  };
+  const sffd::gl::Image unit = shoot(kSphere, "");
+  for (const auto& [mesh, normalize] : {std::pair<std::string, std::string>{(dir / "far.obj").string(), ""},
+                                        {kSphere, " --normalize 1e-30"},
+                                        {kSphere, " --normalize 1e30"}}) {
+    const Diff d = compare(shoot(mesh, normalize), unit);
+    EXPECT_LT(d.meanAbs, 1.0) << mesh << normalize;
+    EXPECT_LT(d.farShare, 0.005) << mesh << normalize;
+  }
+}
+
 TEST(View, UndoRedoRestoreTheLatticeExactly) {
   NEED_X(x);
   fs::path dir = freshDir("undo");

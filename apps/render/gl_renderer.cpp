@@ -358,8 +358,8 @@ void Renderer::deleteMeshes() {
 void Renderer::setBufferItem(const BufferItem& item) {
   context_->activate();
   deleteMeshes();
-  sceneCentre_ = glm::dvec3(0);   // the buffers hold world positions
-  sceneScale_ = 1;
+  sceneCentre_ = item.origin;   // the buffers' positions are the scene's float coordinates as they are
+  sceneScale_ = item.scale;
   auto g = std::make_unique<GpuMesh>();
   g->caption = item.caption;
   g->points = item.fitPoints;

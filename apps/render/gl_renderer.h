@@ -76,8 +76,12 @@ struct BufferDraw {
 };
 struct BufferItem {
   std::vector<BufferDraw> draws;      // drawn together, in one slot
-  std::vector<glm::vec3> fitPoints;   // world positions a fitted camera frames (may be empty with a placement)
+  std::vector<glm::vec3> fitPoints;   // positions a fitted camera frames, in the frame below (may be empty with a placement)
   std::string caption;
+  // The frame of the buffers' positions: world = position / scale + origin (a Deformer's device output is
+  // in its local frame: Deformer::localOrigin(), localScale()).
+  glm::dvec3 origin{0.0};
+  double scale = 1;
 };
 
 // The camera of one slot, as used to draw it (for tests and the viewer's picking).

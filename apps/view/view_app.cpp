@@ -221,7 +221,7 @@ void App::fit() {
   std::vector<gl::SlotCamera> cams = renderer_->cameras(o, w, h);
   if (cams.empty()) return;
   glm::dvec3 lo(1e300), hi(-1e300);
-  for (const glm::vec3& p : scene_->resultPoints()) lo = glm::min(lo, glm::dvec3(p)), hi = glm::max(hi, glm::dvec3(p));
+  for (const glm::dvec3& p : scene_->resultPoints()) lo = glm::min(lo, p), hi = glm::max(hi, p);
   for (const glm::dvec3& p : edit_.lattice().controlPoints) lo = glm::min(lo, p), hi = glm::max(hi, p);
   camera_.fitTo(cams[0], 0.5 * glm::length(hi - lo));
 }

@@ -8,6 +8,7 @@
 #include <string>
 
 #include <glad/gl.h>
+#include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
 
 #include <sffd/error.h>
@@ -100,6 +101,11 @@ GLuint compileProgram(const char* vs, const char* fs, const char* what) {
 }
 
 glm::mat4 mvpOf(const gl::SlotCamera& cam) { return glm::mat4(cam.projection * cam.view); }
+// The same for positions in a source's frame, composed in double (the translation to a far origin cancels
+// against the view's there, before anything becomes float).
+glm::mat4 mvpOf(const gl::SlotCamera& cam, const TessSource& s) {
+  return glm::mat4(cam.projection * cam.view * glm::translate(glm::dmat4(1.0), s.origin) * glm::scale(glm::dmat4(1.0), glm::dvec3(1.0 / s.scale)));
+}
 
 }  // namespace
 
@@ -303,13 +309,13 @@ void Overlays::drawTessEdges(const gl::SlotCamera& cam, const std::vector<TessSo
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LEQUAL);
   glUseProgram(tessProgram_);
-  glm::mat4 mvp = mvpOf(cam);
-  glUniformMatrix4fv(glGetUniformLocation(tessProgram_, "uMvp"), 1, GL_FALSE, glm::value_ptr(mvp));
   glUniform4f(glGetUniformLocation(tessProgram_, "uColor"), 0.55f, 0.10f, 0.05f, 1.0f);
   glBindVertexArray(tessVao_);
   glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, edgeIndex_);
   for (const TessSource& s : sources) {
     if (!s.buffer || !s.patches) continue;
+    const glm::mat4 mvp = mvpOf(cam, s);
+    glUniformMatrix4fv(glGetUniformLocation(tessProgram_, "uMvp"), 1, GL_FALSE, glm::value_ptr(mvp));
     glBindBuffer(GL_ARRAY_BUFFER, s.buffer);
     glEnableVertexAttribArray(0);
     glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 16, nullptr);
@@ -325,13 +331,13 @@ void Overlays::drawNormals(const gl::SlotCamera& cam, const std::vector<TessSour
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LEQUAL);
   glUseProgram(normalsProgram_);
-  glm::mat4 mvp = mvpOf(cam);
-  glUniformMatrix4fv(glGetUniformLocation(normalsProgram_, "uMvp"), 1, GL_FALSE, glm::value_ptr(mvp));
   glUniform4f(glGetUniformLocation(normalsProgram_, "uColor"), 0.05f, 0.35f, 0.75f, 1.0f);
-  glUniform1f(glGetUniformLocation(normalsProgram_, "uLength"), length);
   glBindVertexArray(tessVao_);
   for (const TessSource& s : sources) {
     if (!s.buffer || !s.patches) continue;
+    const glm::mat4 mvp = mvpOf(cam, s);
+    glUniformMatrix4fv(glGetUniformLocation(normalsProgram_, "uMvp"), 1, GL_FALSE, glm::value_ptr(mvp));
+    glUniform1f(glGetUniformLocation(normalsProgram_, "uLength"), float(length * s.scale));   // world length in the frame's units
     const int nv = tessVertexCount(s.level);
     glUniform1i(glGetUniformLocation(normalsProgram_, "uNv"), nv);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, s.buffer);

@@ -43,6 +43,10 @@ struct TessSource {
   unsigned buffer = 0;
   size_t patches = 0;
   int level = 10;
+  // The frame of the buffer's positions: world = position / scale + origin (a Deformer's device output
+  // is in its local frame, Deformer::localOrigin() and localScale(); a host upload is in the world's).
+  glm::dvec3 origin{0.0};
+  double scale = 1;
 };
 
 class Overlays {

@@ -92,10 +92,9 @@ void Scene::update(const Lattice& lattice, const SceneSettings& settings,
   times_.clipMs = t.clipMs;
   times_.deformMs = t.deformMs;
   subTriangles_ = deformer.subTriangles();
-  // The device buffers hold positions in the Deformer's local frame (a model far from the world origin,
-  // or of an unusual size): those are drawn from the host copy, moved back, and the rest straight from
-  // the buffers.
-  if (smooth && zeroCopy_ && !settings.heatmap && deformer.localOrigin() == glm::dvec3(0.0) && deformer.localScale() == 1) {
+  // Straight from the device buffers, which hold positions in the Deformer's local frame (a model far
+  // from the world origin, or of an unusual size): the renderer and the overlays take that frame.
+  if (smooth && zeroCopy_ && !settings.heatmap) {
     drawSession({});
     path_ = "zero-copy";
   } else {
@@ -154,7 +153,7 @@ void Scene::uploadTess(const PatchVertices& pv) {
   tess_ = {{hostTess_, pv.patchCount(), pv.level}};
 }
 
-void Scene::drawSession(std::vector<glm::vec3> fitPoints) {
+void Scene::drawSession(const std::vector<glm::dvec3>& fitPoints) {
   renderer_.context().activate();
   // The deform kernel wrote the buffers as storage; they are read as vertex attributes next.
   glMemoryBarrier(GL_VERTEX_ATTRIB_ARRAY_BARRIER_BIT | GL_ELEMENT_ARRAY_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
@@ -177,31 +176,28 @@ void Scene::drawSession(std::vector<glm::vec3> fitPoints) {
     sessionIndexLevel_ = L;
   }
   gl::BufferItem item;
-  item.fitPoints = std::move(fitPoints);
+  item.origin = active_->localOrigin();
+  item.scale = active_->localScale();
+  item.fitPoints.reserve(fitPoints.size());
+  for (const glm::dvec3& p : fitPoints) item.fitPoints.push_back(glm::vec3((p - item.origin) * item.scale));
   tess_.clear();
   outputTriangles_ = 0;
   for (const auto& c : chunks) {
     const unsigned buffer = gl::glBufferObject(device_.backend(), c.buffer);
     if (!buffer) throw Error(ErrorKind::Internal, "view: the Deformer's buffer is not a GL buffer of the window");
     item.draws.push_back({buffer, sessionIndex_, 0, nv * 16, c.count * nt * 3});
-    tess_.push_back({buffer, c.count, L});
+    tess_.push_back({buffer, c.count, L, item.origin, item.scale});
     outputTriangles_ += c.count * nt;
   }
   renderer_.setBufferItem(item);
   drawingSession_ = true;
 }
 
-std::vector<glm::vec3> Scene::resultPoints() {
-  std::vector<glm::vec3> pts;
-  if (drawingSession_) {
-    PatchVertices pv = *active_->internal().run->patchVertices();
-    pts.reserve(pv.vertexCount());
-    for (size_t v = 0; v < pv.vertexCount(); ++v)
-      pts.push_back(glm::vec3(float(pv.position[3 * v]), float(pv.position[3 * v + 1]), float(pv.position[3 * v + 2])));
-  } else {
-    pts.reserve(drawn_.positions.size());
-    for (const auto& p : drawn_.positions) pts.push_back(glm::vec3(p));
-  }
+std::vector<glm::dvec3> Scene::resultPoints() {
+  if (!drawingSession_) return drawn_.positions;
+  const PatchVertices pv = *active_->internal().run->patchVertices();
+  std::vector<glm::dvec3> pts(pv.vertexCount());
+  for (size_t v = 0; v < pts.size(); ++v) pts[v] = {pv.position[3 * v], pv.position[3 * v + 1], pv.position[3 * v + 2]};
   return pts;
 }
 

@@ -54,7 +54,7 @@ class Scene {
   size_t subTriangles() const { return subTriangles_; }
   size_t outputTriangles() const { return outputTriangles_; }
   // Positions of the result (downloaded on the zero-copy path): what `fit` frames.
-  std::vector<glm::vec3> resultPoints();
+  std::vector<glm::dvec3> resultPoints();
   // Gives the renderer the result's positions, so that Renderer::cameras() can fit them.
   void prepareFit();
   // The result mesh as `sffd deform` would write it.
@@ -65,7 +65,7 @@ class Scene {
   void drawHost(const Mesh& input, const Lattice& lattice, Mesh mesh, const std::optional<PatchVertices>& patches,
                 const SceneSettings& settings);
   void uploadTess(const PatchVertices& pv);
-  void drawSession(std::vector<glm::vec3> fitPoints);
+  void drawSession(const std::vector<glm::dvec3>& fitPoints);   // world positions
   std::unique_ptr<Deformer> makeDeformer(const Lattice& lattice, const SceneSettings& settings, int level);
 
   gl::Renderer& renderer_;
