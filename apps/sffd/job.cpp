@@ -253,6 +253,9 @@ uint64_t memoryLimitFromEnvironment() {
 std::string toolLimitMessage(std::string what) {
   for (const char* name : {"(DeformOptions::memoryLimit)", "(LatticeReadOptions::memoryLimit)", "(the memoryLimit of refineLattice or elevateLattice)"})
     if (size_t at = what.find(name); at != std::string::npos) what.replace(at, std::strlen(name), "(SFFD_MEMORY_LIMIT)");
+  // The library's words for the options, the tool's flags for them.
+  const std::string options = "a longer edge length or a lower tessellation level";
+  if (size_t at = what.find(options); at != std::string::npos) what.replace(at, options.size(), "a longer --edge-length or a lower --tess");
   return what;
 }
 

@@ -72,7 +72,7 @@ int main(int argc, char** argv) {
     }
     throw Error(ErrorKind::Input, std::string("unknown command '") + argv[1] + "' (sffd --help lists them)");
   } catch (const Error& e) {
-    std::fprintf(stderr, "sffd: error: %s\n", oneLine(e.what()).c_str());
+    std::fprintf(stderr, "sffd: error: %s\n", cli::toolLimitMessage(oneLine(e.what())).c_str());   // in the tool's words
     return e.exitStatus();
   } catch (const std::bad_alloc&) {
     std::fprintf(stderr, "sffd: error: out of memory\n");

@@ -230,7 +230,7 @@ void checkHostBytesFit(uint64_t bytes, uint64_t memoryLimit, const char* limitNa
 
 void checkHostFits(const JobEstimate& e, uint64_t memoryLimit, const char* limitName, const char* what) {
   checkHostBytesFit(e.hostBytes, memoryLimit, limitName, std::string("the ") + what + " needs",
-                    "use a smaller mesh, a longer --edge-length or a lower --tess");
+                    "use a smaller mesh, a longer edge length or a lower tessellation level");
 }
 
 void checkJobFits(const JobEstimate& e, const PackedLattice& P, size_t realBytes, const DeviceLimits* limits,
