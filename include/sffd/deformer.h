@@ -88,9 +88,10 @@ struct OutputChunk {
 class Deformer {
  public:
   // Prepares `mesh` for lattices with the structure of `lattice` (degrees, counts, knots, frame) on
-  // `device`, which must outlive the Deformer (it may be moved meanwhile: the Deformer follows it). A
-  // moved-from Deformer throws an input Error from every call but destruction and assignment. Throws an input Error for bad options or a mesh that
-  // cannot be deformed, a device Error when the device refuses the work.
+  // `device`, which must outlive the Deformer (it may be moved meanwhile: the Deformer follows it).
+  // Throws an input Error for bad options or a mesh that cannot be deformed, a device Error when the
+  // device refuses the work. A moved-from Deformer throws an input Error from every call but destruction
+  // and assignment.
   Deformer(Device& device, const Mesh& mesh, const Lattice& lattice, const DeformOptions& options = {});
   Deformer(Device& device, const MeshView& mesh, const Lattice& lattice, const DeformOptions& options = {});
   Deformer(Deformer&&) noexcept;
