@@ -155,7 +155,7 @@ const SessionTimings& DeformSession::precompute(const StageProgress& progress) {
   if (!options_.knotBoxClip) {
     clipN = I.clipCount;
     std::vector<uint32_t> counts(clipN);
-    for (const PreChunkInputs& c : I.pre) K.clipCount(c, &counts[c.ranges.firstClip]);
+    for (const PreChunkInputs& c : I.pre) K.clipCount(c, c.ranges.clips ? &counts[c.ranges.firstClip] : nullptr);   // an empty mesh: none
     offsets.assign(clipN + 1, 0);
     for (size_t i = 0; i < clipN; ++i) offsets[i + 1] = offsets[i] + counts[i], maxSubs = std::max<uint64_t>(maxSubs, counts[i]);
   } else {
