@@ -244,7 +244,11 @@ ErrorReport measureErrorsInFrame(const Mesh& input, const Lattice& lattice, Patc
   }
   const Mesh localInput = localMesh(input, frame);
   const Lattice local = localLattice(lattice, frame);
-  for (size_t i = 0; i < result.position.size(); ++i) result.position[i] = (result.position[i] - frame.origin[i % 3]) * frame.scale;
+  for (size_t i = 0; i + 3 <= result.position.size(); i += 3) {
+    double* p = &result.position[i];
+    const glm::dvec3 local = frame.toLocal({p[0], p[1], p[2]});
+    p[0] = local.x, p[1] = local.y, p[2] = local.z;
+  }
   ErrorReport report = measureErrors(localInput, packLattice(local), result);
   for (double* length : {&report.geometry.avg, &report.geometry.max, &report.geometry.std}) *length /= frame.scale;
   if (isClosed(localInput)) {   // the output's volume in the frame's units too, without a copy of it

@@ -118,9 +118,11 @@ void validateLattice(const Lattice& L, const std::string& source) {
   if (L.controlPoints.size() != L.pointCount())
     throw inputError(source, 0, "lattice has " + std::to_string(L.controlPoints.size()) + " control points; " +
                                     std::to_string(L.pointCount()) + " expected");
-  for (const auto& p : L.controlPoints)
+  for (size_t i = 0; i < L.controlPoints.size(); ++i) {
+    const glm::dvec3& p = L.controlPoints[i];
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
-      throw inputError(source, 0, "a control point is not finite");
+      throw inputError(source, 0, "control point " + std::to_string(i) + " is not finite");
+  }
   double det = glm::determinant(L.frameLinear);
   if (!std::isfinite(det) || std::abs(det) < 1e-300) throw inputError(source, 0, "lattice frame is singular");
 }

@@ -114,6 +114,7 @@ Deformer::Deformer(Device& device, const Mesh& mesh, const Lattice& lattice, con
     throw Error(ErrorKind::Input, big);
   I.structure = lattice;
   I.input = mesh;
+  I.frame = latticeLocalFrame(lattice);
   const ResolvedOptions& r = I.resolved;
   Backend& backend = device.backend();
   ProgressReporter progress(I.options.progress, &backend);
@@ -132,7 +133,7 @@ Deformer::Deformer(Device& device, const Mesh& mesh, const Lattice& lattice, con
     const DeformSessionOptions session = sessionOptionsOf(r);
     if (session.streamed() && !session.knotBoxClip) {   // stream_budget.h bounds the regular clipping's sub-triangles
       // The caller's mesh and, where the lattice box is away from the origin, the local-frame copy.
-      const uint64_t others = meshHeldBytes(mesh) + (latticeLocalFrame(lattice).isWorld() ? 0 : meshHeldBytes(I.input));
+      const uint64_t others = meshHeldBytes(mesh) + (I.frame.isWorld() ? 0 : meshHeldBytes(I.input));
       I.estimate = estimateStreamedSmoothJob(I.input, session, info, others);
       I.estimate->hostBytes += latticeBytes;
       I.wholeEstimate = whole;
@@ -143,7 +144,6 @@ Deformer::Deformer(Device& device, const Mesh& mesh, const Lattice& lattice, con
   }
   // The devices see the mesh and the lattice in the lattice box's frame (deformer_local_frame.cpp), and
   // the edge length in its units.
-  I.frame = latticeLocalFrame(lattice);
   const bool moved = !I.frame.isWorld();
   if (moved) I.localInput = sffd::localMesh(I.input, I.frame);
   const Lattice movedLattice = moved ? sffd::localLattice(lattice, I.frame) : Lattice{};
@@ -173,13 +173,9 @@ const Timings& Deformer::deform(const Lattice& lattice) {
   Impl& I = impl();
   if (!sameLatticeStructure(lattice, I.structure))
     throw Error(ErrorKind::Input, "the lattice's degrees, counts, knots, frame or outside rule differ from the Deformer's");
-  // The constructor's validateLattice checked the first lattice's points; an edited one could hold a NaN,
-  // which every method turned silently into a result of NaN.
-  for (size_t i = 0; i < lattice.controlPoints.size(); ++i) {
-    const glm::dvec3& p = lattice.controlPoints[i];
-    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
-      throw Error(ErrorKind::Input, "control point " + std::to_string(i) + " of the lattice is not finite");
-  }
+  // The constructor checked the first lattice; an edited one could hold a NaN, which every method turned
+  // silently into a result of NaN.
+  validateLattice(lattice, "lattice");
   if (I.options.once && I.deformed) throw Error(ErrorKind::Input, "a one-shot Deformer deforms once (DeformOptions::once)");
   const auto t0 = std::chrono::steady_clock::now();
   ProgressReporter progress(I.options.progress, &I.backend());

@@ -86,8 +86,6 @@ class AccurateRun final : public MethodRun {
   }
 
   void deform(const Lattice& lattice, Timings& t, const ProgressReporter& progress) override {
-    if (once_ && deformed_) throw Error(ErrorKind::Input, "a one-shot Deformer deforms once (DeformOptions::once)");
-    deformed_ = true;
     const auto t0 = std::chrono::steady_clock::now();
     PackedLattice packed = packLattice(lattice);
     std::vector<unsigned char> coeffs = realBytes(packed.coeffs, variant_.f64);
@@ -106,25 +104,17 @@ class AccurateRun final : public MethodRun {
 
   // The patch vertices welded in slices as each chunk comes from the device: none of them held whole.
   Mesh result(const ProgressReporter&) const override {
-    take();
     PatchWelder weld(job_.level, job_.count());
     weldChunks(weld);
     return weld.finish(input_);
   }
 
   void streamResult(MeshSink& sink, const ProgressReporter&) const override {
-    take();
     PatchWelder weld(job_.level, job_.count(), &sink);
     weld.forgetPassedLocations(input_);
     sink.begin(PatchWelder::tablesOf(input_));
     weldChunks(weld);
     sink.end();
-  }
-
-  // A one-shot run's result is taken once: each chunk's buffer goes once read (forEachChunk).
-  void take() const {
-    if (once_ && taken_) throw Error(ErrorKind::Input, "the result was already taken (DeformOptions::once)");
-    taken_ = true;
   }
 
   // Each chunk's patch vertices into `weld`, kWeldSlice patches at a time (their carried fields filled).
@@ -242,8 +232,7 @@ class AccurateRun final : public MethodRun {
   BufferId frameBuffer_ = 0, coeffs_ = 0, scratch_ = 0;
   uint32_t patchesAt_ = 0;   // the first control point in scratch_, after the samples
   mutable std::vector<Chunk> chunks_;   // mutable: a one-shot run frees their buffers as they are read
-  bool once_ = false, deformed_ = false;
-  mutable bool taken_ = false;   // a result was taken (DeformOptions::once allows one)
+  bool once_ = false;   // one deform() and one result, which the Deformer enforces for every method
 };
 
 }  // namespace

@@ -136,8 +136,11 @@ class LocalFrameRun final : public MethodRun {
   std::optional<PatchVertices> patchVertices() const override {
     std::optional<PatchVertices> patches = local_->patchVertices();
     if (patches)
-      for (size_t i = 0; i < patches->position.size(); ++i)
-        patches->position[i] = patches->position[i] / frame_.scale + frame_.origin[i % 3];   // toWorld, a coordinate at a time
+      for (size_t i = 0; i + 3 <= patches->position.size(); i += 3) {
+        double* p = &patches->position[i];
+        const glm::dvec3 world = frame_.toWorld({p[0], p[1], p[2]});
+        p[0] = world.x, p[1] = world.y, p[2] = world.z;
+      }
     return patches;
   }
   void precompute(Timings& timings) override { local_->precompute(timings); }
