@@ -103,7 +103,7 @@ void accurateThreads(const CpuKernelArgs& a, uint64_t first, uint64_t last) {
 }  // namespace
 
 void cpu::accuratePatches(const CpuKernelArgs& a, uint64_t first, uint64_t last) {
-  a.variant.f64 ? accurateThreads<double>(a, first, last) : accurateThreads<float>(a, first, last);
+  a.variant.f64 ? accurateThreads<double>(a, first, last) : withAvx2<accurateThreads<float>>(a, first, last);
 }
 
 }  // namespace sffd

@@ -224,11 +224,11 @@ void writeThreads(const CpuKernelArgs& a, uint64_t first, uint64_t last) {
 }  // namespace
 
 void cpu::clipCount(const CpuKernelArgs& a, uint64_t first, uint64_t last) {
-  a.variant.f64 ? countThreads<double>(a, first, last) : countThreads<float>(a, first, last);
+  a.variant.f64 ? countThreads<double>(a, first, last) : withAvx2<countThreads<float>>(a, first, last);
 }
 
 void cpu::clipWrite(const CpuKernelArgs& a, uint64_t first, uint64_t last) {
-  a.variant.f64 ? writeThreads<double>(a, first, last) : writeThreads<float>(a, first, last);
+  a.variant.f64 ? writeThreads<double>(a, first, last) : withAvx2<writeThreads<float>>(a, first, last);
 }
 
 }  // namespace sffd

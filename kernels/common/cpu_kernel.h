@@ -55,6 +55,32 @@ struct CpuKernelArgs {
 // A kernel's CPU entry: runs threads [first, last) of the dispatch, as its GLSL main() would.
 using CpuKernelFn = void (*)(const CpuKernelArgs& args, uint64_t first, uint64_t last);
 
+// Whether the CPU entries run their AVX2 copies (withAvx2): on an x86-64 host with AVX2, unless
+// SFFD_CPU_AVX2=0 (read at each call, so a test can compare both copies in one process).
+bool cpuUsesAvx2();
+
+// Runs Twin, a kernel's twin on threads [first, last), as compiled for AVX2 where the host has it, else as
+// compiled for the build's baseline. The copy for AVX2 has every call inlined into it (flatten) so that all
+// of it runs with AVX2; what is not inlined is called in its baseline form (a function's target is its
+// own), so no other function is compiled for AVX2 (tools/check_avx2_copies.py). Both copies do the same
+// operations in the same order, and AVX2 brings no fused multiply-add (that is the "fma" target, and
+// -ffp-contract=off forbids it anyway): the same bits. The twins' vectors of eight (LanesOf, rvec.h)
+// become one instruction instead of two. Sanitizer builds keep the baseline copy only (CMakeLists.txt).
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(SFFD_CPU_BASELINE_ONLY)
+#define SFFD_CPU_AVX2_COPIES 1
+template <CpuKernelFn Twin>
+__attribute__((target("avx2"), flatten)) void runTwinWithAvx2(const CpuKernelArgs& a, uint64_t first, uint64_t last) {
+  Twin(a, first, last);
+}
+#endif
+template <CpuKernelFn Twin>
+void withAvx2(const CpuKernelArgs& a, uint64_t first, uint64_t last) {
+#ifdef SFFD_CPU_AVX2_COPIES
+  if (cpuUsesAvx2()) return runTwinWithAvx2<Twin>(a, first, last);
+#endif
+  Twin(a, first, last);
+}
+
 // The lattice of bindings 1 and 2, checked against the sizes its parameters imply.
 template <class Real>
 LatticeEvaluator<Real> boundLattice(const CpuKernelArgs& a, const gpu::LatticeParams& L, const Real* frame = nullptr,

@@ -24,6 +24,12 @@ template <class Real>
 struct Lanes4 {
   typedef Real type __attribute__((vector_size(4 * sizeof(Real))));
 };
+// N reals in the lanes of one vector (one AVX register of floats at 8; pairs or halves without AVX), for
+// the twins' loops across vertices: each lane the operations of one, in its order.
+template <class Real, int N>
+struct LanesOf {
+  typedef Real type __attribute__((vector_size(N * sizeof(Real))));
+};
 
 template <class Real> RVec3<Real> operator+(RVec3<Real> a, RVec3<Real> b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
 template <class Real> RVec3<Real> operator-(RVec3<Real> a, RVec3<Real> b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
@@ -35,6 +41,12 @@ template <class Real> Real sdot(RVec3<Real> a, RVec3<Real> b) {
 }
 template <class Real> RVec3<Real> scross(RVec3<Real> a, RVec3<Real> b) {
   return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+// Whether a is lexicographically before b (smooth_deform.glsl's lexLess).
+template <class Real> bool lexLess(RVec3<Real> a, RVec3<Real> b) {
+  if (a.x != b.x) return a.x < b.x;
+  if (a.y != b.y) return a.y < b.y;
+  return a.z < b.z;
 }
 // Whether a vector of squared length len2 has a direction to normalize to (layout.h, prelude.glsl's
 // sffdHasDirection).

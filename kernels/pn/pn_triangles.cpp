@@ -128,7 +128,7 @@ PnOutput pnTriangles(Backend& backend, const PreparedMesh& mesh, KernelVariant v
 }
 
 void cpu::pnTriangles(const CpuKernelArgs& a, uint64_t first, uint64_t last) {
-  a.variant.f64 ? pnThreads<double>(a, first, last) : pnThreads<float>(a, first, last);
+  a.variant.f64 ? pnThreads<double>(a, first, last) : withAvx2<pnThreads<float>>(a, first, last);
 }
 
 }  // namespace sffd

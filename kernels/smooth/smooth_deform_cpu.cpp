@@ -3,24 +3,18 @@
 // table inline in the parameter block) as the kernels do.
 #include <algorithm>
 #include <cmath>
-#include <cstring>
+#include <optional>
 #include <span>
 
 #include "kernels/common/cpu_kernel.h"
 #include "kernels/pn/pn_eval.h"
 #include "kernels/smooth/smooth_deform.h"
+#include "kernels/smooth/smooth_tessellate_cpu.h"
 
 namespace sffd {
 namespace {
 
 constexpr int kCornerCp[3] = {0, 6, 9};
-
-template <class Real>
-bool lexLess(RVec3<Real> a, RVec3<Real> b) {
-  if (a.x != b.x) return a.x < b.x;
-  if (a.y != b.y) return a.y < b.y;
-  return a.z < b.z;
-}
 
 template <class Real>
 RVec3<Real> nearControlPoint(RVec3<Real> q0, RVec3<Real> q1, RVec3<Real> q2, RVec3<Real> q3) {
@@ -159,62 +153,6 @@ void adjust(uint32_t creaseBits, const RVec3<Real> adj[3], const RVec3<Real> adj
   cp[4] = edgeSum / Real(4) - cornerSum / Real(6);
 }
 
-// Step 6: the tessellation at level Lv, positions then normals; the twin of smoothTessellate (smooth_deform.glsl),
-// one vertex at a time in index order where the kernel has one loop per kind of vertex: the same values.
-// The sums run on x, y, z in the lanes of one vector (Lanes4): the same operations, fewer instructions.
-template <class Real>
-void tessellate(const RVec3<Real> cp[10], const RVec3<Real> ncp[10], int Lv, Real* tessOut) {
-  using V = typename Lanes4<Real>::type;
-  const int nv = (Lv + 1) * (Lv + 2) / 2;
-  V P[10], N[10];
-  for (int q = 0; q < 10; ++q) P[q] = V{cp[q].x, cp[q].y, cp[q].z, 0}, N[q] = V{ncp[q].x, ncp[q].y, ncp[q].z, 0};
-  // snormalize: sqrt of ((x x + y y) + z z), then each lane divided by it (left as it is without a direction).
-  auto normalized = [](V& n) {
-    const Real len2 = (n[0] * n[0] + n[1] * n[1]) + n[2] * n[2];
-    if (!hasDirection(len2)) return;
-    const Real len = std::sqrt(len2);
-    n = n / V{len, len, len, len};
-  };
-  auto put = [](Real* o, V& v) {
-    v[3] = 0;
-    std::memcpy(o, &v, sizeof v);
-  };
-  for (int r = 0; r <= Lv; ++r)
-    for (int t = 0; t <= r; ++t) {
-      int i = Lv - r, j = r - t, k = t;
-      int v = r * (r + 1) / 2 + t;
-      V x, n;
-      if (i == Lv || j == Lv || k == Lv) {
-        int c = i == Lv ? 0 : (j == Lv ? 1 : 2);
-        x = P[kCornerCp[c]];
-        n = N[kCornerCp[c]];
-      } else if (i == 0 || j == 0 || k == 0) {
-        // Evaluated from the lexicographically smaller corner, so both patches of the edge agree bit for bit.
-        int a = k == 0 ? 0 : (i == 0 ? 1 : 2), b = (a + 1) % 3;
-        int stepsFromA = a == 0 ? j : (a == 1 ? k : i);
-        int sa = 2 * a + 1, sb = 2 * b;
-        int lo = a, hi = b, steps = stepsFromA, slo = sa, shi = sb;
-        if (lexLess(cp[kCornerCp[b]], cp[kCornerCp[a]])) lo = b, hi = a, steps = Lv - stepsFromA, slo = sb, shi = sa;
-        // pnEdgeCurve's sums.
-        Real w[4];
-        pnEdgeWeights(Real(steps) / Real(Lv), w);
-        const Real w0 = w[0], w1 = w[1], w2 = w[2], w3 = w[3];
-        const int q0 = kCornerCp[lo], q1 = kSlotControlPoint[slo], q2 = kSlotControlPoint[shi], q3 = kCornerCp[hi];
-        x = ((P[q0] * V{w0, w0, w0, w0} + P[q1] * V{w1, w1, w1, w1}) + P[q2] * V{w2, w2, w2, w2}) + P[q3] * V{w3, w3, w3, w3};
-        n = ((N[q0] * V{w0, w0, w0, w0} + N[q1] * V{w1, w1, w1, w1}) + N[q2] * V{w2, w2, w2, w2}) + N[q3] * V{w3, w3, w3, w3};
-      } else {
-        RVec3<Real> lam = RVec3<Real>{Real(i), Real(j), Real(k)} / Real(Lv);
-        Real w[10];
-        pnCubicWeights(lam, w);
-        x = V{}, n = V{};
-        for (int q = 0; q < 10; ++q) x = x + P[q] * V{w[q], w[q], w[q], w[q]}, n = n + N[q] * V{w[q], w[q], w[q], w[q]};
-      }
-      normalized(n);
-      put(tessOut + 4 * v, x);
-      put(tessOut + 4 * (nv + v), n);
-    }
-}
-
 template <class Real>
 void putPatch(Real* o, const RVec3<Real> cp[10], const RVec3<Real> ncp[10]) {
   for (int k = 0; k < 10; ++k) {
@@ -245,6 +183,9 @@ void deformThreads(const CpuKernelArgs& a, uint64_t first, uint64_t last) {
   if constexpr (K != Step::Sample) patches = section(p.sections.z, SFFD_PATCH_STRIDE * n);
   if constexpr (K == Step::Fused || K == Step::Tessellate) tess = section(0, 2 * nv * n);
   if constexpr (K != Step::Fused && K != Step::Tessellate) samples = section(p.sections.w, sampleStride * n);
+  // Step 6's weights, once for the slice of threads (as the kernel's, per vertex: the same bits).
+  std::optional<SmoothTessellation<Real>> tessellation;
+  if constexpr (K == Step::Fused || K == Step::Tessellate) tessellation.emplace(D.level);
   RVec3<Real> Q[3], QN[3], adj[3], adjNbr[6], E[6], EN[6], cp[10], ncp[10];
   for (uint64_t t = first; t < std::min<uint64_t>(last, p.range.y); ++t) {
     const size_t st = p.range.x + uint32_t(t);
@@ -286,13 +227,17 @@ void deformThreads(const CpuKernelArgs& a, uint64_t first, uint64_t last) {
     } else {
       for (int k = 0; k < 10; ++k) cp[k] = get(patch + 4 * k), ncp[k] = get(patch + 4 * (10 + k));
     }
-    if constexpr (K == Step::Fused || K == Step::Tessellate) tessellate(cp, ncp, D.level, &tess[8 * nv * st]);
+    if constexpr (K == Step::Fused || K == Step::Tessellate) tessellation->run(cp, ncp, &tess[8 * nv * st]);
   }
 }
 
+// The fused kernel also as compiled for AVX2 (withAvx2); the split steps, for per-step timings, as they are.
 template <Step K>
 void deformEntry(const CpuKernelArgs& a, uint64_t first, uint64_t last) {
-  a.variant.f64 ? deformThreads<double, K>(a, first, last) : deformThreads<float, K>(a, first, last);
+  if constexpr (K == Step::Fused)
+    a.variant.f64 ? deformThreads<double, K>(a, first, last) : withAvx2<deformThreads<float, K>>(a, first, last);
+  else
+    a.variant.f64 ? deformThreads<double, K>(a, first, last) : deformThreads<float, K>(a, first, last);
 }
 
 }  // namespace

@@ -26,13 +26,23 @@ unsigned cpuThreadCount() {
   return std::min(t, 256u);
 }
 
+bool cpuUsesAvx2() {
+#ifdef SFFD_CPU_AVX2_COPIES
+  static const bool has = __builtin_cpu_supports("avx2");
+  const char* env = std::getenv("SFFD_CPU_AVX2");
+  return has && !(env && std::string_view(env) == "0");
+#else
+  return false;
+#endif
+}
+
 namespace cpu {
 
 DeviceInfo deviceInfo() {
   DeviceInfo info;
   info.api = "cpu";
   info.provider = "cpu";
-  info.name = "CPU reference (" + std::to_string(cpuThreadCount()) + " threads)";
+  info.name = "CPU reference (" + std::to_string(cpuThreadCount()) + " threads" + (cpuUsesAvx2() ? ", AVX2)" : ")");
   info.driver = "sffd host kernels";
   info.type = "cpu";
   // The largest range a Vulkan device can report: jobs are not chunked below 4 GiB a buffer, and every

@@ -1,14 +1,16 @@
-// What is particular to the CPU backend: every kernel has a CPU entry, the thread count does not
-// change the bits, and a kernel's error on a worker thread comes back as an sffd::Error.
+// What is particular to the CPU backend: every kernel has a CPU entry, neither the thread count nor the
+// kernels' AVX2 copies change the bits, and a kernel's error on a worker thread comes back as an sffd::Error.
 #include "backends/cpu/cpu_backend.h"
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cstdlib>
+#include <cstring>
 #include <random>
 #include <string>
 
-#include <sffd/error.h>
+#include <sffd/sffd.h>
 #include "core/kernel_registry.h"
 #include "kernels/pn/pn_triangles.h"
 #include "pipelines/deform_session.h"
@@ -37,7 +39,7 @@ TEST(CpuBackend, ThreadCountDoesNotChangeTheBits) {
   auto run = [&](const char* threads, bool split) {
     setenv("SFFD_CPU_THREADS", threads, 1);
     auto b = cpu::createBackend();
-    EXPECT_NE(b->info().name.find(std::string("(") + threads + " threads)"), std::string::npos) << b->info().name;
+    EXPECT_NE(b->info().name.find(std::string("(") + threads + " threads"), std::string::npos) << b->info().name;
     DeformSessionOptions o;
     o.edgeLength = 0.1;
     o.level = 4;
@@ -50,6 +52,48 @@ TEST(CpuBackend, ThreadCountDoesNotChangeTheBits) {
   std::vector<double> one = run("1", false);
   EXPECT_EQ(run("3", false), one);
   EXPECT_EQ(run("2", true), one);
+}
+
+// Every kernel's AVX2 copy (withAvx2, cpu_kernel.h) against its baseline copy (SFFD_CPU_AVX2=0): every
+// method, fused and split, float and double, lattices of degree 2, 3 and mixed, levels 1 to 11 (the
+// tessellation's lanes: full groups of eight and tails). On a host without AVX2 both are the baseline.
+TEST(CpuBackend, Avx2CopiesGiveTheBitsOfTheBaseline) {
+  const Mesh mesh = readMesh(std::string(SFFD_TEST_DATA) + "/torus.obj");
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-0.08, 0.08);
+  for (std::array<int, 3> degree : {std::array{2, 2, 2}, std::array{3, 3, 3}, std::array{1, 2, 3}}) {
+    Lattice lattice = fitLattice(mesh, {5, 5, 4}, degree);
+    for (auto& p : lattice.controlPoints) p += glm::dvec3(u(rng), u(rng), u(rng));
+    for (Method method : {Method::Smooth, Method::Accurate, Method::Classic})
+      for (int variant = 0; variant < 3; ++variant) {
+        DeformOptions o;
+        o.method = method;
+        o.edgeLength = 0.35;
+        o.tess = 1 + 5 * variant;
+        o.split = method == Method::Smooth && variant == 1;
+        o.precision = variant == 2 ? Precision::Double : Precision::Float;
+        auto run = [&](const char* avx2) {
+          setenv("SFFD_CPU_AVX2", avx2, 1);
+          DeviceRequest request;
+          request.name = "cpu";
+          Device cpu = Device::open(request);
+          Deformer d(cpu, mesh, lattice, o);
+          d.deform(lattice);
+          Mesh r = d.result();
+          unsetenv("SFFD_CPU_AVX2");
+          return r;
+        };
+        const Mesh baseline = run("0"), avx2 = run("1");
+        const std::string what = "degree " + std::to_string(degree[0]) + std::to_string(degree[2]) + ", method " + std::to_string(int(method)) +
+                                 ", variant " + std::to_string(variant);
+        ASSERT_EQ(baseline.positions.size(), avx2.positions.size()) << what;
+        EXPECT_GT(baseline.positions.size(), 0u) << what;
+        EXPECT_EQ(std::memcmp(baseline.positions.data(), avx2.positions.data(), avx2.positions.size() * sizeof(glm::dvec3)), 0)
+            << what;
+        EXPECT_EQ(std::memcmp(baseline.normals.data(), avx2.normals.data(), avx2.normals.size() * sizeof(glm::dvec3)), 0)
+            << what;
+      }
+  }
 }
 
 TEST(CpuBackend, KernelErrorsOnWorkerThreadsAreInternalErrors) {
