@@ -103,7 +103,8 @@ void accurateThreads(const CpuKernelArgs& a, uint64_t first, uint64_t last) {
 }  // namespace
 
 void cpu::accuratePatches(const CpuKernelArgs& a, uint64_t first, uint64_t last) {
-  a.variant.f64 ? accurateThreads<double>(a, first, last) : withAvx2<accurateThreads<float>>(a, first, last);
+  // Both precisions also as compiled for AVX2: double is what the method runs by default (--precision auto).
+  a.variant.f64 ? withAvx2<accurateThreads<double>>(a, first, last) : withAvx2<accurateThreads<float>>(a, first, last);
 }
 
 }  // namespace sffd

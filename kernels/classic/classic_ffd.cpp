@@ -138,7 +138,8 @@ void classicThreads(const CpuKernelArgs& a, uint64_t first, uint64_t last) {
 }  // namespace
 
 void cpu::classicFfd(const CpuKernelArgs& a, uint64_t first, uint64_t last) {
-  a.variant.f64 ? classicThreads<double>(a, first, last) : withAvx2<classicThreads<float>>(a, first, last);
+  // Both precisions also as compiled for AVX2: double is what the method runs by default (--precision auto).
+  a.variant.f64 ? withAvx2<classicThreads<double>>(a, first, last) : withAvx2<classicThreads<float>>(a, first, last);
 }
 
 Mesh applyClassicOutput(const Mesh& input, const ClassicOutput& out) {
