@@ -7,7 +7,9 @@
 
 namespace sffd {
 
-// Cubic control point of each corner slot (slot 2c: corner c towards corner c+2; 2c+1: towards c+1).
+// Cubic control point of each corner (b300, b030, b003) and of each corner slot (slot 2c: corner c
+// towards corner c+2; 2c+1: towards c+1).
+inline constexpr std::array<int, 3> kCornerControlPoint = {0, 6, 9};
 inline constexpr std::array<int, 6> kSlotControlPoint = {2, 1, 3, 7, 8, 5};
 // Quadratic normal control point of each edge e = (corner e, corner e+1): 110, 011, 101.
 inline constexpr std::array<int, 3> kEdgeNormalIndex = {1, 4, 2};

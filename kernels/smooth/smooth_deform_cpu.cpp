@@ -14,8 +14,6 @@
 namespace sffd {
 namespace {
 
-constexpr int kCornerCp[3] = {0, 6, 9};
-
 template <class Real>
 RVec3<Real> nearControlPoint(RVec3<Real> q0, RVec3<Real> q1, RVec3<Real> q2, RVec3<Real> q3) {
   return (((q0 * Real(-5) + q1 * Real(18)) + q2 * Real(-9)) + q3 * Real(2)) / Real(6);
@@ -114,7 +112,7 @@ struct DeformTwin {
 template <class Real>
 void boundaryControlPoints(const RVec3<Real> Q[3], const RVec3<Real> QN[3], const RVec3<Real> E[6], const RVec3<Real> EN[6],
                            RVec3<Real> cp[10], RVec3<Real> ncp[10]) {
-  for (int c = 0; c < 3; ++c) cp[kCornerCp[c]] = Q[c], ncp[kCornerCp[c]] = QN[c];
+  for (int c = 0; c < 3; ++c) cp[kCornerControlPoint[c]] = Q[c], ncp[kCornerControlPoint[c]] = QN[c];
   for (int s = 0; s < 6; ++s) {
     int c = s / 2;
     int o = (s % 2 == 1) ? (c + 1) % 3 : (c + 2) % 3;
@@ -131,7 +129,7 @@ template <class Real>
 void adjust(uint32_t creaseBits, const RVec3<Real> adj[3], const RVec3<Real> adjNbr[6], RVec3<Real> cp[10]) {
   for (int s = 0; s < 6; ++s) {
     int c = s / 2;
-    RVec3<Real> X = cp[kCornerCp[c]], b = cp[kSlotControlPoint[s]];
+    RVec3<Real> X = cp[kCornerControlPoint[c]], b = cp[kSlotControlPoint[s]];
     RVec3<Real> d = b - X;
     bool adjusted = false;
     if ((creaseBits >> s) & 1u) {

@@ -52,16 +52,17 @@ class SmoothTessellation {
 
   // Writes the nv positions, then the nv normals, 4 reals each (w = 0), to out.
   void run(const RVec3<Real> cp[10], const RVec3<Real> ncp[10], Real* out) const {
-    const int lastRow = L_ * (L_ + 1) / 2, cornerCp[3] = {0, 6, 9}, cornerVertex[3] = {0, lastRow, lastRow + L_};
+    const int lastRow = L_ * (L_ + 1) / 2, cornerVertex[3] = {0, lastRow, lastRow + L_};
     for (int c = 0; c < 3; ++c) {
-      put(out + 4 * cornerVertex[c], cp[cornerCp[c]]);
-      put(out + 4 * (nv_ + cornerVertex[c]), snormalize(ncp[cornerCp[c]]));
+      put(out + 4 * cornerVertex[c], cp[kCornerControlPoint[c]]);
+      put(out + 4 * (nv_ + cornerVertex[c]), snormalize(ncp[kCornerControlPoint[c]]));
     }
-    // Edge a's cubic through corner a, the control points of slots 2a+1 and 2a+2 and corner a+1; evaluated
-    // from the lexicographically smaller corner, so both patches of an edge agree bit for bit.
-    static constexpr int kEdgeCp[3][4] = {{0, 1, 3, 6}, {6, 7, 8, 9}, {9, 5, 2, 0}};
+    // Edge a's cubic through corner a, the control points of slots 2a+1 and 2a+2 and corner a+1 (0 1 3 6,
+    // 6 7 8 9, 9 5 2 0); evaluated from the lexicographically smaller corner, so both patches of an edge
+    // agree bit for bit.
     for (int a = 0; a < 3; ++a) {
-      int q[4] = {kEdgeCp[a][0], kEdgeCp[a][1], kEdgeCp[a][2], kEdgeCp[a][3]};
+      int q[4] = {kCornerControlPoint[a], kSlotControlPoint[2 * a + 1], kSlotControlPoint[(2 * a + 2) % 6],
+                  kCornerControlPoint[(a + 1) % 3]};
       const bool reversed = lexLess(cp[q[3]], cp[q[0]]);
       if (reversed) std::swap(q[0], q[3]), std::swap(q[1], q[2]);
       const Real* table = reversed ? edgeReversed_.data() : edgeForward_.data();
