@@ -229,12 +229,12 @@ void deformThreads(const CpuKernelArgs& a, uint64_t first, uint64_t last) {
   }
 }
 
-// The fused float kernel, what smooth FFD runs by default, also as compiled for AVX2 (withAvx2); double and
-// the split steps (per-step timings) as they are: each copy costs seconds of every build.
+// The fused kernel also as compiled for AVX2 (withAvx2), in float and double; the split steps (per-step
+// timings) as they are: each copy costs seconds of every build.
 template <Step K>
 void deformEntry(const CpuKernelArgs& a, uint64_t first, uint64_t last) {
   if constexpr (K == Step::Fused)
-    a.variant.f64 ? deformThreads<double, K>(a, first, last) : withAvx2<deformThreads<float, K>>(a, first, last);
+    a.variant.f64 ? withAvx2<deformThreads<double, K>>(a, first, last) : withAvx2<deformThreads<float, K>>(a, first, last);
   else
     a.variant.f64 ? deformThreads<double, K>(a, first, last) : deformThreads<float, K>(a, first, last);
 }
