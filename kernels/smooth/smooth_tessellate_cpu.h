@@ -2,7 +2,7 @@
 // patch and its normal patch at level L. The kernel computes each vertex's weights and then its sums; here a
 // level's weights are computed once, by the kernel's own functions (so the same bits), and the sums run
 // across eight vertices in the lanes of one vector, each lane doing one vertex's operations in the kernel's
-// order: the same values, about a third of the instructions of one vertex at a time.
+// order: the same values, no idle lane (docs/performance/stages.md, "The CPU device's AVX2 copies").
 #pragma once
 #include <algorithm>
 #include <cmath>
