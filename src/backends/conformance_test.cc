@@ -18,6 +18,7 @@
 #include "kernels/smooth/smooth_deform.h"
 #include "kernels/clip/split_pattern_table.h"
 #include "backends/vulkan/vk_backend.h"
+#include "core/job_budget.h"
 
 using namespace sffd;
 
@@ -176,6 +177,25 @@ TEST_P(ClassicConformance, SmoothDeformKernelAgreesWithCpuReference) {
   SmoothOutput chunked = smoothDeform(*b.backend, L, subs, fit, 10, {true, false}, false, 50);
   EXPECT_EQ(chunked.tess, cpu.tess);
   EXPECT_EQ(vk::validationMessageCount(), 0u);
+}
+
+// The tessellation at every level a job may ask for (1..kMaxTessLevel): the twin runs its vertices eight
+// at a time (smooth_tessellate_cpu.h), so each level has its own full groups and tail.
+TEST_P(ClassicConformance, SmoothTessellationAgreesAtEveryLevel) {
+  SFFD_OPEN_OR_SKIP(b, GetParam());
+  Mesh m = readMesh(std::string(SFFD_TEST_DATA) + "/cube.obj");
+  PreparedMesh P = prepareMesh(m);
+  PnOutput pn = pnTriangles(sffd::testing::cpuBackend(), P, {true, false});
+  const double l = 4;   // one sub-triangle a triangle
+  SubTriangleRecords subs = regularClip(sffd::testing::cpuBackend(), P, pn, buildClipTriangles(m, l, splitPatternTable().nmax()), l, {true, false});
+  PackedLattice L = packLattice(deformedLattice(OutsideMode::Extrapolate));
+  FitTable fit = makeFitTable(6);
+  for (int level = 1; level <= kMaxTessLevel; ++level) {
+    SmoothOutput cpu = smoothDeform(sffd::testing::cpuBackend(), L, subs, fit, level, {true, false});
+    SmoothOutput gpu = smoothDeform(*b.backend, L, subs, fit, level, {true, false});
+    ASSERT_EQ(gpu.tess.size(), cpu.tess.size()) << "level " << level;
+    EXPECT_EQ(gpu.tess, cpu.tess) << "level " << level;
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, ClassicConformance, ::testing::ValuesIn(sffd::testing::testBackends()),

@@ -55,8 +55,9 @@ TEST(CpuBackend, ThreadCountDoesNotChangeTheBits) {
 }
 
 // Every kernel's AVX2 copy (withAvx2, cpu_kernel.h) against its baseline copy (SFFD_CPU_AVX2=0): every
-// method, fused and split, float and double, lattices of degree 2, 3 and mixed, levels 1 to 11 (the
-// tessellation's lanes: full groups of eight and tails).
+// method in float and double, lattices of degree 2, 3 and mixed, levels 1, 6 and 11 (the tessellation's
+// lanes: a tail alone, and full groups of eight with tails); the split run's steps have no AVX2 copies,
+// its pn and clip do.
 TEST(CpuBackend, Avx2CopiesGiveTheBitsOfTheBaseline) {
   unsetenv("SFFD_CPU_AVX2");
   if (!cpuUsesAvx2()) GTEST_SKIP() << "no AVX2 copies to compare: a sanitizer build, another processor, or no AVX2";
