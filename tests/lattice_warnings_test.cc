@@ -63,5 +63,36 @@ TEST(LatticeWarnings, MeshTooSmallForFloatInTheKnotSpans) {
   fs::remove_all(dir);
 }
 
+// The same in double, 2e-15 inside spans 1 wide (2^-53 of them is 6 % of it); and a mesh 2e-40 of its
+// lattice, whose edge length the clip kernels cannot take as a float (0 on a GPU, where it made every edge
+// the table's most segments, and a NaN count on the CPU device, which failed with an internal error).
+TEST(LatticeWarnings, MeshTooSmallForDoubleAndAnEdgeLengthBelowFloat) {
+  fs::path dir = tempDir("lattice_warnings_double");
+  writeBoxObj(dir / "unit.obj", 0, 0, 0, 1);
+  writeBoxObj(dir / "tiny.obj", 0, 0, 0, 1e-15);
+  writeBoxObj(dir / "tinier.obj", 0, 0, 0, 1e-40);
+  const std::string lattice = (dir / "l.json").string();
+  ASSERT_EQ(runSffd("lattice " + (dir / "unit.obj").string() + " -o " + lattice + " --counts 4 --degree 1 --margin 0.25 --quiet").status, 0);
+  const std::string job = " -l " + lattice + " --backend cpu --tess 1 --quiet -o " + (dir / "o.obj").string();
+  RunResult small = runSffd("deform " + (dir / "tiny.obj").string() + job + " --precision double");
+  EXPECT_EQ(small.status, 0) << small.err;
+  EXPECT_EQ(small.err, "sffd: warning: the mesh is 2e-15 across, and the knot spans of lattice " + lattice +
+                           " that hold it 1: double kernels resolve the result to about 1.1e-16, 5.6% of the mesh; use a lattice "
+                           "closer to the mesh's size\n");
+  // In float the advice is the same: double would not resolve it either.
+  RunResult floats = runSffd("deform " + (dir / "tiny.obj").string() + job);
+  EXPECT_EQ(floats.status, 0) << floats.err;
+  EXPECT_NE(floats.err.find("float kernels resolve the result to about 6e-08, 3e+07 times its size; use a lattice closer"), std::string::npos)
+      << floats.err;
+  fs::remove(dir / "o.obj");
+  for (const char* precision : {"", " --precision double"}) {
+    RunResult r = runSffd("deform " + (dir / "tinier.obj").string() + job + precision);
+    EXPECT_EQ(r.status, 2) << precision << r.err;
+    EXPECT_NE(r.err.find("below the smallest float (1.2e-38) that the clip kernels take it in"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir / "o.obj"));
+  }
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace sffd::test

@@ -2,6 +2,7 @@
 // clipping); writes the sub-triangles and their shape statistics.
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <map>
 
@@ -86,6 +87,11 @@ int run(const ParsedArgs& args) {
   size_t presplit = 0, clipTriangles = 0;
   auto tc = std::chrono::steady_clock::now();
   if (clip == "regular") {
+    if (!clipTargetFits(l)) {
+      char text[32];
+      std::snprintf(text, sizeof text, "%.3g", l);
+      throw Error(ErrorKind::Input, std::string("--edge-length ") + text + " is below the smallest float (1.2e-38) that the clip kernels take it in");
+    }
     ClipTriangles C = buildClipTriangles(job.mesh, l, splitPatternTable().nmax());
     presplit = C.presplitParents;
     clipTriangles = C.triangles.size();

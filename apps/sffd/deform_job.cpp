@@ -110,7 +110,7 @@ DeformRun runDeformJob(const ParsedArgs& args, Job& job, Device& device, const S
   DeformRun run = runMethod(args, job, device, methodOf(args.get("--method", "smooth")), sinkFor);
   for (const std::string& w : warnings)
     if (!w.empty()) warnOnSuccess(w);
-  if (std::string w = floatResolutionWarning(job.mesh, job.lattice, run.deformer.doublePrecision(), job.latticePath); !w.empty())
+  if (std::string w = resolutionWarning(job.mesh, job.lattice, run.deformer.doublePrecision(), job.latticePath); !w.empty())
     warnOnSuccess(w);
   return run;
 }

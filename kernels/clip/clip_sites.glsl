@@ -77,7 +77,8 @@ ClipSetup clipSetupOf(uvec4 welds, real3 corner[3]) {
     P real len = ssqrt(sdot(d, d));
     P real q = sdiv(len, real(params.target.x));
     real segs = ceil(q);
-    n[e] = uint(clamp(segs, real(1), real(nmax)));
+    // clamp() is not told what to do with a NaN (0 / 0 where a target underflowed): one segment.
+    n[e] = segs > real(1) ? uint(min(segs, real(nmax))) : 1u;
   }
   // Sort the edges by (count, index): a-edge, b-edge, c-edge.
   uint ord[3] = uint[3](0u, 1u, 2u);

@@ -62,7 +62,7 @@ struct ClipTwin {
       Real len = std::sqrt(sdot(d, d));
       Real q = len / l;
       Real segs = std::ceil(q);
-      n[e] = uint32_t(std::clamp(segs, Real(1), Real(nmax)));
+      n[e] = segs > Real(1) ? uint32_t(std::min(segs, Real(nmax))) : 1;   // as the kernel: a NaN is one segment
     }
     int ord[3] = {0, 1, 2};
     for (int i = 0; i < 2; ++i)

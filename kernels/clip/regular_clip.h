@@ -3,6 +3,7 @@
 // sub-triangles lifted onto the PN surface, crack-free by construction. Also turns knot-box clipping
 // (knot_box_clip.h) into the same sub-triangle records, so both clippings feed one deform stage.
 #pragma once
+#include <limits>
 #include <memory>
 #include <span>
 #include <vector>
@@ -33,6 +34,11 @@ struct ClipTriangles {
   std::vector<ClipTriangle> triangles;
   size_t presplitParents = 0;   // parents that needed the pre-split
 };
+
+// Whether the clip kernels can take target edge length l, which they read as a float (ClipParams.target):
+// it must be a normal float, since GPUs flush smaller ones to zero, and a zero target makes every edge Nmax
+// segments (and a zero edge NaN). A run checks it in the units its kernels see, before it starts.
+inline bool clipTargetFits(double l) { return float(l) >= std::numeric_limits<float>::min(); }
 
 // Clip triangles for target edge length l: pre-splits where some edge needs more than `nmax` segments.
 ClipTriangles buildClipTriangles(const Mesh& mesh, double l, int nmax);

@@ -52,8 +52,8 @@ std::string discontinuityWarning(const Lattice& L, const std::string& name) {
   return {};
 }
 
-std::string floatResolutionWarning(const Mesh& mesh, const Lattice& L, bool doublePrecision, const std::string& name) {
-  if (doublePrecision || mesh.positions.empty()) return {};
+std::string resolutionWarning(const Mesh& mesh, const Lattice& L, bool doublePrecision, const std::string& name) {
+  if (mesh.positions.empty()) return {};
   glm::dvec3 lo(INFINITY), hi(-INFINITY);
   for (const glm::dvec3& x : mesh.positions) lo = glm::min(lo, x), hi = glm::max(hi, x);
   const double size = std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
@@ -69,7 +69,7 @@ std::string floatResolutionWarning(const Mesh& mesh, const Lattice& L, bool doub
       if (k[i] <= u && u <= k[i + 1] && k[i + 1] > k[i]) width = k[i + 1] - k[i];
     span = std::max(span, width * glm::length(toWorld[a]));
   }
-  const double resolution = std::ldexp(span, -24);
+  const double resolution = std::ldexp(span, doublePrecision ? -53 : -24);
   if (!(size > 0) || !(resolution >= size / 128) || !std::isfinite(resolution)) return {};
   auto g = [](double v, const char* format) {
     char buf[32];
@@ -78,8 +78,9 @@ std::string floatResolutionWarning(const Mesh& mesh, const Lattice& L, bool doub
   };
   const double share = resolution / size;
   return "the mesh is " + g(size, "%.3g") + " across, and the knot spans of lattice " + name + " that hold it " + g(span, "%.3g") +
-         ": float kernels resolve the result to about " + g(resolution, "%.2g") + ", " +
-         (share < 1 ? g(100 * share, "%.2g") + "% of the mesh" : g(share, "%.2g") + " times its size") + "; use --precision double";
+         (doublePrecision ? ": double" : ": float") + " kernels resolve the result to about " + g(resolution, "%.2g") + ", " +
+         (share < 1 ? g(100 * share, "%.2g") + "% of the mesh" : g(share, "%.2g") + " times its size") +
+         (doublePrecision || std::ldexp(span, -53) >= size / 128 ? "; use a lattice closer to the mesh's size" : "; use --precision double");
 }
 
 }  // namespace sffd

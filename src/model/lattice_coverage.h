@@ -20,10 +20,10 @@ std::string outsideWarning(double shareOutside, const Lattice& lattice, const st
 // One line naming the first interior knot whose multiplicity exceeds its axis' degree; else empty.
 std::string discontinuityWarning(const Lattice& lattice, const std::string& latticeName);
 
-// Float kernels evaluate the lattice from a parameter's distance to the knots, to about 2^-24 of a knot
-// span: a mesh much smaller than the spans it lies in is resolved only to that (a mesh 1e-6 of a span
-// across: to about 3 % of its size; the local frame cannot help, the spans are the lattice's). One line
-// when that is 1/128 of the mesh's size or more and `doublePrecision` is false; else empty.
-std::string floatResolutionWarning(const Mesh& mesh, const Lattice& lattice, bool doublePrecision, const std::string& latticeName);
+// The kernels evaluate the lattice from a parameter's distance to the knots, to about 2^-24 of a knot
+// span in float and 2^-53 in double: a mesh much smaller than the spans it lies in is resolved only to
+// that (a mesh 1e-6 of a span across: to about 3 % of its size in float; the local frame cannot help, the
+// spans are the lattice's). One line when that is 1/128 of the mesh's size or more; else empty.
+std::string resolutionWarning(const Mesh& mesh, const Lattice& lattice, bool doublePrecision, const std::string& latticeName);
 
 }  // namespace sffd

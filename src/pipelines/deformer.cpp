@@ -12,6 +12,7 @@
 #include "core/backend.h"
 #include "core/job_budget.h"
 #include "core/wall_clock.h"
+#include "kernels/clip/regular_clip.h"
 #include "model/mesh_topology.h"
 #include "pipelines/deform_session.h"
 #include "pipelines/deformer_internal.h"
@@ -151,6 +152,13 @@ Deformer::Deformer(Device& device, const Mesh& mesh, const Lattice& lattice, con
   const Lattice& localLattice = moved ? movedLattice : lattice;
   ResolvedOptions localOptions = r;
   localOptions.edgeLength *= I.frame.scale;
+  if (r.method == Method::Smooth && !r.knotBoxClip && !clipTargetFits(localOptions.edgeLength)) {
+    char share[32];
+    std::snprintf(share, sizeof share, "%.2g", localOptions.edgeLength);
+    throw Error(ErrorKind::Input, std::string("the edge length is ") + share +
+                                      " of the lattice's box, below the smallest float (1.2e-38) that the clip kernels take it "
+                                      "in; use a lattice closer to the mesh's size or a longer edge length");
+  }
   std::unique_ptr<MethodRun> local;
   if (r.method == Method::Smooth) local = makeSmoothRun(backend, localMesh, localLattice, localOptions, I.timings, progress);
   else if (r.method == Method::Classic) local = makeClassicRun(backend, localMesh, localLattice, localOptions, I.timings, progress);
