@@ -436,6 +436,18 @@ TEST_F(Robust, OptionsAndOutputPathsAreChecked) {
   // A directory given as the mesh.
   Result r = runSffd({"deform", (dir_ / "out").string(), "-l", l, "--method", "classic", "-o", out("o.obj")});
   expectInputError(r, (dir_ / "out").string() + ": ", "directory as mesh");
+  // Inputs that are no regular file: a FIFO nobody writes to (its open blocked for ever) as the mesh or the
+  // lattice, and a device (read as an empty file before).
+  ASSERT_EQ(::mkfifo((dir_ / "fifo.obj").c_str(), 0644), 0);
+  const std::string notRegular = ": cannot read: not a regular file (a FIFO, socket or device)";
+  r = runSffd({"deform", (dir_ / "fifo.obj").string(), "-l", l, "-o", out("o.obj")});
+  expectInputError(r, (dir_ / "fifo.obj").string() + notRegular, "FIFO as mesh");
+  r = runSffd({"deform", m, "-l", (dir_ / "fifo.json").string(), "-o", out("o.obj")});
+  expectInputError(r, (dir_ / "fifo.json").string() + notRegular, "FIFO as lattice");
+  fs::create_symlink("/dev/zero", dir_ / "zero.stl");
+  r = runSffd({"deform", (dir_ / "zero.stl").string(), "-l", l, "-o", out("o.obj")});
+  expectInputError(r, (dir_ / "zero.stl").string() + notRegular, "device as mesh");
+  expectNothingWritten("inputs that are no regular file");
   // Valid sizes still run.
   r = runSffd({"deform", m, "-l", l, "--method", "classic", "--tess", "64", "--edge-length", "0.5", "-o", out("o.obj"), "--quiet"});
   EXPECT_EQ(r.status, 0) << r.err;

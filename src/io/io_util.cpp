@@ -16,7 +16,11 @@ namespace fs = std::filesystem;
 
 std::string readWholeFile(const std::string& path) {
   std::error_code ec;
-  if (fs::is_directory(path, ec)) throw inputError(path, 0, "cannot read: is a directory");
+  const fs::file_status status = fs::status(path, ec);
+  if (fs::is_directory(status)) throw inputError(path, 0, "cannot read: is a directory");
+  // A FIFO would block the open until something writes to it, and /dev/zero never ends.
+  if (fs::exists(status) && !fs::is_regular_file(status))
+    throw inputError(path, 0, "cannot read: not a regular file (a FIFO, socket or device)");
   errno = 0;
   std::ifstream in(path, std::ios::binary);
   if (!in) {

@@ -11,8 +11,8 @@
 
 namespace sffd::io {
 
-// The whole file as bytes. Throws inputError(path, 0, ...) for a missing, unreadable or empty file,
-// or a directory.
+// The whole file as bytes. Throws inputError(path, 0, ...) for a missing, unreadable or empty file, a
+// directory, or anything but a regular file (a FIFO, socket or device, before opening it).
 std::string readWholeFile(const std::string& path);
 
 // Checks the encoding of a text file read whole: a UTF-16 or UTF-32 byte-order mark, or (unless
