@@ -381,6 +381,11 @@ TEST_F(Robust, OptionsAndOutputPathsAreChecked) {
       {{"--edge-length", "nan", "-o", out("o.obj")}, "--edge-length must"},
       {{"--edge-length", "inf", "-o", out("o.obj")}, "--edge-length must"},
       {{"--edge-length", "1e999", "-o", out("o.obj")}, "--edge-length must"},
+      // Values the job would have taken as another (--samples -1 ran as the default) or ignored.
+      {{"--samples", "-1", "-o", out("o.obj")}, "option --samples needs an integer 1..15 (below 3 samples as 3), not '-1'"},
+      {{"--samples", "0", "-o", out("o.obj")}, "option --samples needs"},
+      {{"--samples", "16", "-o", out("o.obj")}, "option --samples needs"},
+      {{"--degree", "3", "-o", out("o.obj")}, "--degree is a .npy lattice's; " + l + " keeps its own"},
       {{"-o", m}, m + ": output path is an input"},
       {{"-o", (dir_ / "." / "m.obj").string()}, (dir_ / "." / "m.obj").string() + ": output path is an input"},
       {{"-o", (dir_ / "out" / ".." / "m.obj").string()}, (dir_ / "out" / ".." / "m.obj").string() + ": output path is an input"},

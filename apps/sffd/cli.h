@@ -132,6 +132,10 @@ size_t chunkFromEnvironment(const char* name);
 // is absent or auto; a number must be 0..180 degrees (an input Error otherwise).
 double creaseAngleOf(const ParsedArgs& args);
 
+// --samples S: the fit's sampling density, 1..15 as DeformOptions::samples takes it (below 3 is 3); 0, the
+// library's nu+nv+nw, when the option is absent. An input Error otherwise.
+int samplesOf(const ParsedArgs& args);
+
 // Refuses a target edge length that is not positive, or so small that the sub-triangles would
 // exceed kMaxSubTriangles (job_budget.h; the message gives the estimate).
 void checkEdgeLength(const Mesh& mesh, double l);

@@ -116,7 +116,7 @@ int run(const ParsedArgs& args) {
   if (o.tess < 1 || o.tess > 64) throw Error(ErrorKind::Input, "--tess must be 1..64");
   o.edgeLength = edgeLengthOf(args, job.mesh);
   checkEdgeLength(job.mesh, o.edgeLength);
-  o.samples = std::max(3, args.getInt("--samples", job.lattice.degree[0] + job.lattice.degree[1] + job.lattice.degree[2]));
+  o.samples = samplesOf(args);
   o.clip = clipName == "knot-box" ? Clip::KnotBox : Clip::Regular;
   o.split = args.has("--split");
   o.creaseAngleDeg = creaseAngleOf(args);

@@ -190,7 +190,7 @@ CaseOutput runCase(Device& device, const Case& c) {
     subs = regularClip(backend, prepared, pn, buildClipTriangles(job.mesh, l, splitPatternTable().nmax()), l, variant,
                        chunkFromEnvironment("SFFD_MAX_CHUNK_SUBTRIANGLES"));
   }
-  const int s = std::max(3, args.getInt("--samples", L.degree[0] + L.degree[1] + L.degree[2]));
+  const int s = std::max(3, samplesOf(args) > 0 ? samplesOf(args) : L.degree[0] + L.degree[1] + L.degree[2]);   // as the Deformer
   SmoothOutput d = smoothDeform(backend, packed, subs, makeFitTable(s), level, variant, args.has("--split"),
                                 chunkFromEnvironment("SFFD_MAX_CHUNK_SUBTRIANGLES"));
   for (size_t i = 0; i < subs.size(); ++i) out.parents.push_back(subs.headers[4 * i]);

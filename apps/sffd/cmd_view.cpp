@@ -108,7 +108,7 @@ int run(const ParsedArgs& args) {
   o.strict = args.has("--strict");
   o.edgeLength = l;
   o.tess = args.getInt("--tess", 10);
-  o.samples = args.getInt("--samples", 0);
+  o.samples = samplesOf(args);
   o.split = args.has("--split");
   o.creaseAngleDeg = creaseAngleOf(args);
   o.memoryLimit = memoryLimitFromEnvironment();   // each Deformer the viewer makes is checked against it

@@ -46,8 +46,7 @@ DeformOptions deformOptionsOf(const ParsedArgs& args, const Job& job, Device& de
   o.tess = args.getInt("--tess", 10);
   o.creaseAngleDeg = creaseAngleOf(args);
   o.split = args.has("--split");
-  const Lattice& L = job.lattice;
-  o.samples = std::max(3, args.getInt("--samples", L.degree[0] + L.degree[1] + L.degree[2]));
+  o.samples = samplesOf(args);
   if (method == Method::Smooth) {
     o.edgeLength = edgeLengthOf(args, job.mesh);
     checkEdgeLength(job.mesh, o.edgeLength);

@@ -117,6 +117,9 @@ Job loadJob(const ParsedArgs& args) {
 
 Lattice loadJobLattice(const ParsedArgs& args, const Job& job, const std::string& latticePath) {
   const std::string ext = io::lowerExtension(latticePath);
+  // An option that would be ignored is refused (as `sffd lattice --from` does).
+  if (args.has("--degree") && ext != ".npy")
+    throw Error(ErrorKind::Input, "--degree is a .npy lattice's; " + latticePath + " keeps its own (sffd lattice --from L --elevate raises it)");
   LatticeReadOptions lo;
   lo.npyDegree = args.getTriple("--degree", {2, 2, 2});
   meshBounds(job.mesh, lo.meshBoxLo, lo.meshBoxHi);
@@ -223,6 +226,19 @@ JobAndDevice loadJobAndOpenDevice(const ParsedArgs& args) {
   const double openMs = std::chrono::duration<double, std::milli>(Clock::now() - t).count();
   Job job = readFirst ? std::move(*readFirst) : reading.get();
   return {std::move(job), std::move(*device), openMs};
+}
+
+int samplesOf(const ParsedArgs& args) {
+  if (!args.has("--samples")) return 0;
+  const Error refused(ErrorKind::Input, "option --samples needs an integer 1..15 (below 3 samples as 3), not '" + args.get("--samples", "") + "'");
+  int s = 0;
+  try {
+    s = args.getInt("--samples", 0);
+  } catch (const Error&) {
+    throw refused;
+  }
+  if (s < 1 || s > 15) throw refused;
+  return s;
 }
 
 double creaseAngleOf(const ParsedArgs& args) {

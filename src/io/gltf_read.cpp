@@ -254,7 +254,10 @@ Mesh readGltf(const std::string& path, const std::string& bytes) {
   loader.SetFsCallbacks(tinygltf::FsCallbacks{fileExists, pathAsWritten, readRegularFile, refuseWrite, nullptr});
   tinygltf::Model model;
   std::string err, warn;
-  const std::string baseDir = std::filesystem::path(path).parent_path().string();
+  // Never empty: tinygltf joins it with each buffer's uri, and an empty one would let an absolute uri
+  // ("/etc/passwd") name a file outside the model's folder when the model is in the current folder only.
+  std::string baseDir = std::filesystem::path(path).parent_path().string();
+  if (baseDir.empty()) baseDir = ".";
   const bool glb = bytes.size() >= 4 && bytes.compare(0, 4, "glTF") == 0;
   const bool ok = glb ? loader.LoadBinaryFromMemory(&model, &err, &warn, reinterpret_cast<const unsigned char*>(bytes.data()),
                                                     unsigned(bytes.size()), baseDir)

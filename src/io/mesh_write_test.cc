@@ -249,6 +249,30 @@ TEST(MeshRead, GltfPrimitivesAndTransforms) {
   fs::remove_all(dir);
 }
 
+// A buffer named by an absolute path is looked for in the model's folder, wherever the model is read from:
+// read from its own folder ("t.gltf", whose folder is empty), "/PATH" named a file elsewhere.
+TEST(MeshRead, GltfBufferPathsStayInTheModelsFolder) {
+  const fs::path dir = tempDir("mesh_read_gltf_uri");
+  const fs::path elsewhere = tempDir("mesh_read_gltf_uri_elsewhere");
+  std::string bin;
+  for (float f : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f}) bin.append(reinterpret_cast<const char*>(&f), 4);
+  std::ofstream(elsewhere / "b.bin", std::ios::binary) << bin;
+  std::ofstream(dir / "t.gltf") << R"({"asset": {"version": "2.0"}, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+    "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+    "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}],
+    "bufferViews": [{"buffer": 0, "byteLength": 36}],
+    "buffers": [{"byteLength": 36, "uri": ")" + (elsewhere / "b.bin").string() + R"("}]})";
+  const fs::path cwd = fs::current_path();
+  for (const bool fromItsFolder : {false, true}) {
+    if (fromItsFolder) fs::current_path(dir);
+    const std::string name = fromItsFolder ? "t.gltf" : (dir / "t.gltf").string();
+    EXPECT_THROW(readMesh(name), Error) << name;
+  }
+  fs::current_path(cwd);
+  fs::remove_all(dir);
+  fs::remove_all(elsewhere);
+}
+
 // An output that is a symbolic link is written through it, whole or streamed: the link stays a link and its
 // target, in another folder, gets the mesh; nothing is left beside either.
 TEST(MeshWrite, ThroughASymbolicLinkTheLinkStays) {

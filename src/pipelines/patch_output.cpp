@@ -34,9 +34,18 @@ void interpolate(const std::vector<glm::vec<N, double>>& values, const std::arra
   int order[3] = {0, 1, 2};
   std::sort(order, order + 3, [&](int a, int b) { return weld[t[a]] < weld[t[b]]; });
   glm::vec<N, double> r(0.0);
+  const glm::vec<N, double>* first = nullptr;
+  bool shared[N];
   for (int c : order)
-    if (lam[c] != 0.0) r += lam[c] * values[t[c]];
-  for (int i = 0; i < N; ++i) out[i] = r[i];
+    if (lam[c] != 0.0) {
+      const glm::vec<N, double>& v = values[t[c]];
+      r += lam[c] * v;
+      if (!first) first = &v;
+      for (int i = 0; i < N; ++i) shared[i] = (first == &v || shared[i]) && v[i] == (*first)[i];
+    }
+  // A value that the corners share is kept exactly: the weights' sum may round off 1 (an opaque alpha came
+  // out 0.9999999999999999, and the PLY writer then wrote an alpha channel of 255s).
+  for (int i = 0; i < N; ++i) out[i] = first && shared[i] ? (*first)[i] : r[i];
 }
 }  // namespace
 
