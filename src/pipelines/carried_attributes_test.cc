@@ -154,4 +154,30 @@ TEST(CarriedAttributes, EveryMethodKeepsThemAndEveryDeviceAgrees) {
   }
 }
 
+// A value all the corners share is carried exactly, whatever the weights' sum rounds to: an opaque alpha at
+// weights 0.7, 0.2, 0.1 summed 0.9999999999999999, and the PLY writer then wrote an alpha channel of 255s.
+TEST(CarriedAttributes, AValueTheCornersShareIsKeptExactly) {
+  Mesh mesh;
+  mesh.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  mesh.triangles = {{0, 1, 2}};
+  mesh.weldId = {0, 1, 2};
+  mesh.colors = {{0.25, 0.5, 1, 1}, {0.25, 0.75, 1, 1}, {0.25, 0.5, 0, 1}};
+  mesh.texcoords = {{0.3, 0.1}, {0.3, 0.7}, {0.3, 0.9}};
+  PatchVertices pv;
+  pv.level = 1;
+  pv.parent = {0};
+  pv.lamParent = {0.7, 0.2, 0.1, 0, 0.6, 0.4, 1, 0, 0};   // inside, on the edge 1-2, at corner 0
+  pv.position.assign(9, 0.0);
+  pv.normal.assign(9, 0.0);
+  ASSERT_EQ(0.7 + 0.2 + 0.1, 0.9999999999999999);
+  carryPatchAttributes(pv, mesh);
+  for (size_t g = 0; g < 3; ++g) {
+    EXPECT_EQ(pv.color[4 * g], 0.25) << g;       // shared by all three corners
+    EXPECT_EQ(pv.color[4 * g + 3], 1.0) << g;    // likewise: opaque stays opaque
+    EXPECT_EQ(pv.texcoord[2 * g], 0.3) << g;
+  }
+  EXPECT_EQ(pv.color[4 * 1 + 2], 0.6);           // on the edge 1-2: blue 1 and 0 are not shared, so interpolated
+  EXPECT_EQ(pv.color[4 * 2 + 1], 0.5);           // at corner 0: its own value
+}
+
 }  // namespace
