@@ -67,6 +67,34 @@ TEST_F(CommandLine, ListOptionsTakeOneValueOrThree) {
   EXPECT_EQ(runSffd("lattice " + box_ + " -o " + out("x.json") + " --degree 3 --counts 6 --quiet").status, 0);
 }
 
+// Values taken as something else or ignored before (a stranger's test, 2026-11-29): a name list with an
+// empty name, options of the deform stage given to clip, --fps with numbered frames, an empty file name, a
+// negative margin (the library's words "fitLattice: ..." before), SFFD_DEVICE_TIMEOUT that is no number (60 s
+// before), an edge length whose estimate overflowed (a memory error of 8388608 TiB before).
+TEST_F(CommandLine, ValuesThatWereTakenOrIgnoredAreRefused) {
+  const std::string job = box_ + " -l " + lattice_;
+  for (const char* list : {"cpu,", ",cpu", "cpu,,vulkan"}) {
+    expectUsageError(runSffd("bench " + job + " --backends " + list),
+                     "option --backends needs names separated by single commas, not '" + std::string(list) + "'");
+    expectUsageError(runSffd("conform " + job + " --backends " + list), "option --backends needs names separated by single commas");
+  }
+  for (const char* option : {"--method classic", "--tess 3", "--split", "--samples 6"})
+    expectUsageError(runSffd("clip " + job + " -o " + out("c.obj") + " " + option),
+                     "unknown option '" + std::string(option).substr(0, std::string(option).find(' ')) + "' for 'sffd clip'");
+  expectUsageError(runSffd("animate " + box_ + " -l " + lattice_ + " -l " + lattice_ + " --frames 2 --fps 30 -o " + out("f_%d.obj")),
+                   "--fps times a glTF animation; numbered files have no times");
+  expectUsageError(runSffd("deform '' -l " + lattice_ + " -o " + out("o.obj")), "the mesh's file name is empty");
+  expectUsageError(runSffd("deform " + box_ + " -l '' -o " + out("o.obj")), "the lattice's file name is empty");
+  expectUsageError(runSffd("deform " + job + " -o ''"), "the output's file name is empty");
+  expectUsageError(runSffd("lattice " + box_ + " -o " + out("x.json") + " --margin -0.1"), "option --margin needs a fraction >= 0, not '-0.1'");
+  expectUsageError(runSffd("deform " + job + " -o " + out("o.obj"), "SFFD_DEVICE_TIMEOUT=abc"),
+                   "SFFD_DEVICE_TIMEOUT must be a number of seconds > 0, like 60 or 0.5, not 'abc'");
+  expectUsageError(runSffd("devices", "SFFD_DEVICE_TIMEOUT=0"), "SFFD_DEVICE_TIMEOUT must be a number of seconds > 0");
+  expectUsageError(runSffd("deform " + job + " -o " + out("o.obj") + " --edge-length 1e-300"),
+                   "--edge-length 1e-300 would make more sub-triangles than a double counts, above the limit of 5e+07");
+  for (const char* name : {"o.obj", "c.obj", "x.json", "f_0.obj"}) EXPECT_FALSE(fs::exists(dir_ / name)) << name;
+}
+
 // lavapipe cannot finish a smooth job in a microsecond: the wait gives up with a device error.
 TEST_F(CommandLine, DeviceWaitTimesOutAsADeviceError) {
   RunResult r = runSffd("deform " + box_ + " -l " + lattice_ + " --backend vulkan --tess 32 --edge-length 0.05 -o " + out("o.obj"),

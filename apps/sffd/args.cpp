@@ -154,6 +154,19 @@ int ParsedArgs::getInt(const std::string& name, int fallback) const {
   return v;
 }
 
+std::vector<std::string> ParsedArgs::getList(const std::string& name, const std::string& fallback) const {
+  const std::string text = get(name, fallback);
+  std::vector<std::string> out;
+  if (text.empty()) return out;
+  for (size_t start = 0;;) {
+    const size_t comma = text.find(',', start);
+    out.push_back(text.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
+    if (out.back().empty()) throw usage("option " + name + " needs names separated by single commas, not '" + text + "'");
+    if (comma == std::string::npos) return out;
+    start = comma + 1;
+  }
+}
+
 std::array<int, 3> ParsedArgs::getTriple(const std::string& name, std::array<int, 3> fallback) const {
   auto it = values.find(name);
   if (it == values.end()) return fallback;

@@ -43,6 +43,8 @@ struct ParsedArgs {
   double getDouble(const std::string& name, double fallback) const;
   int getInt(const std::string& name, int fallback) const;
   std::array<int, 3> getTriple(const std::string& name, std::array<int, 3> fallback) const;
+  // A comma-separated list of names (--backends, --require); an empty name ("cpu,", "a,,b") is refused.
+  std::vector<std::string> getList(const std::string& name, const std::string& fallback) const;
   std::string requireValue(const std::string& name) const;
 };
 

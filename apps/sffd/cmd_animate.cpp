@@ -57,6 +57,7 @@ int run(const ParsedArgs& args) {
   const double fps = args.getDouble("--fps", 24.0);
   if (!std::isfinite(fps) || !(fps > 0) || fps > 1000) throw Error(ErrorKind::Input, "--fps must be a number in (0, 1000]");
   const bool numbered = isFramePattern(out);
+  if (numbered && args.has("--fps")) throw Error(ErrorKind::Input, "--fps times a glTF animation; numbered files have no times");
   // glTF keeps the key times as floats: the last frame's, (N-1)/F seconds, must be one.
   if (!numbered && !(double(frames - 1) / fps <= std::numeric_limits<float>::max()))
     throw Error(ErrorKind::Input, "--fps " + args.get("--fps") + " puts the last frame past the seconds a glTF key time (a float) holds");

@@ -9,7 +9,6 @@
 #include <chrono>
 #include <cstdio>
 #include <map>
-#include <sstream>
 
 #include <nlohmann/json.hpp>
 
@@ -125,10 +124,7 @@ int run(const ParsedArgs& args) {
   else if (args.get("--precision", "float") != "float") throw Error(ErrorKind::Input, "--precision must be float or double");
   else o.precision = Precision::Float;
 
-  std::vector<std::string> names;
-  std::stringstream ss(args.get("--backends", "vulkan,gl"));
-  for (std::string n; std::getline(ss, n, ',');)
-    if (!n.empty()) names.push_back(n);
+  const std::vector<std::string> names = args.getList("--backends", "vulkan,gl");
   if (names.empty()) throw Error(ErrorKind::Input, "--backends names no backend");
 
   std::vector<BackendResult> results;

@@ -146,9 +146,13 @@ int run(const ParsedArgs& args) {
 }  // namespace
 
 CommandSpec clipCommand() {
-  CommandSpec c{"clip", "MESH -l LATTICE --edge-length L -o SUB.obj [--clip regular|knot-box] [--stats S.json]",
+  // The job options less those of the deform stage, which clip does not run (taken and ignored before).
+  std::vector<OptionSpec> options;
+  for (const OptionSpec& o : jobOptions())
+    if (std::string n = o.name; n != "--method" && n != "--tess" && n != "--split" && n != "--samples") options.push_back(o);
+  CommandSpec c{"clip", "MESH -l LATTICE -o SUB.obj [--edge-length L] [--clip regular|knot-box] [--stats S.json]",
                 "Runs the pre-compute stage (PN triangles and clipping) and writes the sub-triangles and their statistics.",
-                jobOptions(), run, 1, 1};
+                options, run, 1, 1};
   c.options.insert(c.options.begin() + 1, {"--output|-o", "FILE", "sub-triangle mesh to write (.obj .ply .off .stl)"});
   c.options.insert(c.options.begin() + 2, {"--flat", nullptr, "write the sub-triangles on the flat parents instead of the PN surface"});
   return c;

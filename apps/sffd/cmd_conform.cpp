@@ -9,7 +9,6 @@
 #include <cstdlib>
 #include <fstream>
 #include <set>
-#include <sstream>
 
 #include <nlohmann/json.hpp>
 #include <sffd/error.h>
@@ -23,14 +22,6 @@ namespace {
 
 using namespace conform;
 using json = nlohmann::ordered_json;
-
-std::vector<std::string> listOf(const std::string& text) {
-  std::vector<std::string> out;
-  std::stringstream ss(text);
-  for (std::string n; std::getline(ss, n, ',');)
-    if (!n.empty()) out.push_back(n);
-  return out;
-}
 
 // Where `--cases default` finds tests/data/conform/default.cases.
 std::string dataDir() {
@@ -112,10 +103,10 @@ std::vector<BackendRun> readDump(const fs::path& dir, const std::vector<Case>& c
 
 int run(const ParsedArgs& args) {
   static const std::set<std::string> known{"vulkan", "gl", "gl-egl", "gl-osmesa", "gl-glfw", "gles", "cpu"};
-  const std::vector<std::string> names = listOf(args.get("--backends", "vulkan,gl-egl,gl-osmesa,cpu"));
+  const std::vector<std::string> names = args.getList("--backends", "vulkan,gl-egl,gl-osmesa,cpu");
   for (const std::string& n : names)
     if (!known.count(n)) throw Error(ErrorKind::Input, "--backends: unknown backend '" + n + "' (vulkan, gl, gl-egl, gl-osmesa, gl-glfw, gles, cpu)");
-  const std::vector<std::string> required = listOf(args.get("--require"));
+  const std::vector<std::string> required = args.getList("--require", "");
   for (const std::string& n : required)
     if (std::find(names.begin(), names.end(), n) == names.end())
       throw Error(ErrorKind::Input, "--require: '" + n + "' is not one of --backends");

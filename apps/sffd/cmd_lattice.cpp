@@ -38,7 +38,9 @@ Lattice fittedLattice(const ParsedArgs& args) {
     if (!(s > 0)) throw Error(ErrorKind::Input, "--normalize needs a positive scale");
     normalizeMesh(mesh, s);
   }
-  return fitLattice(mesh, counts, degree, args.getDouble("--margin", 0.005));
+  const double margin = args.getDouble("--margin", 0.005);
+  if (!(margin >= 0)) throw Error(ErrorKind::Input, "option --margin needs a fraction >= 0, not '" + args.get("--margin") + "'");
+  return fitLattice(mesh, counts, degree, margin);
 }
 
 // --from FILE: read as `deform -l FILE` reads it (a .npy lattice needs MESH for its box, as there).

@@ -39,7 +39,7 @@ std::vector<OptionSpec> jobOptions() {
       {"--normalize", "S", "center the mesh on its box and scale its largest half-extent to S (.npy: 0.99)"},
       {"--degree", "U,V,W", ".npy lattices: B-spline degree per axis (default 2,2,2)"},
       {"--precision", "NAME", "auto|float|double kernel arithmetic (auto: double for classic where supported)"},
-      {"--strict", nullptr, "strict kernels: bit-identical across GL, Vulkan and the CPU reference"},
+      {"--strict", nullptr, "strict kernels: bit-identical across GL, GLES, Vulkan and the CPU reference at one --precision"},
       {"--stats", "FILE", "write run statistics as JSON"},
       {"--quiet", nullptr, "no notes on stderr"},
       {"--help|-h", nullptr, "show this help"},
@@ -154,6 +154,7 @@ std::vector<std::string> gltfBufferFiles(const std::string& gltf) {
 
 void checkOutputPath(const std::string& out, const std::vector<std::string>& inputs, bool renamed) {
   std::error_code ec;
+  if (out.empty()) throw Error(ErrorKind::Input, "the output's file name is empty");
   // Fail before any work when the output cannot be written where asked.
   fs::path dir = fs::path(out).parent_path();
   if (dir.empty()) dir = ".";

@@ -5,15 +5,30 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include <sffd/error.h>
+
 namespace sffd {
 
+namespace {
+// The variable's seconds; 0 when it is unset or empty, -1 when it is not a number > 0.
+double variableSeconds() {
+  const char* s = std::getenv("SFFD_DEVICE_TIMEOUT");
+  if (!s || !*s) return 0;
+  char* end = nullptr;
+  const double v = std::strtod(s, &end);
+  return end != s && *end == '\0' && std::isfinite(v) && v > 0 ? std::min(v, 1e9) : -1;
+}
+}  // namespace
+
 double deviceTimeoutSeconds() {
-  if (const char* s = std::getenv("SFFD_DEVICE_TIMEOUT"); s && *s) {
-    char* end = nullptr;
-    double v = std::strtod(s, &end);
-    if (end != s && *end == '\0' && std::isfinite(v) && v > 0) return std::min(v, 1e9);
-  }
-  return 60.0;
+  const double v = variableSeconds();
+  return v > 0 ? v : 60.0;
+}
+
+void checkDeviceTimeoutVariable() {
+  if (variableSeconds() < 0)
+    throw Error(ErrorKind::Input, std::string("SFFD_DEVICE_TIMEOUT must be a number of seconds > 0, like 60 or 0.5, not '") +
+                                      std::getenv("SFFD_DEVICE_TIMEOUT") + "'");
 }
 
 uint64_t deviceTimeoutNs() { return uint64_t(std::ceil(deviceTimeoutSeconds() * 1e9)); }

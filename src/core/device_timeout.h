@@ -8,6 +8,9 @@ namespace sffd {
 
 // SFFD_DEVICE_TIMEOUT seconds (a number > 0; tests set tiny ones), else 60.
 double deviceTimeoutSeconds();
+// An input Error when SFFD_DEVICE_TIMEOUT is set to anything but such a number (the tool checks it before
+// a command runs; deviceTimeoutSeconds() would wait 60 s instead).
+void checkDeviceTimeoutVariable();
 uint64_t deviceTimeoutNs();
 
 // "DEVICE did not finish its work within 60 s (SFFD_DEVICE_TIMEOUT); the driver or GPU may be hung".

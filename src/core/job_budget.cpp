@@ -93,10 +93,12 @@ double defaultEdgeLength(const Mesh& mesh) {
 void checkSubTriangleCount(const Mesh& mesh, double l, const std::string& name) {
   if (!(l > 0) || !std::isfinite(l)) throw Error(ErrorKind::Input, name + " must be a positive number");
   const double estimate = estimateSubTriangles(mesh, l);
-  if (estimate > kMaxSubTriangles) {
+  if (!(estimate <= kMaxSubTriangles)) {   // NaN too: edges past double's range over l make inf - inf
     char buf[160];
-    std::snprintf(buf, sizeof buf, " %g would make about %.3g sub-triangles, above the limit of %.3g", l, estimate,
-                  kMaxSubTriangles);
+    if (std::isfinite(estimate))
+      std::snprintf(buf, sizeof buf, " %g would make about %.3g sub-triangles, above the limit of %.3g", l, estimate, kMaxSubTriangles);
+    else
+      std::snprintf(buf, sizeof buf, " %g would make more sub-triangles than a double counts, above the limit of %.3g", l, kMaxSubTriangles);
     throw Error(ErrorKind::Input, name + buf);
   }
 }

@@ -311,6 +311,7 @@ Lattice readJson(const std::string& path, const std::string& text, uint64_t memo
 
 Lattice readLattice(const std::string& path, const LatticeReadOptions& options) {
   std::string ext = io::lowerExtension(path);
+  if (path.empty()) throw Error(ErrorKind::Input, "the lattice's file name is empty");
   try {
     if (ext != ".json" && ext != ".prm" && ext != ".npy")
       throw inputError(path, 0,

@@ -20,6 +20,7 @@ Mesh readMesh(const std::string& path, const MeshReadOptions& options) {
   static const char* known[] = {".obj", ".off", ".ply", ".stl", ".om", ".bpt", ".gltf", ".glb"};
   bool ok = false;
   for (const char* k : known) ok = ok || ext == k;
+  if (path.empty()) throw Error(ErrorKind::Input, "the mesh's file name is empty");
   try {
     if (!ok)
       throw inputError(path, 0,
