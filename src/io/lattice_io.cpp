@@ -21,6 +21,7 @@
 #include <cmath>
 #include <cstring>
 #include <iterator>
+#include <limits>
 #include <numbers>
 #include <nlohmann/json.hpp>
 #include <ostream>
@@ -455,8 +456,8 @@ void writeLatticeJson(const std::string& path, const Lattice& L) {
 // half extent along world axis a), a control point x = c + sum_a s_a E_a has local coordinates
 // t_a = s_a |E_a| (model units, zero at the centre) on unit axes d_a = E_a / |E_a|. A preset maps t to t'
 // and moves x by sum_a (t'_a - t_a) d_a. h_a = |E_a| are the half extents; L is the longest axis (the
-// first of equal ones), S the second longest, and s = t_L / h_L in [-1, 1] runs along L. Amount 1 is the
-// intended default of every preset.
+// first of equal ones, equal to rounding), S the second longest, and s = t_L / h_L in [-1, 1] runs along
+// L. Amount 1 is the intended default of every preset.
 //   twist: rotate the cross-section (the two axes other than L) about L by the angle a * 90deg * s / 2,
 //          i.e. a * 90deg in all from one end of the box to the other, the middle fixed.
 //   bend:  t'_S = t_S + a * 0.5 * h_S * s^2: a parabola along L bending toward +S, the ends moving by
@@ -489,12 +490,17 @@ void applyLatticePreset(Lattice& lattice, const std::string& name, double amount
     if (!(h[a] > 0) || !std::isfinite(h[a])) throw Error(ErrorKind::Internal, "lattice preset: degenerate box");
     d[a] = E / h[a];
   }
+  // Longer by more than rounding: the box fitted to a cube differs from axis to axis by the rounding of its
+  // corners, which grows with the distance from the origin, and the twist's axis turned with it.
+  const double rounding = 64 * std::numeric_limits<double>::epsilon() *
+                          (std::max({std::abs(c.x), std::abs(c.y), std::abs(c.z)}) + std::max({h[0], h[1], h[2]}));
+  auto longer = [&](int a, int b) { return h[a] - h[b] > rounding; };
   int Lx = 0;
   for (int a = 1; a < 3; ++a)
-    if (h[a] > h[Lx]) Lx = a;
+    if (longer(a, Lx)) Lx = a;
   int S = -1;
   for (int a = 0; a < 3; ++a)
-    if (a != Lx && (S < 0 || h[a] > h[S])) S = a;
+    if (a != Lx && (S < 0 || longer(a, S))) S = a;
   int B = 3 - Lx - S;   // the remaining axis
   int P = std::min(S, B), Q = std::max(S, B);   // cross-section axes in x, y, z order
 

@@ -486,4 +486,25 @@ TEST_F(LatticeIo, Presets) {
   }
 }
 
+// A cube's box, fitted where it lies: its sides differ by the rounding of its corners, which grows with the
+// distance from the origin; the preset must act on the same axes wherever the cube is (the twist's axis
+// turned from x to another when a side came out an ulp longer: control points 0.65 apart).
+TEST_F(LatticeIo, PresetAxesDoNotTurnWithTheBoxsRounding) {
+  const glm::dvec3 lo(-1.01, -1.01, -1.01), hi(1.01, 1.01, 1.01);   // fitLattice's box of the unit sphere
+  Lattice here = makeIdentityLattice(lo, hi, {5, 5, 5}, {2, 2, 2});
+  for (const glm::dvec3 offset : {glm::dvec3(10, 0, 0), glm::dvec3(1e7, -3e7, 5e6), glm::dvec3(0.1, 0.7, 1e9)}) {
+    SCOPED_TRACE(offset.x);
+    Lattice there = makeIdentityLattice(lo + offset, hi + offset, {5, 5, 5}, {2, 2, 2});
+    for (const char* name : {"twist", "bend", "taper", "bulge"}) {
+      Lattice a = here, b = there;
+      applyLatticePreset(a, name, 0.5);
+      applyLatticePreset(b, name, 0.5);
+      double apart = 0;
+      for (size_t i = 0; i < a.controlPoints.size(); ++i)
+        apart = std::max(apart, glm::length((b.controlPoints[i] - offset) - a.controlPoints[i]));
+      EXPECT_LT(apart, 1e-6 * (1 + glm::length(offset)) * 1e-6) << name;
+    }
+  }
+}
+
 }  // namespace
