@@ -32,6 +32,13 @@ void setControlPoints(Lattice& L, py::handle value) {
   std::copy(p.begin(), p.end(), L.controlPoints.begin());   // in place: views stay valid
 }
 
+// A copy of read-only structure that refuses writes (numpy's writeable flag off): writes to a plain copy
+// were silently lost.
+py::array readOnly(py::array a) {
+  a.attr("flags").attr("writeable") = false;
+  return a;
+}
+
 py::array_t<double> mat3(const glm::dmat3& m) {   // row-major, as numpy reads it: out[r][c] = m[c][r]
   py::array_t<double> a({3, 3});
   auto w = a.mutable_unchecked<2>();
@@ -118,13 +125,13 @@ void bindLattice(py::module_& m) {
       .def_property_readonly("degree", [](const Lattice& L) { return py::make_tuple(L.degree[0], L.degree[1], L.degree[2]); })
       .def_property_readonly("knots", [](const Lattice& L) {
         py::list k;
-        for (const auto& v : L.knots) k.append(py::array_t<double>(py::ssize_t(v.size()), v.data()));
+        for (const auto& v : L.knots) k.append(readOnly(py::array_t<double>(py::ssize_t(v.size()), v.data())));
         return py::tuple(k);
       })
-      .def_property_readonly("frame_linear", [](const Lattice& L) { return mat3(L.frameLinear); },
+      .def_property_readonly("frame_linear", [](const Lattice& L) { return readOnly(mat3(L.frameLinear)); },
                              "M of the world -> parameter map p = M x + o")
       .def_property_readonly("frame_offset", [](const Lattice& L) {
-        return py::array_t<double>(3, &L.frameOffset.x);
+        return readOnly(py::array_t<double>(3, &L.frameOffset.x));
       })
       .def_property_readonly("outside", [](const Lattice& L) { return L.outside == OutsideMode::Keep ? "keep" : "extrapolate"; })
       .def("__repr__", [](const Lattice& L) {

@@ -192,6 +192,10 @@ def test_lattice_files_round_trip(sphere, tmp_path):
     assert again.counts == (4, 5, 6)
     np.testing.assert_array_equal(again.control_points, lat.control_points)
     np.testing.assert_allclose(np.concatenate(again.knots), np.concatenate(lat.knots), rtol=0, atol=1e-15)
+    # The structure is read-only: a write to its arrays is refused (it was lost without a word).
+    for array in (lat.knots[0], lat.frame_linear, lat.frame_offset):
+        with pytest.raises(ValueError):
+            array[0] = 7
 
 
 @pytest.mark.parametrize("label", [d.label for d in sffd.devices()])
