@@ -123,6 +123,26 @@ TEST(Render, OptionsAndComparisons) {
   fs::remove_all(dir);
 }
 
+// A mesh without normals drawn alone has the creases the methods keep (--crease-angle): a cube's face is
+// one flat shade (it was shaded smooth across the cube's edges, a gradient over every face).
+TEST(Render, TheInputAloneKeepsItsCreases) {
+  fs::path dir = freshDir("creases");
+  {
+    std::ofstream f(dir / "box.obj");   // no normals
+    for (int i = 0; i < 8; ++i) f << "v " << (i & 1 ? 1 : -1) << ' ' << (i & 2 ? 1 : -1) << ' ' << (i & 4 ? 1 : -1) << '\n';
+    f << "f 1 5 7\nf 1 7 3\nf 2 4 8\nf 2 8 6\nf 1 2 6\nf 1 6 5\nf 3 7 8\nf 3 8 4\nf 1 3 4\nf 1 4 2\nf 5 6 8\nf 5 8 7\n";
+  }
+  const std::string png = (dir / "box.png").string();
+  Result r = sffd("render " + (dir / "box.obj").string() + " -o " + png + " --width 300 --height 300 --view 30,20 --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const sffd::gl::Image img = sffd::gl::readPng(png);
+  // Two points well inside the face that looks at the viewer's left (a cube at azimuth 30 fills the middle).
+  int worst = 0;
+  for (int ch = 0; ch < 3; ++ch) worst = std::max(worst, std::abs(int(img.pixel(110, 130)[ch]) - int(img.pixel(140, 200)[ch])));
+  EXPECT_LE(worst, 2) << "a face of the cube is not one shade";
+  fs::remove_all(dir);
+}
+
 TEST(Render, BadRequestsLeaveNoFile) {
   fs::path dir = freshDir("bad");
   const std::string base = "render " + kTeapot + " -l " + kLattice + " --method classic --quiet ";

@@ -13,6 +13,7 @@
 #include <sffd/error.h>
 #include "apps/render/gl_renderer.h"
 #include "core/job_budget.h"
+#include "model/mesh_topology.h"
 
 namespace sffd::cli {
 namespace {
@@ -88,6 +89,8 @@ int run(const ParsedArgs& args) {
       if (!(s > 0)) throw usageError("--normalize needs a positive scale");
       normalizeMesh(mesh, s);
     }
+    // Shaded with the creases the methods keep (a cube without normals was drawn smooth across its edges).
+    if (!mesh.normalsFromFile) applyCreaseAngle(mesh, creaseAngleOf(args));
     meshes.push_back(std::move(mesh));
     captions.push_back("");
   } else {
@@ -97,6 +100,7 @@ int run(const ParsedArgs& args) {
     computedOn = ", deformed on " + device.label();
     if (compare == "input") {
       meshes.push_back(job.mesh);
+      if (!job.mesh.normalsFromFile) applyCreaseAngle(meshes.back(), creaseAngleOf(args));
       captions.push_back("input");
     } else if (compare == "classic") {
       Job classicJob = job;   // the methods may prepare the job's mesh in place
