@@ -8,6 +8,11 @@
 // identical across backends: they all see the same local inputs.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <limits>
+#include <string>
+
+#include <sffd/error.h>
 
 #include "pipelines/deformer_internal.h"
 
@@ -27,6 +32,13 @@ double roundedOrigin(double centre, double extent) {
 // keeps a margin of 2^12 below and 2^8 above, and keeps the results of usual models as they were.
 double unitScale(double extent) {
   if (!(extent > 0) || !std::isfinite(extent)) return 1;
+  // Below double's smallest normal number the box has lost bits already, and 2^-e would pass double's range.
+  if (extent < std::numeric_limits<double>::min()) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.3g", extent);
+    throw Error(ErrorKind::Input, std::string("the lattice's box is ") + text +
+                                      " across, below the smallest normal double (2.2e-308): too small to compute in");
+  }
   const int e = std::ilogb(extent);
   return e >= kLocalScaleMinExponent && e < kLocalScaleMaxExponent ? 1 : std::ldexp(1.0, -e);
 }

@@ -61,6 +61,26 @@ TEST(LocalFrame, ScaleIsOneForUsualSizesAndBringsOthersToSizeOne) {
   }
 }
 
+// A box below double's smallest normal number (2^-1022) has lost bits already, and the power of two that
+// would bring it to size 1 is past double's range: an input Error for every method (classic wrote "a
+// non-finite position", smooth "the edge length must be a finite number > 0", accurate an empty mesh).
+TEST(LocalFrame, ABoxBelowDoublesNormalRangeIsRefused) {
+  const Mesh sphere = scaledMesh(uvSphere(false), std::ldexp(1.0, -1032));
+  const Lattice lattice = makeIdentityLattice(glm::dvec3(std::ldexp(-1.0, -1031)), glm::dvec3(std::ldexp(1.0, -1031)), {4, 4, 4}, {2, 2, 2});
+  Device device = Device::open(DeviceRequest{.name = "cpu"});
+  for (Method method : {Method::Smooth, Method::Classic, Method::Accurate}) {
+    DeformOptions o;
+    o.method = method;
+    try {
+      Deformer deformer(device, sphere, lattice, o);
+      ADD_FAILURE() << "method " << int(method) << " took a box of 2^-1030";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.kind(), ErrorKind::Input) << e.what();
+      EXPECT_NE(std::string(e.what()).find("across, below the smallest normal double (2.2e-308)"), std::string::npos) << e.what();
+    }
+  }
+}
+
 TEST(LocalFrame, MeshesFarFromTheOriginKeepTheirTopologyAndGeometryOnEveryDevice) {
   std::vector<std::string> devices = sffd::testing::backendsHere(sffd::testing::testBackends());
   if (std::find(devices.begin(), devices.end(), "cpu") == devices.end()) devices.push_back("cpu");
