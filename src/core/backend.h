@@ -63,6 +63,7 @@ class Backend {
   virtual const DeviceInfo& info() const = 0;
 
   virtual BufferId createBuffer(uint64_t bytes) = 0;
+  // Called by destructors: never throws for a buffer the backend made.
   virtual void destroyBuffer(BufferId buffer) = 0;
   virtual void upload(BufferId buffer, uint64_t offset, const void* data, uint64_t bytes) = 0;
   // Waits for all work that writes the buffer, then copies it out.
