@@ -82,6 +82,10 @@ class Backend {
   virtual void finish() = 0;
   // Timings of the dispatches finished since the last call, in dispatch order.
   virtual std::vector<DispatchTiming> takeTimings() = 0;
+  // The end of a call of the public API (Device::open, a Deformer's calls and destruction): a backend
+  // bound to the calling thread meanwhile (GL: sffd's own EGL or OSMesa context) lets go of it, so that
+  // the next call may come from another thread. Never throws.
+  virtual void endCall() noexcept {}
 };
 
 // Splits a 1-D job of `threads` threads into a grid within the device's group-count limits

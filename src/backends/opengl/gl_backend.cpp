@@ -4,7 +4,8 @@
 // Every GL call goes through glad, whose entry points the context loads when it becomes current;
 // each public method activates the backend's context first, so backends of several providers can
 // live in one process, and restores the bindings it changes (gl_state.h), so that an application's
-// context can be shared (adopted contexts).
+// context can be shared (adopted contexts). The public API ends each of its calls with endCall(),
+// which lets sffd's own EGL or OSMesa context go, so that the next call may come from another thread.
 #include "backends/opengl/gl_backend.h"
 
 #include <glad/gl.h>
@@ -176,7 +177,7 @@ class GlBackend final : public Backend {
   }
 
   // Called by destructors, so it never throws: where the context cannot be made current on this thread
-  // (it is current on another), the buffer is deleted at the next call that can.
+  // (another thread is inside a call on the device), the buffer is deleted at the next call that can.
   void destroyBuffer(BufferId id) override {
     auto it = buffers_.find(id);
     if (it == buffers_.end()) return;
@@ -190,6 +191,8 @@ class GlBackend final : public Backend {
     }
     glDeleteBuffers(1, &name);
   }
+
+  void endCall() noexcept override { ctx_->endCall(); }
 
   void upload(BufferId id, uint64_t offset, const void* data, uint64_t bytes) override {
     activate();

@@ -251,9 +251,9 @@ TEST(GlCrossProvider, TwoEglBackendsAndAnOutsideContextSwitch) {
   expectIdentity<double>(*b, {true, true}, 1e-14);
 }
 
-// A buffer destroyed on a thread where the context cannot be made current (another thread holds it) is
-// deleted by the next call that makes it current, and nothing throws: destroyBuffer runs in destructors,
-// which must not.
+// A buffer destroyed on a thread where the context cannot be made current (another thread holds it: the
+// public API lets it go at the end of each call, a backend used directly does not) is deleted by the next
+// call that makes it current, and nothing throws: destroyBuffer runs in destructors, which must not.
 TEST(GlThreads, ABufferDestroyedWhereTheContextCannotBeCurrentIsDeletedLater) {
   SKIP_WITHOUT(Provider::EGL);
   auto b = open(Provider::EGL);   // current on this thread
@@ -265,6 +265,11 @@ TEST(GlThreads, ABufferDestroyedWhereTheContextCannotBeCurrentIsDeletedLater) {
   EXPECT_TRUE(glIsBuffer(name));   // not deleted from the other thread
   b->finish();
   EXPECT_FALSE(glIsBuffer(name));
+  b->endCall();   // now any thread may use it, one at a time
+  std::thread([&] {
+    expectIdentity<float>(*b, {true, false}, 1e-6);
+    b.reset();
+  }).join();
 }
 
 TEST(GlSelection, ListDevicesGivesEachHeadlessProvider) {

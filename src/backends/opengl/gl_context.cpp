@@ -16,8 +16,8 @@ namespace {
 // The sffd context current on this thread (activate() keeps it; providers release it on destruction).
 thread_local Context* tCurrent = nullptr;
 // The context whose entry points glad's (process-wide) table holds: making it current again, after
-// a release or on another thread, needs no reload (EGL's and the other providers' entry points do not
-// depend on the context current).
+// a release at the end of a call (endCall) or on another thread, needs no reload (EGL's and the other
+// providers' entry points do not depend on the context current).
 std::atomic<const Context*> gGladLoadedBy{nullptr};
 
 GLADapiproc loadThrough(void* userptr, const char* name) {
@@ -127,6 +127,10 @@ void Context::deactivateCurrent() {
     tCurrent->release();
     tCurrent = nullptr;
   }
+}
+
+void Context::endCall() noexcept {
+  if (releasedBetweenCalls()) releaseIfCurrent();
 }
 
 void Context::releaseIfCurrent() {
