@@ -35,9 +35,9 @@
 //     return e.exitStatus();
 //   }
 //
-// Threads: a Device and the Deformers on it are used from one thread at a time (an adopted GL
-// context: the thread it is current on; a gl-egl device: the thread that opened it, where EGL keeps its
-// context). Different Devices are independent.
+// Threads: a Device and the Deformers on it are used from one thread at a time, any thread, their
+// destruction included (an adopted GL context: only the thread it is current on). Different Devices are
+// independent.
 #pragma once
 #include <sffd/deformer.h>
 #include <sffd/device.h>

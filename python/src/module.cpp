@@ -3,7 +3,7 @@
 //
 // Arrays: any real dtype and any strides in (converted to C-contiguous float64 where needed), float64
 // (positions, normals) and uint32 (triangles) out, always fresh copies. The GIL stays held: a Device is
-// used from one thread at a time, and an opened GL context belongs to its thread.
+// used from one thread at a time (any thread: sffd lets a GL context go at the end of each call).
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>

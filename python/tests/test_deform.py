@@ -3,6 +3,7 @@ dtypes and strides, re-deforming, and memory over repeated calls."""
 import resource
 import subprocess
 import sys
+import threading
 
 import numpy as np
 import pytest
@@ -296,3 +297,32 @@ def test_deformer_results_need_a_finished_deform_and_finite_control_points(tmp_p
     with pytest.raises(sffd.InputError, match="not finite"):
         d.deform(bad)
     assert np.isfinite(d.deform(lat)[0]).all()
+
+
+@pytest.mark.parametrize("label", [d.label for d in sffd.devices() if d.api in ("gl", "gles")])
+def test_a_gl_deformer_is_used_and_collected_on_any_thread(sphere, label):
+    """Whichever thread drops a Deformer's last reference (or collects it) runs its destructor: on a GL
+    device from another thread than the one that opened it, that aborted the process (EGL keeps a context
+    current on one thread only)."""
+    v, t, _ = sphere
+    lat = sffd.Lattice.fitted(v).preset("twist", 0.3)
+    made = {}
+
+    def make():
+        made["d"] = sffd.Deformer(v, t, lat, backend=sffd.Device(name=label), tess=2)
+        made["out"] = made["d"].deform(lat)
+
+    worker = threading.Thread(target=make)
+    worker.start()
+    worker.join()
+    d = made.pop("d")
+    for a, b in zip(d.deform(lat), made["out"]):   # on this thread now
+        np.testing.assert_array_equal(a, b)
+    del d   # with its device, here
+
+    made["d"] = sffd.Deformer(v, t, lat, backend=sffd.Device(name=label), tess=2)
+    made["d"].deform(lat)
+    worker = threading.Thread(target=made.clear)   # the last reference dropped on the worker
+    worker.start()
+    worker.join()
+    assert not made

@@ -18,6 +18,8 @@ struct Device::Impl {
 Device::Device(std::string label, std::unique_ptr<Backend> backend) : impl_(std::make_unique<Impl>()) {
   impl_->label = std::move(label);
   if (backend) impl_->info = backend->info();
+  // Opening made a GL context current on this thread: let it go, so that any thread may make the first call.
+  if (backend) backend->endCall();
   impl_->backend = std::move(backend);
   impl_->self = this;
 }

@@ -63,6 +63,7 @@ class Backend {
   virtual const DeviceInfo& info() const = 0;
 
   virtual BufferId createBuffer(uint64_t bytes) = 0;
+  // Called by destructors: never throws for a buffer the backend made.
   virtual void destroyBuffer(BufferId buffer) = 0;
   virtual void upload(BufferId buffer, uint64_t offset, const void* data, uint64_t bytes) = 0;
   // Waits for all work that writes the buffer, then copies it out.
@@ -81,6 +82,10 @@ class Backend {
   virtual void finish() = 0;
   // Timings of the dispatches finished since the last call, in dispatch order.
   virtual std::vector<DispatchTiming> takeTimings() = 0;
+  // The end of a call of the public API (Device::open, a Deformer's calls and destruction): a backend
+  // bound to the calling thread meanwhile (GL: sffd's own EGL or OSMesa context) lets go of it, so that
+  // the next call may come from another thread. Never throws.
+  virtual void endCall() noexcept {}
 };
 
 // Splits a 1-D job of `threads` threads into a grid within the device's group-count limits

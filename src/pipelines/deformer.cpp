@@ -98,6 +98,19 @@ ResolvedOptions resolve(const DeformOptions& o, const DeviceInfo& info, const Me
 }
 
 
+// Ends a public call on the device however the call ends (Backend::endCall: a GL device may then be
+// used from another thread).
+class CallScope {
+ public:
+  explicit CallScope(Backend& backend) : backend_(backend) {}
+  CallScope(const CallScope&) = delete;
+  CallScope& operator=(const CallScope&) = delete;
+  ~CallScope() { backend_.endCall(); }
+
+ private:
+  Backend& backend_;
+};
+
 }  // namespace
 
 Deformer::Deformer(Device& device, const MeshView& mesh, const Lattice& lattice, const DeformOptions& options)
@@ -118,6 +131,7 @@ Deformer::Deformer(Device& device, const Mesh& mesh, const Lattice& lattice, con
   I.frame = latticeLocalFrame(lattice);
   const ResolvedOptions& r = I.resolved;
   Backend& backend = device.backend();
+  CallScope call(backend);
   ProgressReporter progress(I.options.progress, &backend);
   progress("prepare", 0);
   if (r.method == Method::Smooth) {
@@ -168,14 +182,28 @@ Deformer::Deformer(Device& device, const Mesh& mesh, const Lattice& lattice, con
     const uint64_t held = meshHeldBytes(mesh) + (moved ? meshHeldBytes(I.input) : 0) + estimateLatticeBytes(lattice);
     local = makeAccurateRun(backend, localMesh, localLattice, localOptions, I.timings, progress, held, I.estimate, I.wholeEstimate);
   }
-  I.run = inLocalFrame(std::move(local), I.frame);
-  progress("prepare", 1);
+  std::unique_ptr<MethodRun> run = inLocalFrame(std::move(local), I.frame);
+  progress("prepare", 1);   // a cancel here frees the run's buffers before `call` ends
+  I.run = std::move(run);
   I.timings.wallMs = msSince(t0);
 }
 
 Deformer::Deformer(Deformer&&) noexcept = default;
-Deformer& Deformer::operator=(Deformer&&) noexcept = default;
-Deformer::~Deformer() = default;
+Deformer& Deformer::operator=(Deformer&& other) noexcept {
+  if (this != &other) {
+    Deformer old(std::move(*this));   // destroyed below, as a Deformer: its call ends
+    impl_ = std::move(other.impl_);
+  }
+  return *this;
+}
+// Freeing the device buffers is a call on the device like any other: it may come from any thread (a
+// Python Deformer's is made by whichever thread the garbage collector runs on).
+Deformer::~Deformer() {
+  if (!impl_) return;
+  Backend& backend = impl_->backend();   // the constructor succeeded: the device has a backend
+  impl_.reset();
+  backend.endCall();
+}
 
 const Timings& Deformer::deform(const Lattice& lattice) {
   Impl& I = impl();
@@ -186,6 +214,7 @@ const Timings& Deformer::deform(const Lattice& lattice) {
   validateLattice(lattice, "lattice");
   if (I.options.once && I.deformed) throw Error(ErrorKind::Input, "a one-shot Deformer deforms once (DeformOptions::once)");
   const auto t0 = std::chrono::steady_clock::now();
+  CallScope call(I.backend());
   ProgressReporter progress(I.options.progress, &I.backend());
   // The outputs are the last deform()'s only once it has run to its end: a cancelled or failed call leaves
   // them part old, part new.
@@ -213,6 +242,7 @@ Mesh Deformer::result() const {
   impl().checkResult("result()");
   // A streamed job's estimate counts a sink's pieces, not the welded mesh that result() holds.
   if (impl().wholeEstimate) checkEstimateFits(impl(), *impl().wholeEstimate, impl().options.memoryLimit, kLimitName);
+  CallScope call(impl().backend());
   ProgressReporter progress(impl().options.progress, &impl().backend());
   progress("download", 0);
   impl().resultTaken = true;
@@ -223,6 +253,7 @@ Mesh Deformer::result() const {
 
 void Deformer::streamResult(MeshSink& sink) const {
   impl().checkResult("streamResult()");
+  CallScope call(impl().backend());
   ProgressReporter progress(impl().options.progress, &impl().backend());
   progress("download", 0);
   impl().resultTaken = true;
@@ -250,6 +281,7 @@ void MethodRun::streamResult(MeshSink& sink, const ProgressReporter& progress) c
 
 std::vector<double> Deformer::patchControlPoints() const {
   impl().checkResult("patchControlPoints()");
+  CallScope call(impl().backend());
   return impl().run->patchControlPoints();
 }
 size_t Deformer::subTriangles() const { return impl().run->subTriangles(); }

@@ -4,7 +4,8 @@
 // Every GL call goes through glad, whose entry points the context loads when it becomes current;
 // each public method activates the backend's context first, so backends of several providers can
 // live in one process, and restores the bindings it changes (gl_state.h), so that an application's
-// context can be shared (adopted contexts).
+// context can be shared (adopted contexts). The public API ends each of its calls with endCall(),
+// which lets sffd's own EGL or OSMesa context go, so that the next call may come from another thread.
 #include "backends/opengl/gl_backend.h"
 
 #include <glad/gl.h>
@@ -122,7 +123,7 @@ class GlBackend final : public Backend {
   ~GlBackend() override {
     if (hung_) return;   // the device may still use everything: leave it to the context's end
     try {
-      ctx_->activate();
+      activate();
       glFinish();
       programs_->release();
       for (auto& [id, b] : buffers_) glDeleteBuffers(1, &b.name);
@@ -141,7 +142,7 @@ class GlBackend final : public Backend {
 
   const DeviceInfo& info() const override { return info_; }
   const ProgramResources& resources(std::string_view kernelName, KernelVariant variant) {
-    ctx_->activate();
+    activate();
     const EmbeddedKernel* kernel = findKernel(kernelName);
     if (!kernel) throw Error(ErrorKind::Internal, "gl: no kernel named '" + std::string(kernelName) + "'");
     return programs_->get(*kernel, variant).resources;
@@ -152,7 +153,7 @@ class GlBackend final : public Backend {
   }
 
   BufferId createBuffer(uint64_t bytes) override {
-    ctx_->activate();
+    activate();
     StateGuard state;
     state.buffer(GL_COPY_WRITE_BUFFER);
     GLuint name = 0;
@@ -175,16 +176,26 @@ class GlBackend final : public Backend {
     return id;
   }
 
+  // Called by destructors, so it never throws: where the context cannot be made current on this thread
+  // (another thread is inside a call on the device), the buffer is deleted at the next call that can.
   void destroyBuffer(BufferId id) override {
-    ctx_->activate();
     auto it = buffers_.find(id);
     if (it == buffers_.end()) return;
-    glDeleteBuffers(1, &it->second.name);
+    const GLuint name = it->second.name;
     buffers_.erase(it);
+    try {
+      activate();
+    } catch (const Error&) {
+      orphans_.push_back(name);
+      return;
+    }
+    glDeleteBuffers(1, &name);
   }
 
+  void endCall() noexcept override { ctx_->endCall(); }
+
   void upload(BufferId id, uint64_t offset, const void* data, uint64_t bytes) override {
-    ctx_->activate();
+    activate();
     const Buf& b = buffer(id, offset, bytes, "upload");
     if (bytes == 0) return;
     // Shader writes are incoherent: order them before this write.
@@ -197,7 +208,7 @@ class GlBackend final : public Backend {
   }
 
   void download(BufferId id, uint64_t offset, void* data, uint64_t bytes) override {
-    ctx_->activate();
+    activate();
     const Buf& b = buffer(id, offset, bytes, "download");
     if (bytes == 0) return;
     if (dirty_) {
@@ -223,12 +234,12 @@ class GlBackend final : public Backend {
   // NVIDIA's GL otherwise compiles a job's kernels one after the other: 148 s for strict double
   // (docs/performance/gpu.md, run 4).
   void precompile(const std::vector<KernelUse>& kernels) override {
-    ctx_->activate();
+    activate();
     programs_->precompile(kernels);
   }
 
   void dispatch(const Dispatch& d) override {
-    ctx_->activate();
+    activate();
     programs_->settle();
     const EmbeddedKernel* kernel = findKernel(d.kernel);
     if (!kernel) throw Error(ErrorKind::Internal, "gl: no kernel named '" + std::string(d.kernel) + "'");
@@ -311,14 +322,14 @@ class GlBackend final : public Backend {
   }
 
   void barrier() override {
-    ctx_->activate();
+    activate();
     glMemoryBarrier(kAllBarriers);
     dirty_ = false;
     checkGl("barrier");
   }
 
   void finish() override {
-    ctx_->activate();
+    activate();
     waitIdle("finish");
     checkGl("finish");
   }
@@ -337,7 +348,7 @@ class GlBackend final : public Backend {
   }
 
   std::vector<DispatchTiming> takeTimings() override {
-    ctx_->activate();
+    activate();
     std::vector<DispatchTiming> out;
     if (!pending_.empty()) waitIdle("timings");   // the query results below are then ready
     out.reserve(pending_.size());
@@ -390,6 +401,14 @@ class GlBackend final : public Backend {
   // Vulkan's shared namespace needs; ES kernels number them from 0, prelude.glsl's SFFD_SSBO).
   GLuint storageIndex(uint32_t slot) const { return es_ ? slot - 1 : slot; }
 
+  // Makes the context current here and deletes the buffers destroyBuffer could not.
+  void activate() {
+    ctx_->activate();
+    if (orphans_.empty()) return;
+    glDeleteBuffers(static_cast<GLsizei>(orphans_.size()), orphans_.data());
+    orphans_.clear();
+  }
+
   GLuint takeQuery() {
     if (freeQueries_.empty()) {
       GLuint q[16];
@@ -410,6 +429,7 @@ class GlBackend final : public Backend {
   uint64_t uboSize_ = 0, uboHead_ = 0, uboAlign_ = 256, maxParams_ = 16384;
   std::vector<Pending> pending_;
   std::vector<GLuint> freeQueries_;
+  std::vector<GLuint> orphans_;   // buffers destroyed while the context could not be made current
   bool dirty_ = false;   // dispatches since the last barrier
   bool es_ = false;                // an OpenGL ES context (the gles backend)
   bool heldToEsMinimum_ = false;   // es_, and held to the ES 3.1 minimum limits (gl_es_limits.h)

@@ -13,6 +13,7 @@
 #include <cstring>
 #include <random>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <sffd/error.h>
@@ -248,6 +249,27 @@ TEST(GlCrossProvider, TwoEglBackendsAndAnOutsideContextSwitch) {
   expectIdentity<float>(*b, {false, false}, 1e-6);
   a.reset();   // the display stays initialised for b
   expectIdentity<double>(*b, {true, true}, 1e-14);
+}
+
+// A buffer destroyed on a thread where the context cannot be made current (another thread holds it: the
+// public API lets it go at the end of each call, a backend used directly does not) is deleted by the next
+// call that makes it current, and nothing throws: destroyBuffer runs in destructors, which must not.
+TEST(GlThreads, ABufferDestroyedWhereTheContextCannotBeCurrentIsDeletedLater) {
+  SKIP_WITHOUT(Provider::EGL);
+  auto b = open(Provider::EGL);   // current on this thread
+  const BufferId id = b->createBuffer(64);
+  const GLuint name = glBufferObject(*b, id);
+  ASSERT_NE(name, 0u);
+  std::thread([&] { EXPECT_NO_THROW(b->destroyBuffer(id)); }).join();
+  EXPECT_EQ(glBufferObject(*b, id), 0u);
+  EXPECT_TRUE(glIsBuffer(name));   // not deleted from the other thread
+  b->finish();
+  EXPECT_FALSE(glIsBuffer(name));
+  b->endCall();   // now any thread may use it, one at a time
+  std::thread([&] {
+    expectIdentity<float>(*b, {true, false}, 1e-6);
+    b.reset();
+  }).join();
 }
 
 TEST(GlSelection, ListDevicesGivesEachHeadlessProvider) {

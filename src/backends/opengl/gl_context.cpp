@@ -3,6 +3,7 @@
 
 #include <dlfcn.h>
 
+#include <atomic>
 #include <string_view>
 
 #include <glad/gl.h>
@@ -14,6 +15,10 @@ namespace sffd::gl {
 namespace {
 // The sffd context current on this thread (activate() keeps it; providers release it on destruction).
 thread_local Context* tCurrent = nullptr;
+// The context whose entry points glad's (process-wide) table holds: making it current again, after
+// a release at the end of a call (endCall) or on another thread, needs no reload (EGL's and the other
+// providers' entry points do not depend on the context current).
+std::atomic<const Context*> gGladLoadedBy{nullptr};
 
 GLADapiproc loadThrough(void* userptr, const char* name) {
   return reinterpret_cast<GLADapiproc>(static_cast<const Context*>(userptr)->procAddress(name));
@@ -70,6 +75,8 @@ bool providerLibraryPresent(Provider provider) {
 Context::~Context() {
   // Derived destructors released the context already (releaseIfCurrent); forget it in any case.
   if (tCurrent == this) tCurrent = nullptr;
+  const Context* self = this;   // a later context at this address loads glad again
+  gGladLoadedBy.compare_exchange_strong(self, nullptr);
 }
 
 bool Context::isCurrent() const { return tCurrent == this; }
@@ -98,6 +105,8 @@ void Context::activate() {
 void Context::loadGlad() {
   // The GL entry points belong to the provider's library (OSMesa has its own copy of Mesa's GL):
   // reload them whenever another context becomes current.
+  if (gGladLoadedBy.load() == this) return;
+  gGladLoadedBy = nullptr;   // being overwritten
   es_ = currentIsEs(*this);
   if (es_) {
     glVersion_ = loadGlesEntryPoints(procThrough, this);
@@ -110,6 +119,7 @@ void Context::loadGlad() {
     tCurrent = nullptr;
     throw deviceError(std::string(name()) + ": cannot load the GL entry points (glad found no GL version)");
   }
+  gGladLoadedBy = this;
 }
 
 void Context::deactivateCurrent() {
@@ -117,6 +127,10 @@ void Context::deactivateCurrent() {
     tCurrent->release();
     tCurrent = nullptr;
   }
+}
+
+void Context::endCall() noexcept {
+  if (releasedBetweenCalls()) releaseIfCurrent();
 }
 
 void Context::releaseIfCurrent() {

@@ -27,7 +27,8 @@ bool providerLibraryPresent(Provider provider);
 
 using GLProc = void (*)();
 
-// One GL context of one provider. Not thread-safe: use it from the thread that created it.
+// One GL context of one provider. Not thread-safe: used by one thread at a time; a context that is
+// released between calls (releasedBetweenCalls) by any thread, the others only where they are current.
 class Context {
  public:
   Context() = default;
@@ -50,6 +51,14 @@ class Context {
   void activate();
   // Releases whichever sffd context is current on the calling thread.
   static void deactivateCurrent();
+  // Whether the context is let go at the end of every call of the public API (endCall): sffd's own
+  // headless contexts (EGL, OSMesa), so that their Device may be used from any thread, one at a time
+  // (EGL refuses to make a context current on a thread while another still has it). Not the GLFW
+  // window's, which the viewer draws with between calls, nor an adopted one.
+  virtual bool releasedBetweenCalls() const { return false; }
+  // The end of a public call (Backend::endCall): releases this context from the calling thread when
+  // it is releasedBetweenCalls() and current here. Never throws.
+  void endCall() noexcept;
   bool isCurrent() const;
   // The GL version glad found at the last activate(): major * 10 + minor (45 for 4.5, 32 for ES 3.2).
   int glVersion() const { return glVersion_; }

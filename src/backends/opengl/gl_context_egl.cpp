@@ -136,6 +136,7 @@ class EglContext final : public Context {
     if (displayUsers().empty()) l.ReleaseThread();
   }
   const char* name() const override { return api_.provider(); }
+  bool releasedBetweenCalls() const override { return true; }
   GLProc procAddress(const char* function) const override {
     return reinterpret_cast<GLProc>(lib().GetProcAddress(function));
   }
@@ -146,11 +147,12 @@ class EglContext final : public Context {
     l.BindAPI(api_.api());
     if (!l.MakeCurrent(dpy_, EGL_NO_SURFACE, EGL_NO_SURFACE, ctx_)) {
       const EGLint error = l.GetError();
-      // The context stays current on the thread that opened the device (EGL lets no other thread take it
-      // until that one lets go): say so, rather than the bare EGL_BAD_ACCESS.
+      // sffd lets the context go at the end of each call (endCall), so another thread holds it only while
+      // it is inside a call on the same Device (EGL lets no thread take it until that one lets go): say
+      // so, rather than the bare EGL_BAD_ACCESS.
       if (error == EGL_BAD_ACCESS)
-        throw deviceError(std::string(api_.provider()) + ": the device's GL context is current on another thread; use a GL "
-                                                         "device from the thread that opened it (or open one on each thread)");
+        throw deviceError(std::string(api_.provider()) + ": the device's GL context is current on another thread; use a "
+                                                         "Device from one thread at a time (or open one on each thread)");
       throw deviceError(std::string(api_.provider()) + ": eglMakeCurrent failed (" + errorName(error) + ")");
     }
   }

@@ -52,6 +52,7 @@ class OSMesaGLContext final : public Context {
     l.DestroyContext(ctx_);
   }
   const char* name() const override { return "osmesa"; }
+  bool releasedBetweenCalls() const override { return true; }
   GLProc procAddress(const char* function) const override {
     return reinterpret_cast<GLProc>(lib().GetProcAddress(function));
   }
