@@ -26,6 +26,7 @@
 #include <nlohmann/json.hpp>
 #include <ostream>
 #include <unordered_map>
+#include <unordered_set>
 
 #include "io/atomic_file.h"
 #include <sffd/error.h>
@@ -87,6 +88,11 @@ class LineMap {
       case json::parse_event_t::key:
         if (!stack_.empty()) {
           stack_.back().key = parsed.is_string() ? parsed.get<std::string>() : std::string();
+          // JSON leaves a repeated key to the reader (nlohmann keeps the last): which one was meant is unknown.
+          if (!stack_.back().keys.insert(stack_.back().key).second && duplicateKey_.empty()) {
+            duplicateKey_ = stack_.back().key;
+            duplicateLine_ = lineOfOffset(size_t(furthest_ - text_.data()) - (text_.empty() ? 0 : 1));
+          }
           record();
         }
         break;
@@ -113,12 +119,16 @@ class LineMap {
   size_t lineOfOffset(size_t offset) const {
     return 1 + size_t(std::lower_bound(newlines_.begin(), newlines_.end(), offset) - newlines_.begin());
   }
+  // The first key given twice in one object (empty when none), and its second line.
+  const std::string& duplicateKey() const { return duplicateKey_; }
+  size_t duplicateLine() const { return duplicateLine_; }
 
  private:
   struct Frame {
     bool array;
     long index;
     std::string key;
+    std::unordered_set<std::string> keys = {};   // an object's keys so far
   };
   void beginElement() {
     if (!stack_.empty() && stack_.back().array) ++stack_.back().index;
@@ -140,6 +150,8 @@ class LineMap {
   std::vector<size_t> newlines_;
   std::vector<Frame> stack_;
   std::unordered_map<std::string, size_t> lines_;
+  std::string duplicateKey_;
+  size_t duplicateLine_ = 0;
 };
 
 std::string stripNlohmannPrefix(const std::string& what) {
@@ -169,6 +181,8 @@ Lattice readJson(const std::string& path, const std::string& text, uint64_t memo
     size_t line = lines.lineOfOffset(size_t(*lines.furthest() - text.data()) - (text.empty() ? 0 : 1));
     throw inputError(path, line, "JSON error: " + stripNlohmannPrefix(e.what()));
   }
+  if (!lines.duplicateKey().empty())
+    throw inputError(path, lines.duplicateLine(), "the key " + io::quoted(lines.duplicateKey()) + " is given twice in one object");
   auto fail = [&](const std::string& at, const std::string& what) { return inputError(path, lines.line(at), what); };
   if (!j.is_object()) throw inputError(path, 1, "expected a JSON object {\"format\": \"sffd-lattice\", ...}");
 

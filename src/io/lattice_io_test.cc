@@ -404,6 +404,7 @@ TEST_F(LatticeIo, JsonErrorsHaveLines) {
       {"knotn.json", doc("[1, 1, 1]", "[2, 2, 2]", box, ",\n\"knots\": {\n\"v\": [0, 0, 1]}"), 8, "counts+degree+1"},
       {"knotbox.json", doc("[1, 1, 1]", "[2, 2, 2]", box, ",\n\"knots\": {\"w\": [0, 0, 2, 2]}"), 7, "but the box spans"},
       {"unknown.json", doc("[1, 1, 1]", "[2, 2, 2]", box, ",\n\"controlpoints\": []"), 7, "unknown field \"controlpoints\""},
+      {"twice.json", doc("[1, 1, 1]", "[2, 2, 2]", box, ",\n\"degree\": [2, 2, 2]"), 7, "the key 'degree' is given twice in one object"},
       {"outside.json", doc("[1, 1, 1]", "[2, 2, 2]", box, ",\n\"outside\": \"wrap\""), 7, "extrapolate"},
       {"huge.json", doc("[1, 1, 1]", "[4000, 4000, 4000]", box, ""), 5, "too large"},
       {"frame.json", doc("[1, 1, 1]", "[2, 2, 2]", box, ",\n\"frame\": {\"matrix\": [[1, 0, 0], [0, 1, 0], [1, 0, 0]]}"), 7, "singular"},

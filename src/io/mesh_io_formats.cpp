@@ -104,6 +104,10 @@ Mesh readOff(const std::string& path, const std::string& text) {
     }
     addPolygon(mesh, poly.data(), poly.size(), dropped);
   }
+  // More lines than the header declares: faces a wrong count leaves out, or something else; either way unread.
+  if (nextTokens())
+    mesh.warnings.push_back(path + ":" + std::to_string(line) + ": text after the header's last face (of " + std::to_string(nf) +
+                            ") ignored (is the face count wrong?)");
   noteDroppedPolygons(mesh, dropped);
   finishMesh(mesh, fromFile, path);
   return mesh;

@@ -442,6 +442,12 @@ TEST_F(MeshIo, OffPlyStlVariants) {
   EXPECT_TRUE(off.normalsFromFile);
   EXPECT_EQ(off.normals[0], glm::dvec3(0, 0, 1));   // normalised
   EXPECT_EQ(off.normals[3], glm::dvec3(0, 0, 1));   // zero: recomputed
+  // Lines after the declared faces (a face count too low) are not read, and a warning says so.
+  Mesh more = readMesh(write("more.off", "OFF\n4 1 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n"));
+  EXPECT_EQ(more.triangles.size(), 1u);
+  ASSERT_EQ(more.warnings.size(), 1u);
+  EXPECT_EQ(more.warnings[0], path("more.off") + ":8: text after the header's last face (of 1) ignored (is the face count wrong?)");
+  EXPECT_TRUE(readMesh(write("comment.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n# the end\n\n")).warnings.empty());
   // Binary PLY, big-endian, with an extra property and an extra element.
   std::string ply =
       "ply\nformat binary_big_endian 1.0\ncomment x\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
