@@ -89,6 +89,9 @@ class Deformer {
  public:
   // Prepares `mesh` for lattices with the structure of `lattice` (degrees, counts, knots, frame) on
   // `device`, which must outlive the Deformer (it may be moved meanwhile: the Deformer follows it).
+  // A Mesh is checked as meshFromView checks a view (<sffd/mesh.h> says what each field must hold): a
+  // field of the wrong size, an index out of range or a non-finite position or normal is an input Error
+  // naming the field and its first bad element; empty normals or weldId are made as readMesh makes them.
   // Throws an input Error for bad options or a mesh that cannot be deformed, a device Error when the
   // device refuses the work. A moved-from Deformer throws an input Error from every call but destruction
   // and assignment.

@@ -13,6 +13,7 @@
 #include "core/job_budget.h"
 #include "core/wall_clock.h"
 #include "kernels/clip/regular_clip.h"
+#include "model/mesh.h"
 #include "model/mesh_topology.h"
 #include "pipelines/deform_session.h"
 #include "pipelines/deformer_internal.h"
@@ -109,12 +110,18 @@ Deformer::Deformer(Device& device, const Mesh& mesh, const Lattice& lattice, con
   Impl& I = *impl_;
   I.device = device.handle();
   I.options = options;
+  // The checks meshFromView makes, for a Mesh the caller filled: a bad index or count would be read out of
+  // bounds by every method, a NaN deformed into NaN.
+  validateMesh(mesh, "mesh");
   validateLattice(lattice, "lattice");
   I.resolved = resolve(options, device.info(), mesh, lattice);
   if (std::string big = latticeTooLarge(lattice, options.memoryLimit, kLimitName); !big.empty())
     throw Error(ErrorKind::Input, big);
   I.structure = lattice;
   I.input = mesh;
+  // What <sffd/mesh.h> lets a caller leave empty, made as readMesh makes it.
+  if (I.input.normals.empty()) computeVertexNormals(I.input), I.input.normalsFromFile = false;
+  if (I.input.weldId.empty()) weldPositions(I.input);
   I.frame = latticeLocalFrame(lattice);
   const ResolvedOptions& r = I.resolved;
   Backend& backend = device.backend();
