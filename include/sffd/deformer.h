@@ -66,7 +66,8 @@ struct DeformOptions {
   // subTriangles() are then the run's; deviceOutput() is empty, patchControlPoints() throws). Accurate:
   // deform() only takes the lattice, and the result runs the kernels a chunk at a time in one device buffer
   // (timings() are then the run's; deviceOutput() is empty). Every method: a second deform(), or a second
-  // result() or streamResult(), throws an input Error.
+  // result() or streamResult(), throws an input Error; so does a result() or streamResult() after one that
+  // was cancelled or threw, since what the result is made from is freed as it is made.
   bool once = false;
 };
 
@@ -102,9 +103,11 @@ class Deformer {
   ~Deformer();
 
   // Deforms with the lattice's current control points; an input Error if its structure differs
-  // from the one the Deformer was made for. The results below are those of the last call: before the
-  // first, or after one that was cancelled or threw, result(), streamResult() and patchControlPoints()
-  // throw an input Error and deviceOutput() is empty (the device's outputs would be part old, part new).
+  // from the one the Deformer was made for or a control point is not finite. The results below are those
+  // of the last call: before the first, or after one that was cancelled or threw for any reason (a refused
+  // lattice included), result(), streamResult() and patchControlPoints() throw an input Error and
+  // deviceOutput() is empty until a deform() succeeds. The one exception: a one-shot Deformer's second
+  // deform() is refused before it touches anything, and the first one's result is still there to take.
   const Timings& deform(const Lattice& lattice);
   // Times of the preparation (pn, clip) and of the last deform().
   const Timings& timings() const;

@@ -511,4 +511,53 @@ TEST(Deformer, AMeshIsCheckedAsAViewIsAndItsOptionalFieldsAreMade) {
   }
 }
 
+// deformer.h promised result() throws after a deform() that threw; after one refused for its lattice (a
+// NaN control point, another structure) result() gave the previous lattice's result.
+TEST(Deformer, ADeformRefusedForItsLatticeLeavesNoResult) {
+  const Mesh mesh = icosphere(1);
+  const Lattice lattice = twisted(mesh, 0.3);
+  Device device = openDevice("cpu");
+  Lattice nan = lattice, other = fitLattice(mesh, {5, 5, 5}, {2, 2, 2});
+  nan.controlPoints[3].x = std::nan("");
+  struct Count : MeshSink {
+    void add(const Mesh&, size_t) override {}
+  } sink;
+  for (Method method : kMethods)
+    for (const Lattice* refused : {&nan, &other}) {
+      SCOPED_TRACE(nameOf(method));
+      Deformer deformer(device, mesh, lattice, strictOptions(method));
+      deformer.deform(lattice);
+      const Mesh first = deformer.result();
+      EXPECT_EQ(errorKindOf([&] { deformer.deform(*refused); }), ErrorKind::Input);
+      EXPECT_NE(inputMessageOf([&] { deformer.result(); }).find("the last deform() was cancelled or failed"), std::string::npos);
+      EXPECT_EQ(errorKindOf([&] { deformer.streamResult(sink); }), ErrorKind::Input);
+      EXPECT_TRUE(deformer.deviceOutput().empty());
+      if (method == Method::Smooth) { EXPECT_EQ(errorKindOf([&] { deformer.patchControlPoints(); }), ErrorKind::Input); }
+      deformer.deform(lattice);
+      expectSameBits(deformer.result(), first, "deformed again after the refused call");
+    }
+}
+
+// A one-shot result cancelled while it was made was refused on a retry as "already taken".
+TEST(Deformer, ARetriedOneShotResultSaysItWasCancelled) {
+  const Mesh mesh = icosphere(1);
+  const Lattice lattice = twisted(mesh, 0.3);
+  Device device = openDevice("cpu");
+  for (Method method : kMethods) {
+    SCOPED_TRACE(nameOf(method));
+    bool cancel = false;
+    DeformOptions o = strictOptions(method);
+    o.once = true;
+    o.progress = [&](const Progress& p) { return !(cancel && p.fraction > 0); };
+    Deformer deformer(device, mesh, lattice, o);
+    deformer.deform(lattice);
+    cancel = true;
+    EXPECT_EQ(errorKindOf([&] { deformer.result(); }), ErrorKind::Cancelled);
+    cancel = false;
+    const std::string message = inputMessageOf([&] { deformer.result(); });
+    EXPECT_NE(message.find("was cancelled while it was being made"), std::string::npos) << message;
+    EXPECT_EQ(message.find("already taken"), std::string::npos) << message;
+  }
+}
+
 }  // namespace
