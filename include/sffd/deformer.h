@@ -164,7 +164,8 @@ class Deformer {
   Impl& impl() const;   // an input Error on a moved-from Deformer
 };
 
-// Vertices and triangles of one patch tessellated at level L: (L+1)(L+2)/2 and L^2.
+// Vertices and triangles of one patch tessellated at level L: (L+1)(L+2)/2 and L^2. L is a level
+// DeformOptions::tess takes, 1..64; an input Error outside it.
 int tessVertexCount(int level);
 int tessTriangleCount(int level);
 

@@ -560,4 +560,16 @@ TEST(Deformer, ARetriedOneShotResultSaysItWasCancelled) {
   }
 }
 
+// tessVertexCount(100000) gave 705182705, 1000000 a negative count, -1 gave 0.
+TEST(Deformer, TessellationCountsTakeTheLevelsDeformOptionsTakes) {
+  EXPECT_EQ(tessVertexCount(1), 3);
+  EXPECT_EQ(tessTriangleCount(1), 1);
+  EXPECT_EQ(tessVertexCount(64), 65 * 66 / 2);
+  EXPECT_EQ(tessTriangleCount(64), 4096);
+  for (int level : {-1, 0, 65, 100000, 1000000}) {
+    EXPECT_NE(inputMessageOf([&] { tessVertexCount(level); }).find("1..64, not " + std::to_string(level)), std::string::npos);
+    EXPECT_EQ(errorKindOf([&] { tessTriangleCount(level); }), ErrorKind::Input) << level;
+  }
+}
+
 }  // namespace
