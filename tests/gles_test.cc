@@ -69,6 +69,7 @@ TEST_F(Gles, DoublePrecisionIsAUsageError) {
   RunResult r = deform("--method classic --precision double --backend gles", "d.obj");
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_NE(r.err.find("OpenGL ES has no double precision"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("use --precision float (or auto) with --backend gles"), std::string::npos) << r.err;   // in the tool's words
   EXPECT_FALSE(fs::exists(dir / "d.obj"));
 }
 

@@ -123,7 +123,8 @@ uint64_t memoryLimitFromEnvironment();
 // Runs `f`, naming a memory limit the library reports as one of its options SFFD_MEMORY_LIMIT instead.
 template <class F>
 auto withToolLimitName(F&& f) -> decltype(f());
-// The message of `e` with the library's name of the limit replaced by SFFD_MEMORY_LIMIT.
+// The message of `e` in the tool's words: the library's name of the limit replaced by SFFD_MEMORY_LIMIT, its
+// names of options (DeformOptions fields) by the flags that set them.
 std::string toolLimitMessage(std::string what);
 
 // SFFD_MAX_CHUNK_* (elements per chunk, to test chunking): the value of the variable `name`, at

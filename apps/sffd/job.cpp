@@ -271,8 +271,13 @@ std::string toolLimitMessage(std::string what) {
   for (const char* name : {"(DeformOptions::memoryLimit)", "(LatticeReadOptions::memoryLimit)", "(the memoryLimit of refineLattice or elevateLattice)"})
     if (size_t at = what.find(name); at != std::string::npos) what.replace(at, std::strlen(name), "(SFFD_MEMORY_LIMIT)");
   // The library's words for the options, the tool's flags for them.
-  const std::string options = "a longer edge length or a lower tessellation level";
-  if (size_t at = what.find(options); at != std::string::npos) what.replace(at, options.size(), "a longer --edge-length or a lower --tess");
+  static const std::pair<const char*, const char*> flags[] = {
+      {"a longer edge length or a lower tessellation level", "a longer --edge-length or a lower --tess"},
+      {"Precision::Float (or Auto) as DeformOptions::precision on an OpenGL ES device", "--precision float (or auto) with --backend gles"},
+      {"float precision (DeformOptions::precision)", "--precision float"},
+  };
+  for (const auto& [library, tool] : flags)
+    if (size_t at = what.find(library); at != std::string::npos) what.replace(at, std::strlen(library), tool);
   return what;
 }
 

@@ -66,7 +66,8 @@ struct DeformOptions {
   // subTriangles() are then the run's; deviceOutput() is empty, patchControlPoints() throws). Accurate:
   // deform() only takes the lattice, and the result runs the kernels a chunk at a time in one device buffer
   // (timings() are then the run's; deviceOutput() is empty). Every method: a second deform(), or a second
-  // result() or streamResult(), throws an input Error.
+  // result() or streamResult(), throws an input Error; so does a result() or streamResult() after one that
+  // was cancelled or threw, since what the result is made from is freed as it is made.
   bool once = false;
 };
 
@@ -89,6 +90,9 @@ class Deformer {
  public:
   // Prepares `mesh` for lattices with the structure of `lattice` (degrees, counts, knots, frame) on
   // `device`, which must outlive the Deformer (it may be moved meanwhile: the Deformer follows it).
+  // A Mesh is checked as meshFromView checks a view (<sffd/mesh.h> says what each field must hold): a
+  // field of the wrong size, an index out of range or a non-finite position or normal is an input Error
+  // naming the field and its first bad element; empty normals or weldId are made as readMesh makes them.
   // Throws an input Error for bad options or a mesh that cannot be deformed, a device Error when the
   // device refuses the work. A moved-from Deformer throws an input Error from every call but destruction
   // and assignment.
@@ -99,9 +103,11 @@ class Deformer {
   ~Deformer();
 
   // Deforms with the lattice's current control points; an input Error if its structure differs
-  // from the one the Deformer was made for. The results below are those of the last call: before the
-  // first, or after one that was cancelled or threw, result(), streamResult() and patchControlPoints()
-  // throw an input Error and deviceOutput() is empty (the device's outputs would be part old, part new).
+  // from the one the Deformer was made for or a control point is not finite. The results below are those
+  // of the last call: before the first, or after one that was cancelled or threw for any reason (a refused
+  // lattice included), result(), streamResult() and patchControlPoints() throw an input Error and
+  // deviceOutput() is empty until a deform() succeeds. The one exception: a one-shot Deformer's second
+  // deform() is refused before it touches anything, and the first one's result is still there to take.
   const Timings& deform(const Lattice& lattice);
   // Times of the preparation (pn, clip) and of the last deform().
   const Timings& timings() const;
@@ -158,7 +164,8 @@ class Deformer {
   Impl& impl() const;   // an input Error on a moved-from Deformer
 };
 
-// Vertices and triangles of one patch tessellated at level L: (L+1)(L+2)/2 and L^2.
+// Vertices and triangles of one patch tessellated at level L: (L+1)(L+2)/2 and L^2. L is a level
+// DeformOptions::tess takes, 1..64; an input Error outside it.
 int tessVertexCount(int level);
 int tessTriangleCount(int level);
 

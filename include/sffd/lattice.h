@@ -46,11 +46,17 @@ struct Lattice {
   double domainHi(int a) const { return knots[size_t(a)][size_t(counts[size_t(a)])]; }
 };
 
-// Clamped uniform knot vector over [lo, hi]: (degree+1) copies of each end, uniform interior knots.
+// Every function here that takes a Lattice but sameLatticeStructure throws an input Error for one
+// validateLattice refuses (a default-constructed Lattice has no knots), naming the function, its `source`
+// or the file; setIdentityControlPoints needs all but the control points, which it sets.
+
+// Clamped uniform knot vector over [lo, hi]: (degree+1) copies of each end, uniform interior knots. An input
+// Error for a degree outside 1..5 or a count outside degree+1..kMaxLatticeAxisCount.
 std::vector<double> clampedUniformKnots(int count, int degree, double lo, double hi);
 
 // Checks degrees (1..5), counts > degree, the counts' limits (kMaxLatticeAxisCount, kMaxLatticeControlPoints),
-// knot vector sizes and monotonicity, a non-empty domain, finite control points and an invertible frame.
+// knot vector sizes and monotonicity, a non-empty domain, finite control points and an invertible frame
+// with a finite offset.
 // Throws an input Error naming `source`.
 void validateLattice(const Lattice& lattice, const std::string& source);
 

@@ -33,10 +33,16 @@ struct Material {
   std::string baseColorImageMime;
 };
 
+// Every per-vertex field is one per vertex or, where it may be left out, empty; every per-triangle field
+// one per triangle or empty; indices in range. A Deformer and the writers refuse a Mesh that breaks this
+// (an input Error naming the field), and a Deformer a non-finite position, normal, texture coordinate or
+// colour too.
 struct Mesh {
-  std::vector<glm::dvec3> positions;             // per vertex
-  std::vector<glm::dvec3> normals;               // per vertex, unit length
-  std::vector<uint32_t> weldId;                  // per vertex: index of its distinct position, or location (below)
+  std::vector<glm::dvec3> positions;             // per vertex, finite
+  std::vector<glm::dvec3> normals;               // per vertex, unit length; empty: none (a Deformer computes them
+                                                 // as readMesh computes missing ones, the writers write none)
+  std::vector<uint32_t> weldId;                  // per vertex: index of its distinct position, or location (below),
+                                                 // below the vertex count; empty: a Deformer welds by position
   // false: weldId is by exact position (the readers, meshFromView), and the OBJ and OFF writers find
   // the distinct positions themselves. true: weldId names each vertex's location on the input surface
   // (the smooth and accurate output, weldPatchVertices), one position a location, and those writers
@@ -88,7 +94,7 @@ struct MeshView {
 };
 
 // Copies a view into a Mesh (welding, normals as readMesh makes them). Throws an input Error for an
-// index out of range, a non-finite coordinate or a view without positions.
+// index out of range, a non-finite coordinate, a view without positions or one without triangles.
 Mesh meshFromView(const MeshView& view);
 
 struct MeshReadOptions {
@@ -102,7 +108,7 @@ struct MeshReadOptions {
 Mesh readMesh(const std::string& path, const MeshReadOptions& options = {});
 
 struct MeshWriteOptions {
-  int significantDigits = 9;   // text coordinates: 9 for float results, 17 for double (1..17)
+  int significantDigits = 9;   // text coordinates: 9 for float results, 17 for double (1..17; else an input Error)
   // .ply and .stl: binary little-endian instead of text (PLY: float, or double with more than 9
   // digits; STL: float, the format's only type). Other formats refuse it.
   bool binary = false;
@@ -112,7 +118,8 @@ struct MeshWriteOptions {
 // coordinates with `significantDigits` digits, to a temporary file renamed into place on success.
 // OBJ keeps texture coordinates (`vt`), groups, materials (`usemtl`) and `mtllib`; PLY texture
 // coordinates (u, v) and colours (uchar red green blue alpha); glTF all of them, materials as PBR base
-// colour factor and texture URI.
+// colour factor and texture URI. Throws an input Error for a format it cannot write, bad options, a Mesh
+// whose fields' sizes or indices are not as Mesh says (naming the field) or a non-finite vertex.
 void writeMesh(const std::string& path, const Mesh& mesh, int significantDigits = 9);
 void writeMesh(const std::string& path, const Mesh& mesh, const MeshWriteOptions& options);
 
@@ -137,7 +144,9 @@ class MeshSink {
 // joined after its header at end(). Other formats, and .ply with colours (whose header depends on the last
 // vertex's alpha), are gathered and written at end(). The file appears at end(), whole; a writer destroyed
 // before (an exception) leaves nothing. Throws as writeMesh does: an input Error for a format it cannot write
-// or a non-finite vertex (from the add() that gives it), which stops the stream. A streamed file is formatted
+// or a non-finite vertex (from the add() that gives it), which stops the stream; and an input Error for
+// calls out of order (add() outside begin() and end(), either of those twice, a piece's firstVertex not the
+// count so far) or a piece whose fields differ from the first's or whose indices are out of range. A streamed file is formatted
 // and written on a thread of the writer's own while the caller makes the next pieces, so a failed write (a
 // full disk) is thrown by a later add() or by end().
 class MeshFileWriter final : public MeshSink {

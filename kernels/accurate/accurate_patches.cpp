@@ -134,7 +134,7 @@ AccurateJob makeAccurateJob(const Mesh& mesh, const Lattice& lattice, std::vecto
     throw Error(ErrorKind::Input, "accurate FFD: patch degree " + std::to_string(job.degree) + " exceeds " +
                                       std::to_string(SFFD_ACC_MAX_DEGREE));
   if (level < 1 || level > kMaxTessLevel)
-    throw Error(ErrorKind::Input, "--tess must be an integer 1.." + std::to_string(kMaxTessLevel));
+    throw Error(ErrorKind::Input, "the tessellation level must be 1.." + std::to_string(kMaxTessLevel) + ", not " + std::to_string(level));
   job.level = level;
   job.subs = std::move(subs);
   constexpr int stride = 4 * SFFD_ACC_CORNER_STRIDE;
@@ -293,7 +293,7 @@ void dispatchAccurateChunk(Backend& backend, const gpu::AccurateParams& base, Ke
 AccurateOutput accurateFfd(Backend& backend, const AccurateJob& job, const PackedLattice& lattice, KernelVariant variant,
                            size_t maxChunk) {
   if (variant.f64 && !backend.info().limits.float64)
-    throw deviceError(backend.info().name + " has no double-precision shader support; use --precision float");
+    throw noFloat64Error(backend.info());
   AccurateOutput out;
   auto t0 = std::chrono::steady_clock::now();
   if (job.count() > 0) {

@@ -4,6 +4,7 @@
 #include <span>
 
 #include "kernels/accurate/accurate_patches.h"
+#include "core/job_budget.h"
 #include "kernels/common/cpu_kernel.h"
 
 namespace sffd {
@@ -34,7 +35,8 @@ template <class Real>
 void accurateThreads(const CpuKernelArgs& a, uint64_t first, uint64_t last) {
   const auto& p = a.paramsAs<gpu::AccurateParams>();
   const uint32_t n = p.shape.x, m = p.shape.y, L = p.shape.z, nv = p.shape.w, stage = p.range.z;
-  a.check(m <= SFFD_ACC_MAX_CP && m == uint32_t(triangleControlPoints(int(n))) && nv == uint32_t(tessVertexCount(int(L))),
+  a.check(m <= SFFD_ACC_MAX_CP && m == uint32_t(triangleControlPoints(int(n))) && L >= 1 && L <= uint32_t(kMaxTessLevel) &&
+              nv == uint32_t(tessVertexCount(int(L))),
           "accurate: patch shape out of range");
   const uint64_t subs = uint64_t(p.range.x) + p.range.y, per = SFFD_ACC_THREADS_PER_SUB(stage, m, nv);
   // The sections of the chunk and scratch ranges and the tables in the frame range (layout.h).

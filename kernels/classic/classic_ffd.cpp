@@ -98,7 +98,7 @@ void dispatchClassicFfd(Backend& backend, const gpu::LatticeParams& lattice, Ker
 ClassicOutput classicFfd(Backend& backend, const Mesh& mesh, const PackedLattice& lattice, KernelVariant variant,
                          size_t maxChunk) {
   if (variant.f64 && !backend.info().limits.float64)
-    throw deviceError(backend.info().name + " has no double-precision shader support; use --precision float");
+    throw noFloat64Error(backend.info());
   ClassicOutput out;
   auto t0 = std::chrono::steady_clock::now();
   if (variant.f64) classicRun<double>(backend, mesh, lattice, variant, maxChunk, out);

@@ -366,7 +366,7 @@ SubTriangleRecords clipRun(Backend& backend, const PreparedMesh& M, const PnOutp
 SubTriangleRecords regularClip(Backend& backend, const PreparedMesh& mesh, const PnOutput& pn,
                                const ClipTriangles& clip, double l, KernelVariant variant, size_t maxChunk) {
   if (variant.f64 && !backend.info().limits.float64)
-    throw deviceError(backend.info().name + " has no double-precision shader support; use --precision float");
+    throw noFloat64Error(backend.info());
   auto t0 = std::chrono::steady_clock::now();
   SubTriangleRecords R = variant.f64 ? clipRun<double>(backend, mesh, pn, clip, l, variant, maxChunk)
                                      : clipRun<float>(backend, mesh, pn, clip, l, variant, maxChunk);

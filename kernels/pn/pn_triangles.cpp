@@ -116,7 +116,7 @@ std::vector<double> meshVertexRange(const PreparedMesh& mesh) {
 
 PnOutput pnTriangles(Backend& backend, const PreparedMesh& mesh, KernelVariant variant, size_t maxChunk) {
   if (variant.f64 && !backend.info().limits.float64)
-    throw deviceError(backend.info().name + " has no double-precision shader support; use --precision float");
+    throw noFloat64Error(backend.info());
   PnOutput out;
   auto t0 = std::chrono::steady_clock::now();
   if (mesh.triangleCount() > 0) {

@@ -86,7 +86,7 @@ void deformRun(Backend& backend, const PackedLattice& P, const SubTriangleRecord
 SmoothOutput smoothDeform(Backend& backend, const PackedLattice& lattice, const SubTriangleRecords& subs,
                           const FitTable& fit, int level, KernelVariant variant, bool split, size_t maxChunk) {
   if (variant.f64 && !backend.info().limits.float64)
-    throw deviceError(backend.info().name + " has no double-precision shader support; use --precision float");
+    throw noFloat64Error(backend.info());
   SmoothOutput out;
   out.level = level;
   auto t0 = std::chrono::steady_clock::now();

@@ -474,3 +474,127 @@ TEST(Deformer, DeformRefusesANonFiniteControlPoint) {
 }
 
 }  // namespace
+
+namespace {
+
+// The message of the input Error `f` throws ("" and a failure when it throws none).
+template <class F>
+std::string inputMessageOf(F&& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Input) << e.what();
+    return e.what();
+  }
+  ADD_FAILURE() << "nothing was thrown";
+  return "";
+}
+
+// An audit (2026-12): a Mesh handed to the Deformer was not checked as a MeshView is (meshFromView): an
+// index out of range or a field shorter than the positions was read out of bounds (a crash, a corrupt
+// heap), a NaN normal deformed into NaN, a NaN position gave misleading errors or dropped triangles, and
+// an empty weldId crashed. Each is now an input error naming the field and its first bad element; an
+// empty weldId or normals is made as readMesh makes it.
+TEST(Deformer, AMeshIsCheckedAsAViewIsAndItsOptionalFieldsAreMade) {
+  const Mesh mesh = icosphere(1);
+  const Lattice lattice = twisted(mesh, 0.3);
+  Device device = openDevice("cpu");
+  const std::pair<const char*, void (*)(Mesh&)> bad[] = {
+      {"triangles[3]: vertex index 999999 out of range", [](Mesh& m) { m.triangles[3][1] = 999999; }},
+      {"positions[5] is non-finite", [](Mesh& m) { m.positions[5].x = std::nan(""); }},
+      {"positions[6] is non-finite", [](Mesh& m) { m.positions[6].y = HUGE_VAL; }},
+      {"normals[7] is non-finite", [](Mesh& m) { m.normals[7].z = std::nan(""); }},
+      {"normals has 3 entries for 42 vertices", [](Mesh& m) { m.normals.resize(3); }},
+      {"weldId has 41 entries", [](Mesh& m) { m.weldId.pop_back(); }},
+      {"weldId[2] is 42, not below 42 vertices", [](Mesh& m) { m.weldId[2] = 42; }},
+      {"texcoords has 2 entries", [](Mesh& m) { m.texcoords.resize(2); }},
+      {"colors has 50 entries", [](Mesh& m) { m.colors.resize(50); }},
+      {"triangleMaterial[0] is 0, not below 0 materials", [](Mesh& m) { m.triangleMaterial.assign(m.triangles.size(), 0); }},
+      {"triangleGroup has 1 entries for 80 triangles", [](Mesh& m) { m.triangleGroup = {Mesh::kNoIndex}; }},
+  };
+  for (Method method : kMethods)
+    for (const auto& [what, spoil] : bad) {
+      SCOPED_TRACE(std::string(nameOf(method)) + ": " + what);
+      Mesh m = mesh;
+      spoil(m);
+      const std::string message = inputMessageOf([&] { Deformer(device, m, lattice, strictOptions(method)); });
+      EXPECT_EQ(message.rfind(std::string("mesh: ") + what, 0), 0u) << message;
+    }
+  for (Method method : kMethods) {
+    SCOPED_TRACE(nameOf(method));
+    Deformer whole(device, mesh, lattice, strictOptions(method));
+    whole.deform(lattice);
+    Mesh bare = mesh;
+    bare.weldId.clear();
+    Deformer unwelded(device, bare, lattice, strictOptions(method));
+    unwelded.deform(lattice);
+    expectSameBits(unwelded.result(), whole.result(), "without weldId");
+    bare.normals.clear();   // the icosphere's normals were computed too (meshFromView)
+    Deformer withoutNormals(device, bare, lattice, strictOptions(method));
+    withoutNormals.deform(lattice);
+    expectSameBits(withoutNormals.result(), whole.result(), "without normals");
+  }
+}
+
+// deformer.h promised result() throws after a deform() that threw; after one refused for its lattice (a
+// NaN control point, another structure) result() gave the previous lattice's result.
+TEST(Deformer, ADeformRefusedForItsLatticeLeavesNoResult) {
+  const Mesh mesh = icosphere(1);
+  const Lattice lattice = twisted(mesh, 0.3);
+  Device device = openDevice("cpu");
+  Lattice nan = lattice, other = fitLattice(mesh, {5, 5, 5}, {2, 2, 2});
+  nan.controlPoints[3].x = std::nan("");
+  struct Count : MeshSink {
+    void add(const Mesh&, size_t) override {}
+  } sink;
+  for (Method method : kMethods)
+    for (const Lattice* refused : {&nan, &other}) {
+      SCOPED_TRACE(nameOf(method));
+      Deformer deformer(device, mesh, lattice, strictOptions(method));
+      deformer.deform(lattice);
+      const Mesh first = deformer.result();
+      EXPECT_EQ(errorKindOf([&] { deformer.deform(*refused); }), ErrorKind::Input);
+      EXPECT_NE(inputMessageOf([&] { deformer.result(); }).find("the last deform() was cancelled or failed"), std::string::npos);
+      EXPECT_EQ(errorKindOf([&] { deformer.streamResult(sink); }), ErrorKind::Input);
+      EXPECT_TRUE(deformer.deviceOutput().empty());
+      if (method == Method::Smooth) { EXPECT_EQ(errorKindOf([&] { deformer.patchControlPoints(); }), ErrorKind::Input); }
+      deformer.deform(lattice);
+      expectSameBits(deformer.result(), first, "deformed again after the refused call");
+    }
+}
+
+// A one-shot result cancelled while it was made was refused on a retry as "already taken".
+TEST(Deformer, ARetriedOneShotResultSaysItWasCancelled) {
+  const Mesh mesh = icosphere(1);
+  const Lattice lattice = twisted(mesh, 0.3);
+  Device device = openDevice("cpu");
+  for (Method method : kMethods) {
+    SCOPED_TRACE(nameOf(method));
+    bool cancel = false;
+    DeformOptions o = strictOptions(method);
+    o.once = true;
+    o.progress = [&](const Progress& p) { return !(cancel && p.fraction > 0); };
+    Deformer deformer(device, mesh, lattice, o);
+    deformer.deform(lattice);
+    cancel = true;
+    EXPECT_EQ(errorKindOf([&] { deformer.result(); }), ErrorKind::Cancelled);
+    cancel = false;
+    const std::string message = inputMessageOf([&] { deformer.result(); });
+    EXPECT_NE(message.find("was cancelled while it was being made"), std::string::npos) << message;
+    EXPECT_EQ(message.find("already taken"), std::string::npos) << message;
+  }
+}
+
+// tessVertexCount(100000) gave 705182705, 1000000 a negative count, -1 gave 0.
+TEST(Deformer, TessellationCountsTakeTheLevelsDeformOptionsTakes) {
+  EXPECT_EQ(tessVertexCount(1), 3);
+  EXPECT_EQ(tessTriangleCount(1), 1);
+  EXPECT_EQ(tessVertexCount(64), 65 * 66 / 2);
+  EXPECT_EQ(tessTriangleCount(64), 4096);
+  for (int level : {-1, 0, 65, 100000, 1000000}) {
+    EXPECT_NE(inputMessageOf([&] { tessVertexCount(level); }).find("1..64, not " + std::to_string(level)), std::string::npos);
+    EXPECT_EQ(errorKindOf([&] { tessTriangleCount(level); }), ErrorKind::Input) << level;
+  }
+}
+
+}  // namespace

@@ -201,10 +201,27 @@ TEST(VulkanInterop, BufferOfNamesTheDeformersBuffersAndRefusesOtherDevices) {
     EXPECT_NE(r.buffer, VK_NULL_HANDLE);
     EXPECT_EQ(r.size, c.bytes);
   }
-  EXPECT_THROW(opengl::bufferOf(d, d.deviceOutput()[0]), Error);
+  // Each refusal says which mistake it is (a forged chunk was "the Deformer runs on vulkan, not on a Vulkan
+  // device").
+  auto messageOf = [](auto&& f) {
+    try {
+      f();
+    } catch (const Error& e) {
+      EXPECT_EQ(e.kind(), ErrorKind::Input) << e.what();
+      return std::string(e.what());
+    }
+    ADD_FAILURE() << "nothing was thrown";
+    return std::string();
+  };
+  EXPECT_NE(messageOf([&] { opengl::bufferOf(d, d.deviceOutput()[0]); }).find("not on a GL device"), std::string::npos);
+  OutputChunk forged = d.deviceOutput()[0];
+  forged.buffer += 1000;
+  const std::string message = messageOf([&] { vulkan::bufferOf(d, forged); });
+  EXPECT_NE(message.find("is not one of the Deformer's deviceOutput()"), std::string::npos) << message;
+  EXPECT_EQ(message.find("not on a Vulkan device"), std::string::npos) << message;
   Device cpu = Device::open(cpuRequest);
   Deformer onCpu(cpu, j.mesh, j.lattice, classic);
-  EXPECT_THROW(vulkan::bufferOf(onCpu, OutputChunk{}), Error);
+  EXPECT_NE(messageOf([&] { vulkan::bufferOf(onCpu, OutputChunk{}); }).find("not on a Vulkan device"), std::string::npos);
 }
 
 // ---- GL: the application's GLFW window, with bindings of its own ----

@@ -2,6 +2,8 @@
 #include <sffd/opengl.h>
 
 #include <sffd/error.h>
+
+#include "api/output_chunk_check.h"
 #include "backends/opengl/gl_backend.h"
 #include "backends/opengl/gl_context.h"
 
@@ -17,10 +19,9 @@ Device adoptCurrentContext(GetProcAddress getProc) {
 unsigned bufferOf(const Deformer& deformer, const OutputChunk& chunk) {
   Device& device = deformer.device();
   const std::string& api = device.info().api;
-  unsigned name = api == "gl" || api == "gles" ? gl::glBufferObject(device.backend(), chunk.buffer) : 0;
-  if (!name)
-    throw Error(ErrorKind::Input, "sffd::opengl::bufferOf: the Deformer runs on " + device.label() +
-                                      ", not on a GL device, or the chunk is not its output");
+  checkOutputChunk(deformer, chunk, "sffd::opengl::bufferOf", api == "gl" || api == "gles", "GL");
+  unsigned name = gl::glBufferObject(device.backend(), chunk.buffer);
+  if (!name) throw Error(ErrorKind::Internal, "sffd::opengl::bufferOf: no GL buffer for an output chunk of the Deformer");
   return name;
 }
 

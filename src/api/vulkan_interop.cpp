@@ -3,16 +3,17 @@
 
 #include <sffd/error.h>
 
+#include "api/output_chunk_check.h"
+
 namespace sffd::vulkan {
 
 Device adoptDevice(const DeviceConfig& config) { return Device("vulkan-adopted", vk::adoptBackend(config)); }
 
 BufferRange bufferOf(const Deformer& deformer, const OutputChunk& chunk) {
   Device& device = deformer.device();
-  VkBuffer buffer = device.info().api == "vulkan" ? vk::vkBufferOf(device.backend(), chunk.buffer) : VK_NULL_HANDLE;
-  if (!buffer)
-    throw Error(ErrorKind::Input, "sffd::vulkan::bufferOf: the Deformer runs on " + device.label() +
-                                      ", not on a Vulkan device, or the chunk is not its output");
+  checkOutputChunk(deformer, chunk, "sffd::vulkan::bufferOf", device.info().api == "vulkan", "Vulkan");
+  VkBuffer buffer = vk::vkBufferOf(device.backend(), chunk.buffer);
+  if (!buffer) throw Error(ErrorKind::Internal, "sffd::vulkan::bufferOf: no VkBuffer for an output chunk of the Deformer");
   return {buffer, chunk.offset, chunk.bytes};
 }
 

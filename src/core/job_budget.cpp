@@ -243,7 +243,7 @@ void checkJobFits(const JobEstimate& e, const PackedLattice& P, size_t realBytes
     if (coeffBytes > limits->maxStorageBufferRange)
       throw Error(ErrorKind::Input, "the lattice's Bezier coefficients take " + formatBytes(coeffBytes) +
                                         ", more than one storage binding of this device can hold (" +
-                                        formatBytes(limits->maxStorageBufferRange) + "); use fewer control points or --precision float");
+                                        formatBytes(limits->maxStorageBufferRange) + "); use fewer control points or float precision (DeformOptions::precision)");
   }
 }
 

@@ -89,7 +89,7 @@ KernelVariant forDevice(KernelVariant v, const DeviceInfo& device) {
 
 Error noFloat64Error(const DeviceInfo& info) {
   if (info.api == "gles")
-    return Error(ErrorKind::Input, "OpenGL ES has no double precision: use --precision float (or auto) with --backend gles");
+    return Error(ErrorKind::Input, "OpenGL ES has no double precision: use Precision::Float (or Auto) as DeformOptions::precision on an OpenGL ES device");
   return deviceError(info.name + " has no double-precision shader support");
 }
 

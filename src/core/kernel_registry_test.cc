@@ -126,3 +126,15 @@ TEST(KernelRegistry, LoopFormsCompiledAhead) {
     }
   }
 }
+
+// The library's error for double precision on OpenGL ES named the command-line flags ("use --precision float
+// (or auto) with --backend gles"), which a library or Python caller has not got; the tool translates it.
+TEST(KernelRegistry, NoFloat64ErrorSpeaksOfDeformOptions) {
+  const Error gles = noFloat64Error(device("llvmpipe", "OpenGL ES 3.2 Mesa 25.0.7", "gles"));
+  EXPECT_EQ(gles.kind(), ErrorKind::Input);
+  EXPECT_NE(std::string(gles.what()).find("DeformOptions::precision"), std::string::npos) << gles.what();
+  EXPECT_EQ(std::string(gles.what()).find("--"), std::string::npos) << gles.what();
+  const Error vulkan = noFloat64Error(device("some GPU", "1.0"));
+  EXPECT_EQ(vulkan.kind(), ErrorKind::Device);
+  EXPECT_EQ(std::string(vulkan.what()).find("--"), std::string::npos) << vulkan.what();
+}

@@ -487,6 +487,7 @@ void applyLatticePreset(Lattice& lattice, const std::string& name, double amount
   if (std::find_if(std::begin(names), std::end(names), [&](const char* n) { return name == n; }) == std::end(names))
     throw inputError("", 0, "unknown lattice preset " + io::quoted(name) + "; expected twist, bend, taper, bulge or noise");
   if (!std::isfinite(amount)) throw inputError("", 0, "preset amount must be a finite number");
+  validateLattice(lattice, "applyLatticePreset");   // a default-constructed Lattice has no knots to read
   glm::dmat3 inv = glm::inverse(lattice.frameLinear);
   glm::dvec3 pc, ph;   // parameter-space centre and half extents
   for (int a = 0; a < 3; ++a) {
@@ -501,7 +502,8 @@ void applyLatticePreset(Lattice& lattice, const std::string& name, double amount
     e[a] = ph[a];
     glm::dvec3 E = inv * e;
     h[a] = std::hypot(E.x, E.y, E.z);   // glm::length's square leaves double's range for a box 1e-160 or 1e160 across
-    if (!(h[a] > 0) || !std::isfinite(h[a])) throw Error(ErrorKind::Internal, "lattice preset: degenerate box");
+    if (!(h[a] > 0) || !std::isfinite(h[a]))
+      throw inputError("applyLatticePreset", 0, "the lattice's box has an edge of no length or beyond double's range in world units");
     d[a] = E / h[a];
   }
   // Longer by more than rounding: the box fitted to a cube differs from axis to axis by the rounding of its

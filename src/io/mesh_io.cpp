@@ -123,20 +123,9 @@ namespace meshio {
 
 void finishMesh(Mesh& mesh, const std::vector<uint8_t>& fromFile, const std::string& path, const std::vector<uint32_t>& normalShared) {
   const size_t n = mesh.positions.size();
-  if (n > kMaxVertices) throw inputError(path, 0, "too many vertices");
-  if (mesh.triangles.empty()) throw inputError(path, 0, "no triangles");
-  for (const auto& t : mesh.triangles)
-    for (uint32_t i : t)
-      if (i >= n) throw inputError(path, 0, "vertex index " + std::to_string(i) + " out of range");
-  for (const auto& p : mesh.positions)
-    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) throw inputError(path, 0, "non-finite vertex coordinate");
-  for (const auto& t : mesh.texcoords)
-    if (!std::isfinite(t.x) || !std::isfinite(t.y)) throw inputError(path, 0, "non-finite texture coordinate");
-  for (const auto& k : mesh.colors)
-    if (!std::isfinite(k.r) || !std::isfinite(k.g) || !std::isfinite(k.b) || !std::isfinite(k.a)) throw inputError(path, 0, "non-finite colour");
-  if ((!mesh.texcoords.empty() && mesh.texcoords.size() != n) || (!mesh.colors.empty() && mesh.colors.size() != n))
-    throw Error(ErrorKind::Internal, path + ": texture coordinates or colours not one per vertex");
+  if (mesh.triangles.empty()) throw inputError(path, 0, "no triangles");   // a file's (a Deformer takes an empty Mesh)
   mesh.normals.resize(n, glm::dvec3(0.0));
+  validateMesh(mesh, path, /*normals=*/false);   // unset or non-finite file normals are recomputed below
   bool anyFromFile = false, anyComputed = false;
   std::vector<uint8_t> compute(n, 1);
   for (size_t v = 0; v < n; ++v) {

@@ -15,6 +15,7 @@
 #include "io/gltf_io.h"
 #include "io/io_util.h"
 #include "io/mesh_io_internal.h"
+#include "model/mesh.h"
 #include "io/mesh_write_records.h"
 
 namespace sffd {
@@ -240,27 +241,12 @@ using namespace meshio;
 
 meshio::Carried checkWritable(const std::string& path, const Mesh& mesh, bool floats) {
   const size_t n = mesh.positions.size();
-  auto sized = [&](size_t count, const char* what) {
-    if (count != 0 && count != n)
-      throw Error(ErrorKind::Internal, path + ": mesh has " + std::to_string(count) + " " + what + " for " + std::to_string(n) + " vertices");
-    return count != 0;
-  };
+  checkMeshStructure(mesh, path);   // a caller's mistake: an input error naming the field
   meshio::Carried c;
-  c.normals = sized(mesh.normals.size(), "normals");
-  c.texcoords = sized(mesh.texcoords.size(), "texture coordinates");
-  c.colors = sized(mesh.colors.size(), "colours");
+  c.normals = !mesh.normals.empty();
+  c.texcoords = !mesh.texcoords.empty();
+  c.colors = !mesh.colors.empty();
   for (const glm::dvec4& k : mesh.colors) c.alpha = c.alpha || k.a != 1.0;
-  for (const auto& t : mesh.triangles)
-    for (uint32_t i : t)
-      if (i >= n) throw Error(ErrorKind::Internal, path + ": mesh triangle index out of range");
-  auto perTriangle = [&](const std::vector<uint32_t>& index, size_t tableSize, const char* what) {
-    if (index.empty()) return;
-    if (index.size() != mesh.triangles.size()) throw Error(ErrorKind::Internal, path + ": mesh " + what + " not one per triangle");
-    for (uint32_t i : index)
-      if (i != Mesh::kNoIndex && i >= tableSize) throw Error(ErrorKind::Internal, path + ": mesh " + what + " index out of range");
-  };
-  perTriangle(mesh.triangleMaterial, mesh.materials.size(), "materials");
-  perTriangle(mesh.triangleGroup, mesh.groups.size(), "groups");
   // A lattice that sends points beyond the floating-point range gives inf or NaN: refuse to write a
   // file of them, and say where (the lattice is the input at fault, so this is an input error).
   for (size_t v = 0; v < n; ++v) checkFiniteVertex(path, v, mesh.positions[v], c.normals ? &mesh.normals[v] : nullptr, floats);
@@ -454,7 +440,7 @@ std::string meshio::checkWriteTarget(const std::string& path, const MeshWriteOpt
   if (options.binary && ext != ".ply" && ext != ".stl")
     throw inputError(path, 0, "binary output is for .ply and .stl (.glb is binary glTF), not " + io::quoted(ext));
   if (options.significantDigits < 1 || options.significantDigits > 17)
-    throw Error(ErrorKind::Internal, "writeMesh: significant digits must be 1..17");
+    throw inputError(path, 0, "MeshWriteOptions::significantDigits must be 1..17, not " + std::to_string(options.significantDigits));
   return ext;
 }
 

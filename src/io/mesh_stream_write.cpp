@@ -78,29 +78,38 @@ struct MeshFileWriter::Impl {
     writer = std::make_unique<PieceQueue>([this](const Mesh& piece) { write(piece); });
   }
 
+  // The caller's mistakes (a piece out of order, unlike the first or with a bad index) are input errors.
   void check(const Mesh& piece, size_t first) {
-    if (!begun || ended) throw Error(ErrorKind::Internal, "MeshFileWriter: add() outside begin() and end()");
-    if (first != vertices) throw Error(ErrorKind::Internal, path + ": mesh pieces out of order");
+    if (first != vertices)
+      throw inputError(path, 0, "mesh piece out of order: add() given firstVertex " + std::to_string(first) + " after " +
+                                    std::to_string(vertices) + " vertices");
     const size_t n = piece.positions.size();
     auto sized = [&](size_t count, bool want, const char* what) {
       if (count != (want && n ? n : 0))
-        throw Error(ErrorKind::Internal, path + ": mesh piece has " + std::to_string(count) + " " + what + " for " +
-                                             std::to_string(n) + " vertices");
+        throw inputError(path, 0, "mesh piece has " + std::to_string(count) + " " + what + " for " + std::to_string(n) +
+                                      " vertices (the first piece with vertices had " + (want ? "one each" : "none") + ")");
     };
     sized(piece.normals.size(), has.normals, "normals");
-    sized(piece.texcoords.size(), has.texcoords, "texture coordinates");
-    sized(piece.colors.size(), has.colors, "colours");
-    for (const auto& t : piece.triangles)
-      for (uint32_t i : t)
-        if (i >= vertices + n) throw Error(ErrorKind::Internal, path + ": mesh triangle index out of range");
-    auto perTriangle = [&](const std::vector<uint32_t>& index, size_t tableSize, const char* what) {
+    sized(piece.texcoords.size(), has.texcoords, "texcoords");
+    sized(piece.colors.size(), has.colors, "colors");
+    for (size_t t = 0; t < piece.triangles.size(); ++t)
+      for (uint32_t i : piece.triangles[t])
+        if (i >= vertices + n)
+          throw inputError(path, 0, "mesh piece's triangles[" + std::to_string(t) + "]: vertex index " + std::to_string(i) +
+                                        " out of range (" + std::to_string(vertices + n) + " vertices so far)");
+    auto perTriangle = [&](const std::vector<uint32_t>& index, size_t tableSize, const char* what, const char* table) {
       if (index.empty()) return;
-      if (index.size() != piece.triangles.size()) throw Error(ErrorKind::Internal, path + ": mesh " + what + " not one per triangle");
-      for (uint32_t i : index)
-        if (i != Mesh::kNoIndex && i >= tableSize) throw Error(ErrorKind::Internal, path + ": mesh " + what + " index out of range");
+      if (index.size() != piece.triangles.size())
+        throw inputError(path, 0, "mesh piece's " + std::string(what) + " has " + std::to_string(index.size()) + " entries for " +
+                                      std::to_string(piece.triangles.size()) + " triangles");
+      for (size_t t = 0; t < index.size(); ++t)
+        if (index[t] != Mesh::kNoIndex && index[t] >= tableSize)
+          throw inputError(path, 0, "mesh piece's " + std::string(what) + "[" + std::to_string(t) + "] is " +
+                                        std::to_string(index[t]) + ", not below " + std::to_string(tableSize) + " " + table +
+                                        " (begin()'s tables) nor Mesh::kNoIndex");
     };
-    perTriangle(piece.triangleMaterial, held.materials.size(), "materials");
-    perTriangle(piece.triangleGroup, held.groups.size(), "groups");
+    perTriangle(piece.triangleMaterial, held.materials.size(), "triangleMaterial", "materials");
+    perTriangle(piece.triangleGroup, held.groups.size(), "triangleGroup", "groups");
     for (size_t v = 0; v < n; ++v)
       meshio::checkFiniteVertex(path, vertices + v, piece.positions[v], has.normals ? &piece.normals[v] : nullptr,
                                 mode == Mode::Stl && options.binary);
@@ -177,7 +186,7 @@ MeshFileWriter::~MeshFileWriter() = default;
 
 void MeshFileWriter::begin(const Mesh& tables) {
   Impl& I = *impl_;
-  if (I.begun) throw Error(ErrorKind::Internal, "MeshFileWriter: begin() called twice");
+  if (I.begun) throw Error(ErrorKind::Input, "MeshFileWriter: begin() called twice");
   I.begun = true;
   I.held.materials = tables.materials;
   I.held.groups = tables.groups;
@@ -188,6 +197,8 @@ void MeshFileWriter::begin(const Mesh& tables) {
 
 void MeshFileWriter::add(const Mesh& piece, size_t firstVertex) {
   Impl& I = *impl_;
+  // Out of order, nothing is chosen (no file made) before check() says so.
+  if (!I.begun || I.ended) throw Error(ErrorKind::Input, "MeshFileWriter: add() outside begin() and end()");
   if (!I.modeKnown && !piece.positions.empty()) I.choose(piece);
   I.check(piece, firstVertex);
   I.add(piece);
@@ -195,7 +206,7 @@ void MeshFileWriter::add(const Mesh& piece, size_t firstVertex) {
 
 void MeshFileWriter::end() {
   Impl& I = *impl_;
-  if (!I.begun || I.ended) throw Error(ErrorKind::Internal, "MeshFileWriter: end() without begin(), or twice");
+  if (!I.begun || I.ended) throw Error(ErrorKind::Input, "MeshFileWriter: end() without begin(), or twice");
   I.ended = true;
   if (!I.modeKnown) I.choose(Mesh{});   // no vertices at all
   I.end();

@@ -296,4 +296,54 @@ TEST(MeshWrite, ThroughASymbolicLinkTheLinkStays) {
   }
 }
 
+// An audit (2026-12): writeMesh refused a Mesh with a bad index or a normals count unlike the vertex count,
+// and significant digits of 0 or 18, as an internal error (sffd's own bug), and so did MeshFileWriter used
+// out of order. They are the caller's mistakes: input errors, naming the field.
+TEST(MeshWrite, CallersMistakesAreInputErrors) {
+  const fs::path dir = tempDir("mesh_write_mistakes");
+  const Mesh cube = readMesh(kData + "/cube.obj");
+  const std::string out = (dir / "x.obj").string();
+  auto expectInput = [&](const std::string& what, const std::string& message, auto&& f) {
+    try {
+      f();
+      ADD_FAILURE() << what << ": nothing was thrown";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.kind(), ErrorKind::Input) << what << ": " << e.what();
+      EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << what << ": " << e.what();
+    }
+  };
+  Mesh badIndex = cube, fewNormals = cube, badGroup = cube;
+  badIndex.triangles[2][0] = uint32_t(cube.positions.size());
+  fewNormals.normals.pop_back();
+  badGroup.triangleGroup.assign(cube.triangles.size(), 3);
+  expectInput("index", "triangles[2]: vertex index", [&] { writeMesh(out, badIndex); });
+  expectInput("normals", "normals has", [&] { writeMesh(out, fewNormals); });
+  expectInput("groups", "triangleGroup[0] is 3", [&] { writeMesh(out, badGroup); });
+  for (int digits : {0, 18})
+    expectInput("digits " + std::to_string(digits), "significantDigits must be 1..17", [&] { writeMesh(out, cube, digits); });
+  EXPECT_FALSE(fs::exists(out));
+  for (const char* name : {"x.obj", "x.ply"}) {
+    SCOPED_TRACE(name);
+    const std::string path = (dir / name).string();
+    {
+      MeshFileWriter early(path);
+      expectInput("add() before begin()", "add() outside begin() and end()", [&] { early.add(cube, 0); });
+      expectInput("end() before begin()", "end() without begin()", [&] { early.end(); });
+    }
+    EXPECT_FALSE(fs::exists(path));
+    MeshFileWriter writer(path);
+    writer.begin(Mesh{});
+    expectInput("begin() twice", "begin() called twice", [&] { writer.begin(Mesh{}); });
+    expectInput("a piece out of order", "firstVertex 5", [&] { writer.add(cube, 5); });
+    writer.add(cube, 0);
+    Mesh next = cube;
+    next.normals.clear();
+    expectInput("a piece unlike the first", "0 normals", [&] { writer.add(next, cube.positions.size()); });
+    writer.end();
+    expectInput("end() twice", "end() without begin(), or twice", [&] { writer.end(); });
+    fs::remove(path);
+  }
+  fs::remove_all(dir);
+}
+
 }  // namespace

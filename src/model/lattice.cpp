@@ -11,6 +11,11 @@
 namespace sffd {
 
 std::vector<double> clampedUniformKnots(int count, int degree, double lo, double hi) {
+  // What validateLattice allows, so that a negative or huge count makes no vector of it.
+  if (degree < 1 || degree > 5 || count <= degree || count > kMaxLatticeAxisCount)
+    throw inputError("clampedUniformKnots", 0, "a knot vector is for degree 1..5 and " + std::to_string(degree) + " + 1.." +
+                                                   std::to_string(kMaxLatticeAxisCount) + " control points, not degree " +
+                                                   std::to_string(degree) + " with " + std::to_string(count));
   std::vector<double> k;
   int spans = count - degree;
   for (int i = 0; i <= degree; ++i) k.push_back(lo);
@@ -34,7 +39,10 @@ glm::dmat3 cofactor(const glm::dmat3& m) {
   return glm::dmat3(glm::cross(m[1], m[2]), glm::cross(m[2], m[0]), glm::cross(m[0], m[1]));
 }
 
-void setIdentityControlPoints(Lattice& L) {
+namespace {
+
+// The identity control points of a lattice whose structure is valid.
+void identityPoints(Lattice& L) {
   std::array<std::vector<double>, 3> xi;
   for (int a = 0; a < 3; ++a) xi[a] = grevilleAbscissae(L.knots[a], L.degree[a]);
   glm::dmat3 inv = glm::inverse(L.frameLinear);
@@ -45,23 +53,40 @@ void setIdentityControlPoints(Lattice& L) {
         L.controlPoints[L.index(i, j, k)] = inv * (glm::dvec3(xi[0][i], xi[1][j], xi[2][k]) - L.frameOffset);
 }
 
-Lattice makeIdentityLattice(glm::dvec3 lo, glm::dvec3 hi, std::array<int, 3> counts, std::array<int, 3> degree) {
+// makeIdentityLattice, its errors naming `source`.
+Lattice identityLattice(glm::dvec3 lo, glm::dvec3 hi, std::array<int, 3> counts, std::array<int, 3> degree,
+                        const std::string& source) {
   size_t points = 1;
   for (int a = 0; a < 3; ++a) {
     if (counts[a] < 1 || counts[a] > kMaxLatticeAxisCount)
-      throw Error(ErrorKind::Input, "a lattice has 1.." + std::to_string(kMaxLatticeAxisCount) + " control points an axis, not " +
-                                        std::to_string(counts[a]));
+      throw inputError(source, 0, "a lattice has 1.." + std::to_string(kMaxLatticeAxisCount) + " control points an axis, not " +
+                                      std::to_string(counts[a]));
     points *= size_t(counts[a]);
   }
   if (points > kMaxLatticeControlPoints)
-    throw Error(ErrorKind::Input, "a lattice of " + std::to_string(points) + " control points is too large (at most " +
-                                      std::to_string(kMaxLatticeControlPoints) + ")");
+    throw inputError(source, 0, "a lattice of " + std::to_string(points) + " control points is too large (at most " +
+                                    std::to_string(kMaxLatticeControlPoints) + ")");
   Lattice L;
   L.counts = counts;
   L.degree = degree;
-  for (int a = 0; a < 3; ++a) L.knots[a] = clampedUniformKnots(counts[a], degree[a], lo[a], hi[a]);
-  setIdentityControlPoints(L);
+  // Degrees and counts first: knots made for a degree outside 1..5 or too few points would be refused for
+  // their length, a message about something the caller did not give.
+  for (int a = 0; a < 3; ++a)
+    if (degree[a] >= 1 && degree[a] <= 5 && counts[a] > degree[a]) L.knots[a] = clampedUniformKnots(counts[a], degree[a], lo[a], hi[a]);
+  validateLatticeStructure(L, source);   // also a box of no size or of non-finite corners
+  identityPoints(L);
   return L;
+}
+
+}  // namespace
+
+void setIdentityControlPoints(Lattice& L) {
+  validateLatticeStructure(L, "setIdentityControlPoints");   // its knots and frame are all it reads
+  identityPoints(L);
+}
+
+Lattice makeIdentityLattice(glm::dvec3 lo, glm::dvec3 hi, std::array<int, 3> counts, std::array<int, 3> degree) {
+  return identityLattice(lo, hi, counts, degree, "makeIdentityLattice");
 }
 
 Lattice fitLattice(const Mesh& mesh, std::array<int, 3> counts, std::array<int, 3> degree, double margin) {
@@ -82,7 +107,7 @@ Lattice fitLattice(const Mesh& mesh, std::array<int, 3> counts, std::array<int, 
   const double extent = size > 0 ? size : 1e-12 * far;
   lo -= glm::dvec3(margin * extent);
   hi += glm::dvec3(margin * extent);
-  Lattice L = makeIdentityLattice(lo, hi, counts, degree);
+  Lattice L = identityLattice(lo, hi, counts, degree, "fitLattice");
   // Said here, not by the next user of the lattice: a box of a non-finite vertex or past the range of doubles
   // (a huge margin), or one without size (a flat mesh with no margin).
   validateLattice(L, "fitLattice");
@@ -90,6 +115,18 @@ Lattice fitLattice(const Mesh& mesh, std::array<int, 3> counts, std::array<int, 
 }
 
 void validateLattice(const Lattice& L, const std::string& source) {
+  validateLatticeStructure(L, source);
+  if (L.controlPoints.size() != L.pointCount())
+    throw inputError(source, 0, "lattice has " + std::to_string(L.controlPoints.size()) + " control points; " +
+                                    std::to_string(L.pointCount()) + " expected");
+  for (size_t i = 0; i < L.controlPoints.size(); ++i) {
+    const glm::dvec3& p = L.controlPoints[i];
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+      throw inputError(source, 0, "control point " + std::to_string(i) + " is not finite");
+  }
+}
+
+void validateLatticeStructure(const Lattice& L, const std::string& source) {
   static const char* axis = "uvw";
   for (int a = 0; a < 3; ++a) {
     std::string ax(1, axis[a]);
@@ -115,16 +152,10 @@ void validateLattice(const Lattice& L, const std::string& source) {
   if (L.pointCount() > kMaxLatticeControlPoints)
     throw inputError(source, 0, "lattice of " + std::to_string(L.pointCount()) + " control points is too large (at most " +
                                     std::to_string(kMaxLatticeControlPoints) + ")");
-  if (L.controlPoints.size() != L.pointCount())
-    throw inputError(source, 0, "lattice has " + std::to_string(L.controlPoints.size()) + " control points; " +
-                                    std::to_string(L.pointCount()) + " expected");
-  for (size_t i = 0; i < L.controlPoints.size(); ++i) {
-    const glm::dvec3& p = L.controlPoints[i];
-    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
-      throw inputError(source, 0, "control point " + std::to_string(i) + " is not finite");
-  }
   double det = glm::determinant(L.frameLinear);
   if (!std::isfinite(det) || std::abs(det) < 1e-300) throw inputError(source, 0, "lattice frame is singular");
+  if (!std::isfinite(L.frameOffset.x) || !std::isfinite(L.frameOffset.y) || !std::isfinite(L.frameOffset.z))
+    throw inputError(source, 0, "lattice frame offset is not finite");
 }
 
 void insertKnot(std::vector<double>& U, std::vector<std::vector<double>>& P, int p, double t) {

@@ -1,9 +1,15 @@
 // Lattice internals: the per-knot-box Bezier form the kernels evaluate, and helpers. The Lattice
 // type itself is public (<sffd/lattice.h>).
 #pragma once
+#include <string>
+
 #include <sffd/lattice.h>
 
 namespace sffd {
+
+// validateLattice without the control points (their count and values): what a lattice whose control
+// points are about to be set (setIdentityControlPoints) must hold.
+void validateLatticeStructure(const Lattice& lattice, const std::string& source);
 
 // Greville abscissae of one axis: xi_i = (u_{i+1} + ... + u_{i+n}) / n.
 std::vector<double> grevilleAbscissae(const std::vector<double>& knots, int degree);

@@ -184,8 +184,8 @@ TEST(Lattice, ValidationRefusesBadLattices) {
   bad = L;
   bad.controlPoints[5].x = NAN;
   EXPECT_THROW(validateLattice(bad, "x"), std::exception);
-  bad = makeIdentityLattice({0, 0, 0}, {0, 1, 1}, {4, 4, 4}, {2, 2, 2});
-  EXPECT_THROW(validateLattice(bad, "x"), std::exception);
+  // A box of no size is refused where it is made.
+  EXPECT_THROW(makeIdentityLattice({0, 0, 0}, {0, 1, 1}, {4, 4, 4}, {2, 2, 2}), Error);
 }
 
 // fitLattice says when it cannot make a box (it returned lattices of infinite or NaN knots, or of no size,
@@ -238,4 +238,41 @@ TEST(Lattice, FittedBoxIsValidOrRefused) {
       EXPECT_EQ(std::string(e.what()).rfind("fitLattice: ", 0), 0u) << e.what();
     }
   }
+}
+
+// An audit (2026-12): a default-constructed Lattice (no knots, no control points) crashed
+// applyLatticePreset and made setIdentityControlPoints throw std::length_error. Every public function that
+// takes a lattice now says what is wrong with it, as validateLattice does.
+TEST(Lattice, PublicFunctionsRefuseAnInvalidLatticeWithAnInputError) {
+  auto expectInput = [](const char* what, auto&& f) {
+    try {
+      f();
+      ADD_FAILURE() << what << ": nothing was thrown";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.kind(), ErrorKind::Input) << what << ": " << e.what();
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << what << ": not an sffd::Error: " << e.what();
+    }
+  };
+  Lattice none;   // counts 5x5x5, degree 2, nothing else
+  expectInput("applyLatticePreset", [&] { applyLatticePreset(none, "twist", 0.5); });
+  expectInput("setIdentityControlPoints", [&] { setIdentityControlPoints(none); });
+  none.counts = {3, 3, 3};
+  expectInput("setIdentityControlPoints 3x3x3", [&] { setIdentityControlPoints(none); });
+  expectInput("refineLattice", [&] { refineLattice(none, {2, 2, 2}); });
+  expectInput("elevateLattice", [&] { elevateLattice(none, {1, 1, 1}); });
+  expectInput("writeLattice", [&] { writeLattice("never-written.json", none); });
+  expectInput("makeIdentityLattice degree 0", [] { makeIdentityLattice(glm::dvec3(0), glm::dvec3(1), {3, 3, 3}, {0, 2, 2}); });
+  expectInput("makeIdentityLattice degree 3 of 2 points", [] { makeIdentityLattice(glm::dvec3(0), glm::dvec3(1), {2, 3, 3}, {3, 2, 2}); });
+  expectInput("makeIdentityLattice of no size", [] { makeIdentityLattice(glm::dvec3(0), glm::dvec3(0), {3, 3, 3}, {2, 2, 2}); });
+  expectInput("clampedUniformKnots", [] { clampedUniformKnots(-1, 2, 0, 1); });
+  expectInput("clampedUniformKnots huge", [] { clampedUniformKnots(2000000000, 2, 0, 1); });
+  Lattice offset = makeIdentityLattice(glm::dvec3(0), glm::dvec3(1), {3, 3, 3}, {2, 2, 2});
+  offset.frameOffset.y = NAN;
+  expectInput("validateLattice NaN frame offset", [&] { validateLattice(offset, "lattice"); });
+  // Made whole, the same lattice takes every call.
+  none.knots = {clampedUniformKnots(3, 2, 0, 1), clampedUniformKnots(3, 2, 0, 1), clampedUniformKnots(3, 2, 0, 1)};
+  setIdentityControlPoints(none);
+  applyLatticePreset(none, "twist", 0.5);
+  EXPECT_NO_THROW(validateLattice(none, "lattice"));
 }

@@ -77,7 +77,7 @@ void DeformSession::prepare(const Mesh& input, const Lattice& lattice, const Sta
     throw Error(ErrorKind::Input, "the edge length must be a finite number > 0");
   if (options.level < 1 || options.level > 64) throw Error(ErrorKind::Input, "the tessellation level must be 1..64");
   if (options.variant.f64 && !backend.info().limits.float64)
-    throw deviceError(backend.info().name + " has no double-precision shader support; use --precision float");
+    throw noFloat64Error(backend.info());
   Impl& I = *impl_;
   const bool f64 = options.variant.f64;
   I.realSize = f64 ? 8 : 4;

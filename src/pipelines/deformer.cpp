@@ -13,6 +13,7 @@
 #include "core/job_budget.h"
 #include "core/wall_clock.h"
 #include "kernels/clip/regular_clip.h"
+#include "model/mesh.h"
 #include "model/mesh_topology.h"
 #include "pipelines/deform_session.h"
 #include "pipelines/deformer_internal.h"
@@ -122,12 +123,18 @@ Deformer::Deformer(Device& device, const Mesh& mesh, const Lattice& lattice, con
   Impl& I = *impl_;
   I.device = device.handle();
   I.options = options;
+  // The checks meshFromView makes, for a Mesh the caller filled: a bad index or count would be read out of
+  // bounds by every method, a NaN deformed into NaN.
+  validateMesh(mesh, "mesh");
   validateLattice(lattice, "lattice");
   I.resolved = resolve(options, device.info(), mesh, lattice);
   if (std::string big = latticeTooLarge(lattice, options.memoryLimit, kLimitName); !big.empty())
     throw Error(ErrorKind::Input, big);
   I.structure = lattice;
   I.input = mesh;
+  // What <sffd/mesh.h> lets a caller leave empty, made as readMesh makes it.
+  if (I.input.normals.empty()) computeVertexNormals(I.input), I.input.normalsFromFile = false;
+  if (I.input.weldId.empty()) weldPositions(I.input);
   I.frame = latticeLocalFrame(lattice);
   const ResolvedOptions& r = I.resolved;
   Backend& backend = device.backend();
@@ -207,18 +214,20 @@ Deformer::~Deformer() {
 
 const Timings& Deformer::deform(const Lattice& lattice) {
   Impl& I = impl();
+  // Refused before anything else: a one-shot Deformer's second call leaves its one result to be taken.
+  if (I.options.once && I.deformed) throw Error(ErrorKind::Input, "a one-shot Deformer deforms once (DeformOptions::once)");
+  // Whatever else this call throws for, the outputs are no longer the last deform()'s result (deformer.h): a
+  // cancelled or failed call leaves them part old, part new, and one refused leaves another lattice's.
+  I.hasResult = false;
+  I.called = true;
   if (!sameLatticeStructure(lattice, I.structure))
     throw Error(ErrorKind::Input, "the lattice's degrees, counts, knots, frame or outside rule differ from the Deformer's");
   // The constructor checked the first lattice; an edited one could hold a NaN, which every method turned
   // silently into a result of NaN.
   validateLattice(lattice, "lattice");
-  if (I.options.once && I.deformed) throw Error(ErrorKind::Input, "a one-shot Deformer deforms once (DeformOptions::once)");
   const auto t0 = std::chrono::steady_clock::now();
   CallScope call(I.backend());
   ProgressReporter progress(I.options.progress, &I.backend());
-  // The outputs are the last deform()'s only once it has run to its end: a cancelled or failed call leaves
-  // them part old, part new.
-  I.hasResult = false;
   progress("deform", 0);
   I.timings.steps.clear();
   I.deformed = true;
@@ -233,10 +242,32 @@ const Timings& Deformer::timings() const { return impl().timings; }
 
 void Deformer::Impl::checkResult(const char* call) {
   if (!hasResult)
-    throw Error(ErrorKind::Input, std::string(call) + (deformed ? ": the last deform() was cancelled or failed; deform() again first"
-                                                                : ": no result yet; call deform() first"));
+    throw Error(ErrorKind::Input, std::string(call) + (called ? ": the last deform() was cancelled or failed; deform() again first"
+                                                              : ": no result yet; call deform() first"));
+  if (options.once && resultLost)
+    throw Error(ErrorKind::Input, std::string(call) + ": the one-shot result (DeformOptions::once) " + resultLost +
+                                      " while it was being made, and what it is made from is not kept to make it again; "
+                                      "make a new Deformer");
   if (options.once && resultTaken) throw Error(ErrorKind::Input, std::string(call) + ": the result was already taken (DeformOptions::once)");
 }
+
+namespace {
+// Runs `take` (the run's result or streamResult) as the one result a one-shot Deformer gives, noting how it
+// ended if it threw.
+template <class Take>
+auto takeResult(Deformer::Impl& I, Take&& take) -> decltype(take()) {
+  I.resultTaken = true;
+  try {
+    return take();
+  } catch (const Error& e) {
+    I.resultLost = e.kind() == ErrorKind::Cancelled ? "was cancelled" : "failed";
+    throw;
+  } catch (...) {
+    I.resultLost = "failed";
+    throw;
+  }
+}
+}  // namespace
 
 Mesh Deformer::result() const {
   impl().checkResult("result()");
@@ -245,10 +276,11 @@ Mesh Deformer::result() const {
   CallScope call(impl().backend());
   ProgressReporter progress(impl().options.progress, &impl().backend());
   progress("download", 0);
-  impl().resultTaken = true;
-  Mesh mesh = impl().run->result(progress);
-  progress("download", 1);
-  return mesh;
+  return takeResult(impl(), [&] {
+    Mesh mesh = impl().run->result(progress);
+    progress("download", 1);
+    return mesh;
+  });
 }
 
 void Deformer::streamResult(MeshSink& sink) const {
@@ -256,9 +288,10 @@ void Deformer::streamResult(MeshSink& sink) const {
   CallScope call(impl().backend());
   ProgressReporter progress(impl().options.progress, &impl().backend());
   progress("download", 0);
-  impl().resultTaken = true;
-  impl().run->streamResult(sink, progress);
-  progress("download", 1);
+  takeResult(impl(), [&] {
+    impl().run->streamResult(sink, progress);
+    progress("download", 1);
+  });
 }
 
 void checkEstimateFits(const Deformer::Impl& impl, const JobEstimate& estimate, uint64_t memoryLimit, const char* limitName) {

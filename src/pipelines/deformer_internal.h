@@ -125,9 +125,11 @@ struct Deformer::Impl {
   // Smooth and accurate: the host-memory estimate checked against the limit (a streamed job's, stream_budget.h),
   // and for a streamed job the whole job's, which result() checks before it holds the welded mesh.
   std::optional<JobEstimate> estimate, wholeEstimate;
-  // deform() has been called; the last one ran to its end (the outputs are its result); a result was taken
-  // (DeformOptions::once allows one, for every method).
-  bool deformed = false, hasResult = false, resultTaken = false;
+  // deform() has been called; it ran the method's deform step; the last one ran to its end (the outputs are
+  // its result); a result was taken (DeformOptions::once allows one, for every method); that one-shot result
+  // threw while being made (cancelled or failed: what it was made from is gone, so it cannot be made again).
+  bool called = false, deformed = false, hasResult = false, resultTaken = false;
+  const char* resultLost = nullptr;
   // The input Error of `call` (result(), ...) where there is no result to give.
   void checkResult(const char* call);
 };

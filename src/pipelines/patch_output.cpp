@@ -6,13 +6,29 @@
 #include <cstring>
 #include <stdexcept>
 
+#include <sffd/error.h>
+
 #include "core/huge_pages.h"
+#include "core/job_budget.h"
 #include "core/key3_map.h"
 
 namespace sffd {
 
-int tessVertexCount(int level) { return (level + 1) * (level + 2) / 2; }
-int tessTriangleCount(int level) { return level * level; }
+namespace {
+// Public (<sffd/deformer.h>): past DeformOptions::tess's range the counts are no level's, and overflow int.
+int checkedLevel(int level, const char* call) {
+  if (level < 1 || level > kMaxTessLevel)
+    throw Error(ErrorKind::Input, std::string(call) + ": the tessellation level must be 1.." + std::to_string(kMaxTessLevel) +
+                                      ", not " + std::to_string(level));
+  return level;
+}
+}  // namespace
+
+int tessVertexCount(int level) {
+  checkedLevel(level, "tessVertexCount");
+  return (level + 1) * (level + 2) / 2;
+}
+int tessTriangleCount(int level) { return checkedLevel(level, "tessTriangleCount") * level; }
 
 std::vector<uint32_t> tessTriangles(int L) {
   std::vector<uint32_t> t;
