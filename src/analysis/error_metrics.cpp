@@ -75,19 +75,22 @@ ErrorReport measureErrors(const Mesh& input, const PackedLattice& lattice, const
   ExactReference ref(input, lattice);
   const size_t nv = size_t(tessVertexCount(result.level));
   const size_t total = result.vertexCount();
-  std::vector<double> geo(total), nrm(total);
+  std::vector<double> geo, nrm;
+  geo.reserve(total), nrm.reserve(total);
   for (size_t g = 0; g < total; ++g) {
     const uint32_t parent = result.parent[g / nv];
+    // A parent without area (two corners at one position) has no part in the result (patch_output.h).
+    if (!input.weldId.empty() && weldDegenerate(input, input.triangles[parent])) continue;
     glm::dvec3 lam(result.lamParent[3 * g], result.lamParent[3 * g + 1], result.lamParent[3 * g + 2]);
     glm::dvec3 x, n, xr, nr;
     ref.preImage(parent, lam, x, n);
     ref.deform(x, n, xr, nr);
     glm::dvec3 p(result.position[3 * g], result.position[3 * g + 1], result.position[3 * g + 2]);
     glm::dvec3 q(result.normal[3 * g], result.normal[3 * g + 1], result.normal[3 * g + 2]);
-    geo[g] = glm::length(p - xr);
-    nrm[g] = angleDeg(q, nr);
+    geo.push_back(glm::length(p - xr));
+    nrm.push_back(angleDeg(q, nr));
   }
-  rep.vertices = total;
+  rep.vertices = geo.size();
   rep.geometry = errorStats(geo);
   rep.normalDeg = errorStats(nrm);
   return rep;

@@ -597,4 +597,39 @@ TEST(Deformer, TessellationCountsTakeTheLevelsDeformOptionsTakes) {
   }
 }
 
+// A triangle with two corners at one position (a duplicate vertex, as unwelded STL files have them) has no
+// area: smooth and accurate FFD leave its patches out. Its patch, fitted to the duplicate's own normal, stuck
+// out of the cube's face by 0.03 and made the cube's edge non-manifold; the cube stays the cube now.
+TEST(Deformer, ATriangleWithoutAreaLeavesNoPatch) {
+  const std::vector<double> corners = {-1, -1, -1, 1, -1, -1, -1, 1, -1, 1, 1, -1, -1, -1, 1, 1, -1, 1, -1, 1, 1, 1, 1, 1};
+  const std::vector<uint32_t> cube = {0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4,
+                                      2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6, 1, 3, 5, 3, 7, 5};
+  std::vector<double> withDuplicate = corners;
+  withDuplicate.insert(withDuplicate.end(), {-1, -1, -1});   // vertex 8: vertex 0 again
+  std::vector<uint32_t> withCollapsed = cube;
+  withCollapsed.insert(withCollapsed.end(), {0, 8, 1});     // along the cube's edge 0-1
+  const Mesh clean = sffd::testing::meshFromArrays(corners, cube);
+  const Mesh odd = sffd::testing::meshFromArrays(withDuplicate, withCollapsed);
+  const Lattice identity = fitLattice(clean);
+  Device device = openDevice("cpu");
+  for (Method method : {Method::Smooth, Method::Accurate}) {
+    SCOPED_TRACE(nameOf(method));
+    DeformOptions o = strictOptions(method);
+    Deformer a(device, clean, identity, o), b(device, odd, identity, o);
+    a.deform(identity);
+    b.deform(identity);
+    const Mesh want = a.result(), got = b.result();
+    EXPECT_EQ(got.triangles.size(), want.triangles.size());
+    auto offTheCube = [](const Mesh& m) {   // the largest distance of a vertex from the cube's surface
+      double off = 0;
+      for (const glm::dvec3& p : m.positions)
+        off = std::max(off, std::min({std::abs(1 - std::abs(p.x)), std::abs(1 - std::abs(p.y)), std::abs(1 - std::abs(p.z))}));
+      return off;
+    };
+    EXPECT_LT(offTheCube(want), 1e-5);   // float rounding
+    EXPECT_EQ(offTheCube(got), offTheCube(want));
+  }
+}
+
+
 }  // namespace

@@ -34,14 +34,17 @@ void checkMesh(const Mesh& mesh, const char* who, bool needNormals) {
       if (v >= n) throw Error(ErrorKind::Internal, std::string(who) + ": triangle vertex index out of range");
 }
 
-// A triangle with two corners at one welded position has a collapsed edge. It is left out of the
-// adjacency altogether: its other two edges are the same welded edge twice, and counting them would
-// turn the real edge it lies on into a non-manifold one and disconnect the two proper triangles there
-// (which, the collapsed one having no area, really are neighbours).
+}  // namespace
+
+// Left out of the adjacency altogether: counting its edges would turn the real edge it lies on into a
+// non-manifold one and disconnect the two proper triangles there (which, the collapsed one having no
+// area, really are neighbours).
 bool weldDegenerate(const Mesh& mesh, const std::array<uint32_t, 3>& t) {
   uint32_t a = mesh.weldId[t[0]], b = mesh.weldId[t[1]], c = mesh.weldId[t[2]];
   return a == b || b == c || c == a;
 }
+
+namespace {
 
 struct Adjacency {
   std::vector<std::array<int32_t, 3>> neighbour;

@@ -259,6 +259,11 @@ struct PatchWelder::Impl {
       const uint32_t parent = P.parent[p];
       if (sink && parent < lastParent) throw std::logic_error("PatchWelder: streamed patches out of parent order");
       lastParent = parent;
+      // A parent with two corners at one location has no area, and neither has its part of the surface: its
+      // patch, made from normals that need not agree at that location (a duplicate vertex of an unwelded file),
+      // stuck out of the surface, and its edge points could give the real triangles' edge their positions.
+      const uint32_t* pw = &P.parentWeld[3 * p];
+      if (pw[0] == pw[1] || pw[1] == pw[2] || pw[0] == pw[2]) continue;
       for (int v = 0; v < nv; ++v) {
         const size_t g = p * nv + v;
         uint32_t fresh = Locations::kNone, until = parent;

@@ -69,7 +69,8 @@ void carryPatchAttributes(PatchVertices& patches, const Mesh& input);
 // (creases and seams split vertices,
 // never positions); its vertices share a weldId, the location's index (Mesh::weldIdIsLocation, so the
 // writers keep locations that round to one position apart). A triangle with two corners at
-// one location (of a degenerate patch) is dropped. The carried fields become the Mesh's.
+// one location (of a degenerate patch) is dropped, and so are the patches of a parent with two corners
+// at one location (no area). The carried fields become the Mesh's.
 Mesh weldPatchVertices(const PatchVertices& patches);
 
 // weldPatchVertices a slice of patches at a time, for a producer that need not hold all the patch
