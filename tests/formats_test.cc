@@ -235,6 +235,23 @@ TEST(Formats, AnimateLeavesNothingWhenAFrameCannotBeWritten) {
       }
   };
   expectRefused(runSffd(job + (dir / "f_%d.ply").string()), "numbered frames");   // frame 0 is fine, frame 1 not finite
+  // Files the frames would replace, one through a link, are as they were (a failing frame 1 took away the
+  // user's frame 0, and the file at the end of the link).
+  std::ofstream(dir / "g_0.ply") << "the user's frame 0";
+  std::ofstream(dir / "target.ply") << "the user's target";
+  fs::create_symlink("target.ply", dir / "g_1.ply");
+  std::ofstream(dir / "g_2.ply") << "the user's frame 2";
+  const std::string l1 = (dir / "l1.json").string();
+  ASSERT_EQ(runSffd("lattice " + box + " --quiet -o " + l1 + " --preset twist:0.5").status, 0);
+  RunResult failed = runSffd("animate " + box + " -l " + l0 + " -l " + l1 + " -l " + far + " --frames 5 --backend cpu --method classic --quiet -o " +
+                             (dir / "g_%d.ply").string());   // frames 0 to 2 written, frame 3 not finite
+  EXPECT_EQ(failed.status, 2) << failed.err;
+  EXPECT_EQ(slurp(dir / "g_0.ply"), "the user's frame 0");
+  EXPECT_EQ(slurp(dir / "target.ply"), "the user's target");
+  EXPECT_TRUE(fs::is_symlink(dir / "g_1.ply"));
+  EXPECT_EQ(slurp(dir / "g_2.ply"), "the user's frame 2");
+  for (const char* f : {"g_0.ply", "g_1.ply", "g_2.ply", "target.ply"}) fs::remove(dir / f);
+  expectRefused(failed, "frames that replace files");
   expectRefused(runSffd(job + (dir / "a.glb").string()), "glTF");
   // A double result past a float's range: finite in the other formats, not in glTF's floats.
   ASSERT_EQ(runSffd("lattice " + box + " --quiet -o " + far + " --preset bend:1e300").status, 0);

@@ -87,11 +87,16 @@ class WrittenFiles {
   WrittenFiles(const WrittenFiles&) = delete;
   WrittenFiles& operator=(const WrittenFiles&) = delete;
   ~WrittenFiles();
+  // Before `path` is written: a file it will replace is moved aside, put back when the command fails and
+  // removed by keep() (animate's frames: a failing frame took away the user's files the earlier ones had
+  // replaced). A .gltf's .bin beside it too.
+  void willReplace(const std::string& path);
   void add(const std::string& path);   // a .gltf's .bin beside it too
-  void keep() { paths_.clear(); }
+  void keep();
 
  private:
   std::vector<std::string> paths_;
+  std::vector<std::pair<std::string, std::string>> asides_;   // (moved aside to, from)
 };
 
 // Opens the device the options ask for (--backend, --device), printing fallback notes unless --quiet.

@@ -87,13 +87,14 @@ int run(const ParsedArgs& args) {
                   "the " + std::to_string(frames) + " frames of " + out,
                   "use fewer --frames, or numbered files (frame_%04d.ply), written one at a time");
   std::vector<Mesh> meshes;
-  WrittenFiles written;   // numbered frames: removed again when a later one fails
+  WrittenFiles written;   // numbered frames: removed again when a later one fails, the files they replaced put back
   for (int f = 0; f < frames; ++f) {
     if (f > 0) {
       run.deformer.deform(frameLattice(keys, f, frames));
       run.mesh = run.deformer.result();
     }
     if (numbered) {
+      written.willReplace(frameName(out, f));
       writeMesh(frameName(out, f), run.mesh, write);
       written.add(frameName(out, f));
     } else {

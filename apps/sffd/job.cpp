@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -6,6 +7,7 @@
 #include <filesystem>
 #include <future>
 #include <optional>
+#include <unistd.h>
 
 #include <nlohmann/json.hpp>
 
@@ -183,6 +185,29 @@ void checkOutputPath(const std::string& out, const std::vector<std::string>& inp
 
 WrittenFiles::~WrittenFiles() {
   for (const std::string& p : paths_) std::remove(p.c_str());
+  for (auto it = asides_.rbegin(); it != asides_.rend(); ++it) std::rename(it->first.c_str(), it->second.c_str());
+}
+
+void WrittenFiles::willReplace(const std::string& path) {
+  std::vector<std::string> files = {replacedFile(path)};
+  if (io::lowerExtension(path) == ".gltf") files.push_back(fs::path(files[0]).replace_extension(".bin").string());
+  for (const std::string& file : files) {
+    std::error_code ec;
+    if (!fs::is_regular_file(fs::symlink_status(file, ec))) continue;
+    // Beside it (a rename within the folder), under a name no user file has.
+    const std::string aside = (fs::path(file).parent_path() / (".sffd-replaced-" + std::to_string(::getpid()) + "-" +
+                                                               std::to_string(asides_.size())))
+                                  .string();
+    if (std::rename(file.c_str(), aside.c_str()) != 0)
+      throw Error(ErrorKind::Input, file + ": cannot write: cannot move the file it replaces aside (" + std::strerror(errno) + ")");
+    asides_.emplace_back(aside, file);
+  }
+}
+
+void WrittenFiles::keep() {
+  paths_.clear();
+  for (const auto& [aside, file] : asides_) std::remove(aside.c_str());
+  asides_.clear();
 }
 
 void WrittenFiles::add(const std::string& path) {
