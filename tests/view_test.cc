@@ -292,6 +292,15 @@ TEST(View, ScriptErrorsFoundWhileRunningNameTheirLine) {
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_NE(r.err.find("sffd: error: " + (dir / "s.txt").string() + ":2: drag: point index 9 is outside 0..4"), std::string::npos)
       << r.err;
+  // A lattice is saved in the format its name says (JSON went into a .npy that nothing could read back), and
+  // a screenshot under another name than .png is refused (PNG data went into x.jpg).
+  writeFile(dir / "save.txt", "save-lattice " + (dir / "l.npy").string() + "\nscreenshot " + (dir / "x.jpg").string() + "\n");
+  r = run("view " + kSphere + " --replay " + (dir / "save.txt").string() + " --width 160 --height 120 --method classic", dir, x);
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find(":2: " + (dir / "x.jpg").string() + ": a screenshot is a PNG picture; name it .png"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "x.jpg"));
+  Result back = run("deform " + kSphere + " -l " + (dir / "l.npy").string() + " --method classic --quiet -o " + (dir / "o.obj").string(), dir, x);
+  EXPECT_EQ(back.status, 0) << back.err;
 }
 
 }  // namespace

@@ -16,6 +16,7 @@
 
 #include <sffd/error.h>
 #include "model/lattice_fold.h"
+#include "io/io_util.h"
 #include "io/lattice_io.h"
 #include "model/lattice_pack.h"
 #include "apps/view/view_camera.h"
@@ -452,6 +453,8 @@ void App::execute(const Command& c) {
     fbH_ = h;
   } else if (v == "screenshot") {
     const std::string path = resolve(c.words[0], "sffd-view-" + std::to_string(++screenshotCount_) + ".png");
+    if (io::lowerExtension(path) != ".png")   // as `sffd render` (PNG data under another name misleads)
+      throw Error(ErrorKind::Input, path + ": a screenshot is a PNG picture; name it .png");
     if (fbW_ <= 0 || fbH_ <= 0) {
       std::fprintf(stderr, "sffd: warning: %s: the window has no pixels (minimised); no screenshot\n", path.c_str());
       return;
@@ -463,7 +466,7 @@ void App::execute(const Command& c) {
     status("wrote " + path + " (" + settings_.method + ", " + scene_->path() + ")");
   } else if (v == "save-lattice") {
     const std::string path = resolve(c.words[0], "sffd-view-lattice.json");
-    writeLatticeJson(path, edit_.lattice());
+    writeLattice(path, edit_.lattice());   // the format its extension names, as `sffd lattice -o`
     status("wrote " + path);
   } else if (v == "load-lattice") {
     const std::string path = resolve(c.words[0], "");

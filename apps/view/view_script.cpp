@@ -43,7 +43,7 @@ const std::vector<Verb>& verbs() {
       {"fit", "", {}, "fit (frame the result as render does)"},
       {"resize", "ii", {}, "resize W H (pixels; 0 0 acts as a minimised window)"},
       {"screenshot", "f", {}, "screenshot FILE.png"},
-      {"save-lattice", "f", {}, "save-lattice FILE.json"},
+      {"save-lattice", "f", {}, "save-lattice FILE (.json .npy .prm .vtk)"},
       {"load-lattice", "f", {}, "load-lattice FILE"},
       {"save-mesh", "f", {}, "save-mesh FILE (.obj .ply .off .stl)"},
       {"frame", "", {}, "frame (draw one more frame)"},
