@@ -90,6 +90,13 @@ TEST_F(CommandLine, ValuesThatWereTakenOrIgnoredAreRefused) {
   expectUsageError(runSffd("deform " + job + " -o " + out("o.obj"), "SFFD_DEVICE_TIMEOUT=abc"),
                    "SFFD_DEVICE_TIMEOUT must be a number of seconds > 0, like 60 or 0.5, not 'abc'");
   expectUsageError(runSffd("devices", "SFFD_DEVICE_TIMEOUT=0"), "SFFD_DEVICE_TIMEOUT must be a number of seconds > 0");
+  for (const char* threads : {"abc", "0", "-1", "257"})   // 1 thread, 256 and 256 before
+    expectUsageError(runSffd("devices", std::string("SFFD_CPU_THREADS=") + threads),
+                     "SFFD_CPU_THREADS must be an integer 1..256, not '" + std::string(threads) + "'");
+  EXPECT_NE(runSffd("devices", "SFFD_CPU_THREADS=3").out.find("CPU reference (3 threads"), std::string::npos);
+  expectUsageError(runSffd("conform " + job + " --backends cpu,cpu"), "option --backends names 'cpu' twice, in 'cpu,cpu'");
+  expectUsageError(runSffd("animate " + box_ + " -l " + lattice_ + " -l " + lattice_ + " -o " + out("a.glb")),
+                   "animate needs --frames N (2..10000)");
   expectUsageError(runSffd("deform " + job + " -o " + out("o.obj") + " --edge-length 1e-300"),
                    "--edge-length 1e-300 would make more sub-triangles than a double counts, above the limit of 5e+07");
   for (const char* name : {"o.obj", "c.obj", "x.json", "f_0.obj"}) EXPECT_FALSE(fs::exists(dir_ / name)) << name;

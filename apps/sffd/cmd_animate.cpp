@@ -52,6 +52,7 @@ int run(const ParsedArgs& args) {
   checkJobOptions(args);
   const std::vector<std::string> paths = args.all("--lattice");
   if (paths.size() < 2) throw Error(ErrorKind::Input, "animate needs at least two lattices (-l L0 -l L1 ...)");
+  if (!args.has("--frames")) throw Error(ErrorKind::Input, "animate needs --frames N (2..10000): how many frames to make");
   const int frames = args.getInt("--frames", 0);
   if (frames < 2 || frames > 10000) throw Error(ErrorKind::Input, "--frames must be 2..10000");
   const double fps = args.getDouble("--fps", 24.0);

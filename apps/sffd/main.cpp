@@ -6,6 +6,7 @@
 #include <string>
 
 #include "apps/sffd/cli.h"
+#include "backends/cpu/cpu_backend.h"
 #include "core/device_timeout.h"
 #include "core/huge_pages.h"
 #include <sffd/sffd.h>
@@ -67,6 +68,7 @@ int main(int argc, char** argv) {
         return 0;
       }
       checkDeviceTimeoutVariable();
+      checkCpuThreadsVariable();
       const int status = c.run(args);
       if (status == 0)
         for (const std::string& w : cli::takeWarnings()) std::fprintf(stderr, "sffd: warning: %s\n", oneLine(w.c_str()).c_str());

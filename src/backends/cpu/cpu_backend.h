@@ -15,8 +15,12 @@
 
 namespace sffd {
 
-// Threads a dispatch runs on: every core, or SFFD_CPU_THREADS (1..256).
+// Threads a dispatch runs on: every core (at most 256), or SFFD_CPU_THREADS where it is an integer 1..256
+// (more than the cores is allowed: the tests split work as a larger machine would).
 unsigned cpuThreadCount();
+// An input Error when SFFD_CPU_THREADS is set to anything else (the tool checks it before a command runs;
+// cpuThreadCount() would take every core instead).
+void checkCpuThreadsVariable();
 
 namespace cpu {
 
