@@ -94,7 +94,6 @@ TEST_F(CommandLine, ValuesThatWereTakenOrIgnoredAreRefused) {
     expectUsageError(runSffd("devices", std::string("SFFD_CPU_THREADS=") + threads),
                      "SFFD_CPU_THREADS must be an integer 1..256, not '" + std::string(threads) + "'");
   EXPECT_NE(runSffd("devices", "SFFD_CPU_THREADS=3").out.find("CPU reference (3 threads"), std::string::npos);
-  expectUsageError(runSffd("conform " + job + " --backends cpu,cpu"), "option --backends names 'cpu' twice, in 'cpu,cpu'");
   expectUsageError(runSffd("animate " + box_ + " -l " + lattice_ + " -l " + lattice_ + " -o " + out("a.glb")),
                    "animate needs --frames N (2..10000)");
   expectUsageError(runSffd("deform " + job + " -o " + out("o.obj") + " --edge-length 1e-300"),

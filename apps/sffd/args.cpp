@@ -162,9 +162,6 @@ std::vector<std::string> ParsedArgs::getList(const std::string& name, const std:
     const size_t comma = text.find(',', start);
     out.push_back(text.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
     if (out.back().empty()) throw usage("option " + name + " needs names separated by single commas, not '" + text + "'");
-    // A name given twice compared a backend with itself (conform passed whatever it computed).
-    if (std::find(out.begin(), out.end() - 1, out.back()) != out.end() - 1)
-      throw usage("option " + name + " names '" + out.back() + "' twice, in '" + text + "'");
     if (comma == std::string::npos) return out;
     start = comma + 1;
   }
