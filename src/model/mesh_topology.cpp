@@ -40,8 +40,7 @@ void checkMesh(const Mesh& mesh, const char* who, bool needNormals) {
 // non-manifold one and disconnect the two proper triangles there (which, the collapsed one having no
 // area, really are neighbours).
 bool weldDegenerate(const Mesh& mesh, const std::array<uint32_t, 3>& t) {
-  uint32_t a = mesh.weldId[t[0]], b = mesh.weldId[t[1]], c = mesh.weldId[t[2]];
-  return a == b || b == c || c == a;
+  return weldsCollapsed(mesh.weldId[t[0]], mesh.weldId[t[1]], mesh.weldId[t[2]]);
 }
 
 namespace {

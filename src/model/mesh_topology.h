@@ -35,9 +35,12 @@ constexpr double kSameNormalTolerance = 1e-6;
 inline int slotEdge(int slot) { return slot % 2 ? slot / 2 : (slot / 2 + 2) % 3; }
 inline int slotCorner(int slot) { return slot / 2; }
 
-// Whether triangle t has two corners at one welded position (mesh.weldId): a collapsed edge and no area.
-// Such a triangle is no neighbour of any (its other two edges are the same welded edge twice), and the
-// smooth and accurate results leave its patches out (patch_output.h).
+// Whether a triangle whose corners have weld ids a, b, c has two corners at one welded position: a
+// collapsed edge and no area.
+inline bool weldsCollapsed(uint32_t a, uint32_t b, uint32_t c) { return a == b || b == c || c == a; }
+// The same for triangle t of `mesh` (mesh.weldId). Such a triangle is no neighbour of any (its other two
+// edges are the same welded edge twice), and the smooth and accurate results leave its patches out
+// (patch_output.h).
 bool weldDegenerate(const Mesh& mesh, const std::array<uint32_t, 3>& t);
 
 // Builds adjacency from mesh.weldId (edges with more than two triangles are non-manifold: left

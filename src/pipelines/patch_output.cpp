@@ -11,6 +11,7 @@
 #include "core/huge_pages.h"
 #include "core/job_budget.h"
 #include "core/key3_map.h"
+#include "model/mesh_topology.h"
 
 namespace sffd {
 
@@ -262,8 +263,7 @@ struct PatchWelder::Impl {
       // A parent with two corners at one location has no area, and neither has its part of the surface: its
       // patch, made from normals that need not agree at that location (a duplicate vertex of an unwelded file),
       // stuck out of the surface, and its edge points could give the real triangles' edge their positions.
-      const uint32_t* pw = &P.parentWeld[3 * p];
-      if (pw[0] == pw[1] || pw[1] == pw[2] || pw[0] == pw[2]) continue;
+      if (weldsCollapsed(P.parentWeld[3 * p], P.parentWeld[3 * p + 1], P.parentWeld[3 * p + 2])) continue;
       for (int v = 0; v < nv; ++v) {
         const size_t g = p * nv + v;
         uint32_t fresh = Locations::kNone, until = parent;
@@ -287,7 +287,7 @@ struct PatchWelder::Impl {
       for (size_t i = 0; i < local.size(); i += 3) {
         std::array<uint32_t, 3> t{map[local[i]], map[local[i + 1]], map[local[i + 2]]};
         const uint32_t* w = m.weldId.data();
-        if (w[t[0]] == w[t[1]] || w[t[1]] == w[t[2]] || w[t[0]] == w[t[2]]) continue;   // a collapsed corner of a degenerate patch
+        if (weldsCollapsed(w[t[0]], w[t[1]], w[t[2]])) continue;   // a collapsed corner of a degenerate patch
         if (forgetting) t = {vertexId[t[0]], vertexId[t[1]], vertexId[t[2]]};
         m.triangles.push_back(t);
         if (!P.material.empty()) m.triangleMaterial.push_back(P.material[p]);
