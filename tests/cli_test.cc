@@ -26,6 +26,8 @@ using sffd::test::runSffd;
 using sffd::test::slurp;
 using sffd::test::tempDir;
 using sffd::test::usable;
+using sffd::test::hasDevice;
+using sffd::test::hasDoubles;
 
 std::vector<glm::dvec3> readPoints(const std::string& path) {
   std::ifstream f(path);
@@ -47,6 +49,8 @@ class PygemOracle : public ::testing::TestWithParam<std::string> {};
 // expected_points.txt within PyGeM's 1.5e-6 (1e-10 for the CPU reference), outside points unmoved.
 TEST_P(PygemOracle, SphereMatchesExpectedPoints) {
   if (!usable(GetParam())) GTEST_SKIP() << GetParam() << " is not on this machine";
+  // 1.5e-6 is below float's resolution at the sphere's coordinates: classic FFD meets it in double.
+  if (hasDevice(GetParam()) && !hasDoubles(GetParam())) GTEST_SKIP() << GetParam() << " has no double precision here";
   fs::path dir = tempDir("pygem_" + GetParam());
   std::string out = (dir / "sphere.obj").string();
   std::string base = kData + "/pygem/sphere_ffd/";

@@ -37,27 +37,6 @@ std::string deviceJson(const std::string& label, const DeviceInfo& info) {
 
 namespace {
 
-// Tolerances (docs/CONFORMANCE.md): strict is bit-identical; fast allows a few roundings.
-CompareTolerance toleranceFor(const Case& c, const std::string& buffer) {
-  CompareTolerance t;
-  if (c.strict() || buffer == "clip.headers") {
-    t.bitExact = true;   // sub-triangle topology is the same everywhere, in fast mode too
-    return t;
-  }
-  t.maxUlp = c.f64() ? 1e6 : 64;
-  // 2e-6 between any two devices: one that fuses multiply-adds (NVIDIA's) and one that does not
-  // (Mesa's, whose fast bits are the CPU's) differ as a GPU and the CPU do (an H200 against
-  // lavapipe's dump: 1.04e-6 in one normal of the sphere).
-  t.absOfScale = c.f64() ? 1e-12 : 2e-6;
-  // The accurate control points solve A_n^{-1} S: the samples' rounding grows by up to |A_n^{-1}|_inf
-  // (412 for n = 7), which the tessellated values do not see.
-  if (buffer == "accurate.patches" && !c.f64()) t.absOfScale = 1e-4;
-  // The smooth patches fit 19 samples by least squares, which amplifies their rounding less, but beyond
-  // 2e-6 with a driver that fuses multiply-adds: NVIDIA's (H200, driver 580) reached 2.2e-6 of the scale.
-  if (buffer == "deform.patches" && !c.f64()) t.absOfScale = 1e-5;
-  return t;
-}
-
 std::string describe(const Buffer& buf, const std::vector<uint32_t>& parents, size_t element) {
   const size_t unit = element / buf.perUnit, within = element % buf.perUnit;
   std::string s = buf.unit + " " + std::to_string(unit);
@@ -109,7 +88,7 @@ std::vector<Result> compareRuns(const std::vector<Case>& cases, const std::vecto
           results.push_back(r);
           continue;
         }
-        r.tolerance = toleranceFor(c, name);
+        r.tolerance = crossDeviceTolerance(name, c.strict(), c.f64());
         r.compare = compareBuffers(ba->values, bb->values, !c.f64(), r.tolerance);
         r.compared = true;
         r.status = r.compare.mismatched ? Status::Fail : Status::Pass;

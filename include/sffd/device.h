@@ -19,7 +19,8 @@ struct DeviceLimits {
   uint64_t maxStorageBufferRange = 128u << 20;   // bytes one storage binding may cover
   uint64_t storageOffsetAlignment = 256;         // alignment of a storage binding's offset
   uint32_t maxWorkGroupCount[3] = {65535, 65535, 65535};
-  bool float64 = false;                          // kernels in the f64 variant can run
+  bool float64 = false;                          // kernels in the f64 variant can run (never on GLES, nor on NVIDIA's
+                                                 // OpenGL driver, which rounds them: docs/CONFORMANCE.md)
   bool timestamps = false;                       // per-dispatch GPU times are measured
 };
 

@@ -4,6 +4,7 @@
 #pragma once
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace sffd {
@@ -20,6 +21,10 @@ struct CompareResult {
   size_t mismatched = 0, total = 0;
   size_t firstMismatch = SIZE_MAX;   // index of the first element outside the tolerance (sffd conform names it)
 };
+
+// The tolerance between two devices' outputs of one kernel (docs/CONFORMANCE.md "Tolerances"): `buffer` is
+// the output's name as sffd conform gives it ("pn.records", "clip.records", "deform.patches", ...).
+CompareTolerance crossDeviceTolerance(std::string_view buffer, bool strict, bool f64);
 
 // Values are compared in the precision the kernel wrote (float32 when `float32`, else double); the
 // CPU reference's double values are rounded to float32 first when compared with float32 output.

@@ -37,5 +37,17 @@ TEST(BufferCompare, FastPassesWithinUlpsOrAFractionOfTheScale) {
   EXPECT_EQ(compareBuffers({1.0, 1e-3}, {1.0, 1e-3 + 5e-6}, true, t).mismatched, 1u);
 }
 
+// One rule for sffd conform and the backend tests: strict and the clip topology exact, fast within a few
+// roundings of the largest value, wider where a solve amplifies them (the smooth fit, the accurate solve).
+TEST(BufferCompare, CrossDeviceToleranceFollowsTheBuffer) {
+  EXPECT_TRUE(crossDeviceTolerance("deform.patches", true, false).bitExact);
+  EXPECT_TRUE(crossDeviceTolerance("clip.headers", false, false).bitExact);
+  EXPECT_FALSE(crossDeviceTolerance("clip.records", false, false).bitExact);
+  EXPECT_EQ(crossDeviceTolerance("clip.records", false, false).absOfScale, 2e-6);
+  EXPECT_EQ(crossDeviceTolerance("deform.patches", false, false).absOfScale, 1e-5);
+  EXPECT_EQ(crossDeviceTolerance("accurate.patches", false, false).absOfScale, 1e-4);
+  EXPECT_EQ(crossDeviceTolerance("deform.patches", false, true).absOfScale, 1e-12);
+}
+
 }  // namespace
 }  // namespace sffd

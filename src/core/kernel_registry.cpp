@@ -90,6 +90,10 @@ KernelVariant forDevice(KernelVariant v, const DeviceInfo& device) {
 Error noFloat64Error(const DeviceInfo& info) {
   if (info.api == "gles")
     return Error(ErrorKind::Input, "OpenGL ES has no double precision: use Precision::Float (or Auto) as DeformOptions::precision on an OpenGL ES device");
+  // Every GL 4.3 core driver has doubles; the GL backend refuses them where they lose bits (NVIDIA's).
+  if (info.api == "gl")
+    return deviceError(info.name + ": this OpenGL driver rounds the kernels' doubles to float, so double precision is "
+                       "refused on it (docs/CONFORMANCE.md, \"NVIDIA's OpenGL doubles\"); its Vulkan driver runs them");
   return deviceError(info.name + " has no double-precision shader support");
 }
 

@@ -138,3 +138,14 @@ TEST(KernelRegistry, NoFloat64ErrorSpeaksOfDeformOptions) {
   EXPECT_EQ(vulkan.kind(), ErrorKind::Device);
   EXPECT_EQ(std::string(vulkan.what()).find("--"), std::string::npos) << vulkan.what();
 }
+
+// A GL device without float64 is one whose doubles the GL backend refuses (NVIDIA's): the error says why
+// and where doubles run instead, not that the device has none.
+TEST(KernelRegistry, NoFloat64ErrorOnOpenGlSaysTheDriverRoundsDoubles) {
+  const Error gl = noFloat64Error(device("NVIDIA H200/PCIe/SSE2", "4.5.0 NVIDIA 580.159.04", "gl"));
+  EXPECT_EQ(gl.kind(), ErrorKind::Device);
+  const std::string what = gl.what();
+  EXPECT_NE(what.find("rounds the kernels' doubles to float"), std::string::npos) << what;
+  EXPECT_NE(what.find("Vulkan"), std::string::npos) << what;
+  EXPECT_EQ(what.find("--"), std::string::npos) << what;
+}

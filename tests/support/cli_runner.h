@@ -81,6 +81,13 @@ inline bool hasDevice(const std::string& backend) {
   return listed.find("\n" + backend + " ") != std::string::npos;
 }
 
+// Whether `sffd devices` lists that backend with double-precision kernels ("[f64]").
+inline bool hasDoubles(const std::string& backend) {
+  static const std::string listed = "\n" + runSffd("devices").out;
+  size_t at = listed.find("\n" + backend + " ");
+  return at != std::string::npos && listed.substr(at + 1, listed.find('\n', at + 1) - at - 1).find("[f64]") != std::string::npos;
+}
+
 // Whether a test may run on backend `name`: this machine has it, or must have it (then its absence fails).
 inline bool usable(const std::string& backend) { return hasDevice(backend) || sffd::testing::requiredHere(backend); }
 

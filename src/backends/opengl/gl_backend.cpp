@@ -94,7 +94,12 @@ class GlBackend final : public Backend {
       glGetIntegeri_v(GL_MAX_COMPUTE_WORK_GROUP_COUNT, i, &n);
       L.maxWorkGroupCount[i] = static_cast<uint32_t>(std::max(n, 0));
     }
-    L.float64 = !es_;   // GL 4.0+ core has doubles (ARB_gpu_shader_fp64); ES has none
+    // GL 4.0+ core has doubles (ARB_gpu_shader_fp64); ES has none. NVIDIA's GL compiler does too, but
+    // keeps a kernel's indexed local arrays of doubles in 32-bit registers (`TEMP lmem0[]` in its
+    // program binary), so every double that passes through one is rounded to float: 1e-9 to 2e-5 off
+    // the CPU on the H200 (driver 580), where the same kernels through Vulkan give the CPU's bits
+    // (docs/CONFORMANCE.md "NVIDIA's OpenGL doubles"). Refused there rather than wrong.
+    L.float64 = !es_ && !doublesLoseBits(glString(GL_VENDOR));
     GLint bits = 0;
     // ES: timestamps only through EXT_disjoint_timer_query (gl_loader_es.cpp points glQueryCounter at it).
     if (!es_ || glad_glQueryCounter) glGetQueryiv(GL_TIMESTAMP, GL_QUERY_COUNTER_BITS, &bits);
@@ -456,6 +461,8 @@ std::unique_ptr<Backend> backendOf(Provider provider, const std::string& deviceS
 }
 
 }  // namespace
+
+bool doublesLoseBits(std::string_view vendor) { return vendor.find("NVIDIA") != std::string_view::npos; }
 
 std::unique_ptr<Backend> createBackend(const Options& options) {
   Provider provider = options.provider;

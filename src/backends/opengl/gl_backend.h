@@ -4,6 +4,7 @@
 #pragma once
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/backend.h"
@@ -25,6 +26,9 @@ struct ProgramResources {
   int groupSize[3] = {0, 0, 0};   // GL_COMPUTE_WORK_GROUP_SIZE
 };
 
+// Whether a GL driver of this GL_VENDOR rounds doubles to float inside the kernels (NVIDIA's: see
+// gl_backend.cpp), so that its devices report no float64.
+bool doublesLoseBits(std::string_view vendor);
 // One entry per headless provider that gives a GL 4.3+ core context. Throws a device Error when none does.
 std::vector<DeviceInfo> listDevices();
 std::unique_ptr<Backend> createBackend(const Options& options);
