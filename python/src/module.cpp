@@ -8,8 +8,11 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <cstring>
 #include <map>
 #include <memory>
+#include <string>
+#include <utility>
 
 #include <sffd/sffd.h>
 
@@ -32,6 +35,19 @@ PyObject* newException(py::module_& m, const char* name, py::tuple bases, const 
   return type;
 }
 
+// The library names its options as C++ does (DeformOptions::precision); a Python caller sets keywords.
+std::string inPythonWords(std::string what) {
+  static const std::pair<const char*, const char*> words[] = {
+      {"Precision::Float (or Auto) as DeformOptions::precision on an OpenGL ES device", "precision='float' (or 'auto') with backend='gles'"},
+      {"float precision (DeformOptions::precision)", "precision='float'"},
+      {"a longer edge length or a lower tessellation level", "a longer edge_length or a lower tess"},
+      {"(DeformOptions::once)", "(once=True)"},
+  };
+  for (const auto& [library, python] : words)
+    for (size_t at; (at = what.find(library)) != std::string::npos;) what.replace(at, std::strlen(library), python);
+  return what;
+}
+
 void registerErrors(py::module_& m) {
   gError = newException(m, "Error", py::make_tuple(py::handle(PyExc_Exception)), "Every error sffd raises; str() is one line.");
   gInputError = newException(m, "InputError", py::make_tuple(py::handle(gError), py::handle(PyExc_ValueError)),
@@ -49,7 +65,7 @@ void registerErrors(py::module_& m) {
                        : e.kind() == ErrorKind::Device ? gDeviceError
                        : e.kind() == ErrorKind::Cancelled ? gCancelled
                                                           : gInternalError;
-      PyErr_SetString(type, e.what());
+      PyErr_SetString(type, inPythonWords(e.what()).c_str());
     }
   });
 }

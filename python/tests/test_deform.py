@@ -326,3 +326,18 @@ def test_a_gl_deformer_is_used_and_collected_on_any_thread(sphere, label):
     worker.start()
     worker.join()
     assert not made
+
+
+def test_library_errors_name_the_python_keywords(sphere):
+    # The library's messages name DeformOptions' C++ members; Python callers see their keywords.
+    v, t, n = sphere
+    lat = sffd.Lattice.fitted(v)
+    if any(d.api == "gles" for d in sffd.devices()):
+        with pytest.raises(sffd.InputError) as e:
+            sffd.deform(v, t, lat, backend="gles", precision="double")
+        assert "precision='float' (or 'auto') with backend='gles'" in str(e.value) and "DeformOptions" not in str(e.value)
+    d = sffd.Deformer(v, t, lat, backend="cpu", once=True)
+    d.deform(lat)
+    with pytest.raises(sffd.InputError) as e:
+        d.deform(lat)
+    assert "(once=True)" in str(e.value) and "DeformOptions" not in str(e.value)

@@ -67,7 +67,9 @@ TEST(LocalFrame, ScaleIsOneForUsualSizesAndBringsOthersToSizeOne) {
 TEST(LocalFrame, ABoxBelowDoublesNormalRangeIsRefused) {
   const Mesh sphere = scaledMesh(uvSphere(false), std::ldexp(1.0, -1032));
   const Lattice lattice = makeIdentityLattice(glm::dvec3(std::ldexp(-1.0, -1031)), glm::dvec3(std::ldexp(1.0, -1031)), {4, 4, 4}, {2, 2, 2});
-  Device device = Device::open(DeviceRequest{.name = "cpu"});
+  DeviceRequest cpu;
+  cpu.name = "cpu";
+  Device device = Device::open(cpu);
   for (Method method : {Method::Smooth, Method::Classic, Method::Accurate}) {
     DeformOptions o;
     o.method = method;
