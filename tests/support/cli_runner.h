@@ -75,18 +75,17 @@ inline RunResult runSffd(const std::string& args, const std::string& env = "") {
   return r;
 }
 
-// Whether `sffd devices` lists a backend of that name here (asked once a process).
-inline bool hasDevice(const std::string& backend) {
-  static const std::string listed = "\n" + runSffd("devices").out;
-  return listed.find("\n" + backend + " ") != std::string::npos;
-}
-
-// Whether `sffd devices` lists that backend with double-precision kernels ("[f64]").
-inline bool hasDoubles(const std::string& backend) {
+// The line `sffd devices` gives a backend of that name here (asked once a process), or "" when it lists none.
+inline std::string deviceLine(const std::string& backend) {
   static const std::string listed = "\n" + runSffd("devices").out;
   size_t at = listed.find("\n" + backend + " ");
-  return at != std::string::npos && listed.substr(at + 1, listed.find('\n', at + 1) - at - 1).find("[f64]") != std::string::npos;
+  return at == std::string::npos ? std::string() : listed.substr(at + 1, listed.find('\n', at + 1) - at - 1);
 }
+
+inline bool hasDevice(const std::string& backend) { return !deviceLine(backend).empty(); }
+
+// Whether that backend runs double-precision kernels here ("[f64]" on its line).
+inline bool hasDoubles(const std::string& backend) { return deviceLine(backend).find("[f64]") != std::string::npos; }
 
 // Whether a test may run on backend `name`: this machine has it, or must have it (then its absence fails).
 inline bool usable(const std::string& backend) { return hasDevice(backend) || sffd::testing::requiredHere(backend); }
