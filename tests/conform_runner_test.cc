@@ -302,10 +302,17 @@ TEST(ConformRunner, ResultFilesAndFoldersAreCheckedBeforeTheRun) {
   // A --json that cannot be written after the --junit was: neither is left.
   RunResult j = runSffd(job + " --junit " + (dir / "j.xml").string() + " --json /proc/sffd-conform.json");
   EXPECT_EQ(j.status, 2) << j.err;
-  EXPECT_EQ(j.err, "sffd: error: /proc/sffd-conform.json: cannot write\n");
+  EXPECT_EQ(j.err, "sffd: error: /proc/sffd-conform.json: cannot write: No such file or directory\n");
   EXPECT_FALSE(fs::exists(dir / "j.xml"));
-  // Reports are written in place (/dev/stdout works); a write that fails is an error (into /dev/full the
-  // report was lost with exit status 0).
+  // A --junit file it replaced is put back (it was taken away), and nothing else is left beside it.
+  fs::create_directories(dir / "out");
+  std::ofstream(dir / "out" / "k.xml") << "the user's report";
+  j = runSffd(job + " --junit " + (dir / "out" / "k.xml").string() + " --json /proc/sffd-conform.json");
+  EXPECT_EQ(j.status, 2) << j.err;
+  EXPECT_EQ(slurp(dir / "out" / "k.xml"), "the user's report");
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir / "out"), fs::directory_iterator()), 1);
+  // A device, a pipe or the file stdout goes to is written in place (/dev/stdout works); a write that fails is
+  // an error (into /dev/full the report was lost with exit status 0).
   RunResult full = runSffd(job + " --json /dev/full");
   EXPECT_EQ(full.status, 2) << full.err;
   EXPECT_EQ(full.err, "sffd: error: /dev/full: cannot write: write failed (disk full?)\n");

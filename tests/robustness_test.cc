@@ -466,6 +466,47 @@ TEST_F(Robust, OptionsAndOutputPathsAreChecked) {
   }
 }
 
+// A small file that cannot be written once the output has replaced the user's file (a --stats in /proc passes
+// the checks made before the work, as a full disk or a folder removed during the run would): every file the
+// command replaced is as it was, a link stays a link, and nothing new is left. The output was taken away.
+TEST_F(Robust, AFailedCommandPutsBackTheFilesItReplaced) {
+  const std::string m = (kOdd / "partly_outside.obj").string(), l = (kOdd / "lattice_small_box_extrapolate.json").string();
+  const std::string bad = "/proc/sffd-robustness.json";
+  struct Case {
+    std::vector<std::string> args;
+    std::vector<std::string> replaced;   // files in out/ the user had
+  };
+  const std::vector<std::string> deform = {"deform", m, "-l", l, "--backend", "cpu", "--tess", "2"};
+  const std::vector<Case> cases = {
+      {{"--method", "classic", "-o", out("o.obj"), "--stats", bad}, {"o.obj"}},
+      {{"--method", "classic", "-o", out("o.gltf"), "--stats", bad}, {"o.gltf", "o.bin"}},
+      {{"-o", out("o.ply"), "--stats", bad}, {"o.ply"}},   // smooth into a .ply: streamed as it is made
+      {{"-o", out("o.ply"), "--patches", out("p.txt"), "--stats", bad}, {"o.ply", "p.txt"}},
+      {{"-o", out("o.ply"), "--patches", out("p.txt"), "--stats", bad}, {"p.txt"}},   // the output is new
+      {{"--method", "classic", "-o", out("link.obj"), "--stats", bad}, {"target.obj"}},
+      {{"clip"}, {"c.obj"}},
+  };
+  for (const Case& c : cases) {
+    std::vector<std::string> args = deform;
+    if (c.args[0] == "clip") args = {"clip", m, "-l", l, "--backend", "cpu", "-o", out("c.obj"), "--stats", bad};
+    else args.insert(args.end(), c.args.begin(), c.args.end());
+    std::string context;
+    for (const auto& a : args) context += a + " ";
+    for (const std::string& f : c.replaced) std::ofstream(out(f)) << "the user's " << f;
+    if (c.replaced[0] == "target.obj") fs::create_symlink("target.obj", out("link.obj"));
+    expectInputError(runSffd(args), bad + ": cannot write", context);
+    for (const std::string& f : c.replaced) {
+      EXPECT_EQ(slurp(out(f)), "the user's " + f) << context;
+      fs::remove(out(f));
+    }
+    if (c.replaced[0] == "target.obj") {
+      EXPECT_TRUE(fs::is_symlink(out("link.obj"))) << context;
+      fs::remove(out("link.obj"));
+    }
+    expectNothingWritten(context);
+  }
+}
+
 // A job above the memory limit is refused before the GPU work, with the numbers.
 TEST_F(Robust, JobAboveTheMemoryLimitIsRefused) {
   const std::string mesh = (kOdd / "polygon_1000.obj").string(), lattice = (kOdd / "lattice_small_box_extrapolate.json").string();

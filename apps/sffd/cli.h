@@ -9,6 +9,7 @@
 #include <sffd/device.h>
 #include <sffd/error.h>
 
+#include "io/atomic_file.h"
 #include "model/lattice.h"
 #include "model/mesh.h"
 
@@ -79,25 +80,29 @@ void meshBounds(const Mesh& mesh, glm::dvec3& lo, glm::dvec3& hi);
 // is no regular file.
 void checkOutputPath(const std::string& out, const std::vector<std::string>& inputs, bool renamed = true);
 
-// The files a command has written so far, removed again when it fails before keep() (a later file that
-// cannot be written, a later frame that fails): a failed command leaves nothing, not even whole files.
+// The files a command writes, as they were again when it fails before keep() (a later file that cannot be
+// written, a later frame that fails; an interrupt too, unless `keptOnInterrupt`): a failed command leaves
+// nothing, not even whole files, and takes none of the user's away (a --stats that failed took away the
+// output file it had replaced).
 class WrittenFiles {
  public:
-  WrittenFiles() = default;
+  explicit WrittenFiles(bool keptOnInterrupt = false) : keptOnInterrupt_(keptOnInterrupt) {}
   WrittenFiles(const WrittenFiles&) = delete;
   WrittenFiles& operator=(const WrittenFiles&) = delete;
   ~WrittenFiles();
-  // Before `path` is written: a file it will replace is moved aside, put back when the command fails and
-  // removed by keep() (animate's frames: a failing frame took away the user's files the earlier ones had
-  // replaced). A .gltf's .bin beside it too.
-  void willReplace(const std::string& path);
-  void add(const std::string& path);   // a .gltf's .bin beside it too
+  // Before `path` is written (a .gltf's .bin beside it too): a file there is kept aside, put back when the
+  // command fails and dropped by keep(); a file made there is removed then.
+  void willWrite(const std::string& path);
   void keep();
 
  private:
-  std::vector<std::string> paths_;
-  std::vector<std::pair<std::string, std::string>> asides_;   // (moved aside to, from)
+  bool keptOnInterrupt_;
+  std::vector<OutputUndo> files_;
 };
+
+// Whether `path` is the file stdout or stderr goes to (--json /dev/stdout > log): the shell's, written in
+// place, never moved or removed.
+bool isStandardStream(const std::string& path);
 
 // Opens the device the options ask for (--backend, --device), printing fallback notes unless --quiet.
 Device openDeviceFromArgs(const ParsedArgs& args);

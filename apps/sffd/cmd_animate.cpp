@@ -88,21 +88,25 @@ int run(const ParsedArgs& args) {
                   "the " + std::to_string(frames) + " frames of " + out,
                   "use fewer --frames, or numbered files (frame_%04d.ply), written one at a time");
   std::vector<Mesh> meshes;
-  WrittenFiles written;   // numbered frames: removed again when a later one fails, the files they replaced put back
+  // Numbered frames: as they were again when a later one fails; kept on an interrupt, as finished files (there
+  // may be thousands: more than the handler's fixed storage holds).
+  WrittenFiles written(/*keptOnInterrupt=*/numbered);
   for (int f = 0; f < frames; ++f) {
     if (f > 0) {
       run.deformer.deform(frameLattice(keys, f, frames));
       run.mesh = run.deformer.result();
     }
     if (numbered) {
-      written.willReplace(frameName(out, f));
+      written.willWrite(frameName(out, f));
       writeMesh(frameName(out, f), run.mesh, write);
-      written.add(frameName(out, f));
     } else {
       meshes.push_back(std::move(run.mesh));
     }
   }
-  if (!numbered) meshio::writeGltfAnimation(out, meshes, fps);
+  if (!numbered) {
+    written.willWrite(out);   // a .gltf's .bin is written first
+    meshio::writeGltfAnimation(out, meshes, fps);
+  }
   written.keep();
   note(args, "wrote " + (numbered ? std::to_string(frames) + " frames " + out : out + " (" + std::to_string(frames) + " frames)") + " (" +
                  device.label() + ", " + device.info().name + ")");

@@ -102,9 +102,9 @@ int run(const ParsedArgs& args) {
   }
   double clipMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - tc).count();
   Mesh result = subTriangleMesh(subs, args.has("--flat"));
+  WrittenFiles written;   // as they were again when a --stats cannot be written
+  written.willWrite(out);
   writeMesh(out, result, variant.f64 ? 17 : 9);
-  WrittenFiles written;   // a --stats that cannot be written takes the output away again
-  written.add(out);
 
   if (args.has("--stats")) {
     std::vector<std::array<glm::dvec3, 3>> flatTris;
@@ -136,6 +136,7 @@ int run(const ParsedArgs& args) {
         {"timings_ms", {{"pn", pn.wallMs}, {"clip", clipMs}, {"total", totalMs}}},
     };
     std::string text = j.dump(1) + "\n";
+    written.willWrite(args.get("--stats"));
     writeFileAtomically(args.get("--stats"), [&](std::ostream& o) { o << text; });
   }
   written.keep();

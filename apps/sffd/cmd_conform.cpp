@@ -181,12 +181,15 @@ int run(const ParsedArgs& args) {
   std::vector<Result> results = compareRuns(cases, runs, pairs);
   if (args.has("--baseline")) applyBaseline(results, args.get("--baseline"));
   printText(results, fromFile);
-  WrittenFiles written;   // a --json that cannot be written takes the --junit away again
+  WrittenFiles written;   // as they were again when the --json cannot be written after the --junit
   if (args.has("--junit")) {
+    written.willWrite(args.get("--junit"));
     writeJunit(args.get("--junit"), results);
-    written.add(args.get("--junit"));
   }
-  if (args.has("--json")) writeJson(args.get("--json"), cases, runs, results);
+  if (args.has("--json")) {
+    written.willWrite(args.get("--json"));
+    writeJson(args.get("--json"), cases, runs, results);
+  }
   written.keep();
   bool pass = true;
   for (const Result& r : results) pass = pass && !isFailure(r.status);

@@ -12,6 +12,7 @@
 #include <sffd/error.h>
 
 #include "apps/sffd/conform.h"
+#include "io/atomic_file.h"
 
 namespace sffd::cli::conform {
 
@@ -171,18 +172,19 @@ std::string xml(const std::string& s) {
   return o;
 }
 
-// Reports are written in place (--json /dev/stdout works): a write that fails is an error, and a plain file
-// it left half-written goes (into /dev/full the report was lost without a word, exit 0).
+// A report replaces a file as every output does (a temporary renamed into place: the file it replaces is
+// kept aside meanwhile, WrittenFiles); a pipe, a device or the file stdout goes to is written in place
+// (--json /dev/stdout works), where a write that fails is an error (into /dev/full the report was lost
+// without a word, exit 0).
 void writeReport(const std::string& path, const std::function<void(std::ostream&)>& write) {
+  std::error_code ec;
+  const fs::file_status st = fs::status(path, ec);
+  if ((!fs::exists(st) || fs::is_regular_file(st)) && !isStandardStream(path)) return writeFileAtomically(path, write);
   std::ofstream f(path);
   if (!f) throw Error(ErrorKind::Input, path + ": cannot write");
   write(f);
   f.flush();
-  if (f) return;
-  f.close();
-  std::error_code ec;
-  if (fs::is_regular_file(fs::symlink_status(path, ec))) fs::remove(path, ec);
-  throw Error(ErrorKind::Input, path + ": cannot write: write failed (disk full?)");
+  if (!f) throw Error(ErrorKind::Input, path + ": cannot write: write failed (disk full?)");
 }
 
 json numberOrNull(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }

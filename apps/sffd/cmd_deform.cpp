@@ -68,10 +68,12 @@ int run(const ParsedArgs& args) {
   // (--patches reads the Deformer again afterwards: then the result is taken as before).
   const bool streamed = methodOf(args.get("--method", "smooth")) != Method::Classic && !args.has("--patches") &&
                         MeshFileWriter::streams(out, {.binary = args.has("--binary")}, !job.mesh.colors.empty());
+  WrittenFiles written;   // as they were again when a later file fails (a --patches or --stats that cannot be written)
   std::unique_ptr<MeshFileWriter> writer;
   auto writerFor = [&](Deformer& d) -> MeshSink& {
     const MeshWriteOptions options{.significantDigits = d.resultDigits(), .binary = args.has("--binary")};
     checkSinkFits(d, MeshFileWriter::heldBytesPerVertex(out, options));
+    written.willWrite(out);
     writer = std::make_unique<MeshFileWriter>(out, options);
     return *writer;
   };
@@ -79,16 +81,16 @@ int run(const ParsedArgs& args) {
   const double checksMs = lap() - run.prepareMs - run.deformMs - run.resultMs;   // the lattice's fold, knot and coverage checks
   const Timings& t = run.deformer.timings();
   const Mesh& deformed = run.mesh;
-  if (!streamed)
+  if (!streamed) {
+    written.willWrite(out);
     writeMesh(out, deformed, MeshWriteOptions{.significantDigits = run.deformer.resultDigits(), .binary = args.has("--binary")});
+  }
   const double writeMs = lap();
   const size_t outVertices = streamed ? writer->vertexCount() : deformed.positions.size();
   const size_t outTriangles = streamed ? writer->triangleCount() : deformed.triangles.size();
-  WrittenFiles written;   // a --patches or --stats that cannot be written takes the output away again
-  written.add(out);
   if (args.has("--patches")) {
+    written.willWrite(args.get("--patches"));
     writePatchFile(args.get("--patches"), run, run.deformer.patchControlPoints());
-    written.add(args.get("--patches"));
   }
   double totalMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 
@@ -131,6 +133,7 @@ int run(const ParsedArgs& args) {
       if ((args.has("--split") && step.find('.') != std::string::npos) || step.rfind("accurate_", 0) == 0)
         j["timings_ms"][step] = ms;
     std::string text = j.dump(1) + "\n";
+    written.willWrite(args.get("--stats"));
     writeFileAtomically(args.get("--stats"), [&](std::ostream& o) { o << text; });
   }
   written.keep();

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <future>
 #include <optional>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <nlohmann/json.hpp>
@@ -183,41 +184,52 @@ void checkOutputPath(const std::string& out, const std::vector<std::string>& inp
     checkOutputPath(fs::path(replacedFile(out)).replace_extension(".bin").string(), files, renamed);
 }
 
-WrittenFiles::~WrittenFiles() {
-  for (const std::string& p : paths_) std::remove(p.c_str());
-  for (auto it = asides_.rbegin(); it != asides_.rend(); ++it) std::rename(it->first.c_str(), it->second.c_str());
+bool isStandardStream(const std::string& path) {
+  struct stat file {}, stream {};
+  if (::stat(path.c_str(), &file) != 0) return false;
+  for (int fd : {1, 2})
+    if (::fstat(fd, &stream) == 0 && stream.st_dev == file.st_dev && stream.st_ino == file.st_ino) return true;
+  return false;
 }
 
-void WrittenFiles::willReplace(const std::string& path) {
+WrittenFiles::~WrittenFiles() {
+  for (auto it = files_.rbegin(); it != files_.rend(); ++it) it->undo();   // the latest first, as an interrupt does
+}
+
+void WrittenFiles::willWrite(const std::string& path) {
+  // The file written, through a link as the writers write (the link stays).
   std::vector<std::string> files = {replacedFile(path)};
   if (io::lowerExtension(path) == ".gltf") files.push_back(fs::path(files[0]).replace_extension(".bin").string());
   for (const std::string& file : files) {
     std::error_code ec;
-    if (!fs::is_regular_file(fs::symlink_status(file, ec))) continue;
-    // Beside it (a rename within the folder), under a name no user file has.
+    const fs::file_status st = fs::symlink_status(file, ec);
+    // Written in place, no file of the command's: a device, a FIFO, the file the shell sends stdout to.
+    if ((fs::exists(st) && !fs::is_regular_file(st)) || isStandardStream(file)) continue;
+    if (!fs::exists(st)) {
+      files_.emplace_back(file, "", !keptOnInterrupt_);
+      continue;
+    }
+    // Beside it, under a name no user file has; registered before it exists.
     const std::string aside = (fs::path(file).parent_path() / (".sffd-replaced-" + std::to_string(::getpid()) + "-" +
-                                                               std::to_string(asides_.size())))
+                                                               std::to_string(files_.size())))
                                   .string();
-    if (std::rename(file.c_str(), aside.c_str()) != 0)
-      throw Error(ErrorKind::Input, file + ": cannot write: cannot move the file it replaces aside (" + std::strerror(errno) + ")");
-    asides_.emplace_back(aside, file);
+    files_.emplace_back(file, aside, !keptOnInterrupt_);
+    // A second link keeps the file in its place until the output is renamed onto it (a reader sees the old
+    // file or the new one); where the file system has no links, the file is moved aside meanwhile.
+    if (::link(file.c_str(), aside.c_str()) != 0 && std::rename(file.c_str(), aside.c_str()) != 0) {
+      const int e = errno;
+      files_.pop_back();
+      throw Error(ErrorKind::Input, file + ": cannot write: cannot keep the file it replaces aside (" + std::strerror(e) + ")");
+    }
   }
 }
 
 void WrittenFiles::keep() {
-  paths_.clear();
-  for (const auto& [aside, file] : asides_) std::remove(aside.c_str());
-  asides_.clear();
-}
-
-void WrittenFiles::add(const std::string& path) {
-  // The file written, through a link as the writers write (a link stays); only a plain file: a report written
-  // through /dev/stdout (conform's, in place) is no file of the command's.
-  const std::string file = replacedFile(path);
-  std::error_code ec;
-  if (!fs::is_regular_file(fs::symlink_status(file, ec))) return;
-  paths_.push_back(file);
-  if (io::lowerExtension(path) == ".gltf") paths_.push_back(fs::path(file).replace_extension(".bin").string());
+  std::vector<std::string> asides;
+  for (const OutputUndo& f : files_) asides.push_back(f.aside());
+  files_.clear();   // first: an interrupt from now on leaves the command's outputs
+  for (const std::string& aside : asides)
+    if (!aside.empty()) std::remove(aside.c_str());
 }
 
 Device openDeviceFromArgs(const ParsedArgs& args) {

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <mutex>
 #include <random>
+#include <utility>
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -22,18 +23,31 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// Temporary files being written, removed by the handler of SIGINT, SIGTERM and SIGHUP so that an
-// interrupted run leaves nothing behind. Fixed storage: the handler may only call async-signal-safe
-// functions (unlink, signal, raise) and read plain memory.
-constexpr int kSlots = 16;
+// What the handler of SIGINT, SIGTERM and SIGHUP undoes so that an interrupted run leaves nothing behind:
+// the temporary files being written (the first kTemporarySlots), then a command's outputs (OutputUndo, the
+// others). Fixed storage: the handler may only call async-signal-safe functions (unlink, rename, signal,
+// raise) and read plain memory.
+constexpr int kTemporarySlots = 16, kSlots = kTemporarySlots + 64;
 constexpr size_t kPathMax = 4096;
-char gTempPath[kSlots][kPathMax];
-volatile std::sig_atomic_t gTempUsed[kSlots];
-std::mutex gTempMutex;
+char gPath[kSlots][kPathMax], gAside[kSlots][kPathMax];
+volatile std::sig_atomic_t gUsed[kSlots];
+std::mutex gSlotMutex;
 
-extern "C" void removeTemporariesAndDie(int sig) {
-  for (int i = 0; i < kSlots; ++i)
-    if (gTempUsed[i]) ::unlink(gTempPath[i]);
+// One output undone: a file made removed, or the file it replaced, kept at `aside`, renamed back over it.
+// Twice is as once. A rename between two links to one file does nothing: where the file was never replaced,
+// its second name goes.
+void undoOutput(const char* path, const char* aside) {
+  if (!*aside) {
+    ::unlink(path);
+    return;
+  }
+  ::rename(aside, path);
+  ::unlink(aside);
+}
+
+extern "C" void undoAndDie(int sig) {
+  for (int i = kSlots; i-- > 0;)   // the latest first (slots are taken in order): a file replaced twice gets its first contents back
+    if (gUsed[i]) undoOutput(gPath[i], gAside[i]);
   std::signal(sig, SIG_DFL);
   std::raise(sig);
 }
@@ -47,7 +61,7 @@ void installInterruptHandlers() {
       struct sigaction old {};
       if (::sigaction(sig, nullptr, &old) == 0 && old.sa_handler == SIG_DFL) {
         struct sigaction sa {};
-        sa.sa_handler = removeTemporariesAndDie;
+        sa.sa_handler = undoAndDie;
         sigemptyset(&sa.sa_mask);
         ::sigaction(sig, &sa, nullptr);
       }
@@ -55,32 +69,38 @@ void installInterruptHandlers() {
   });
 }
 
-// Registers a temporary path for the handler while it exists; a path too long or more than kSlots at
-// once are simply not registered (they are still removed on every failure the program sees).
+// Registers `path` (and `aside`) for the handler in a free slot of [from, to); a path too long or no slot
+// free: not registered (still undone on every failure the program sees). The slot, or -1.
+int claimSlot(const std::string& path, const std::string& aside, int from, int to) {
+  installInterruptHandlers();
+  if (path.size() >= kPathMax || aside.size() >= kPathMax) return -1;
+  std::lock_guard<std::mutex> lock(gSlotMutex);
+  for (int i = from; i < to; ++i)
+    if (!gUsed[i]) {
+      std::memcpy(gPath[i], path.c_str(), path.size() + 1);
+      std::memcpy(gAside[i], aside.c_str(), aside.size() + 1);
+      gUsed[i] = 1;
+      return i;
+    }
+  return -1;
+}
+
+void releaseSlot(int slot) {
+  if (slot < 0) return;
+  std::lock_guard<std::mutex> lock(gSlotMutex);
+  gUsed[slot] = 0;
+}
+
+// A temporary path registered for the handler while it exists.
 class TemporaryGuard {
  public:
-  explicit TemporaryGuard(const std::string& path) {
-    installInterruptHandlers();
-    if (path.size() >= kPathMax) return;
-    std::lock_guard<std::mutex> lock(gTempMutex);
-    for (int i = 0; i < kSlots; ++i)
-      if (!gTempUsed[i]) {
-        std::memcpy(gTempPath[i], path.c_str(), path.size() + 1);
-        gTempUsed[i] = 1;
-        slot_ = i;
-        return;
-      }
-  }
-  ~TemporaryGuard() {
-    if (slot_ < 0) return;
-    std::lock_guard<std::mutex> lock(gTempMutex);
-    gTempUsed[slot_] = 0;
-  }
+  explicit TemporaryGuard(const std::string& path) : slot_(claimSlot(path, "", 0, kTemporarySlots)) {}
+  ~TemporaryGuard() { releaseSlot(slot_); }
   TemporaryGuard(const TemporaryGuard&) = delete;
   TemporaryGuard& operator=(const TemporaryGuard&) = delete;
 
  private:
-  int slot_ = -1;
+  int slot_;
 };
 
 std::string temporaryBeside(const std::string& path) {
@@ -209,5 +229,15 @@ void AtomicFile::commit() {
   impl_->committed = true;
   renameInto(impl_->tmp, impl_->file, impl_->path);   // removes the temporary file itself when the rename fails
 }
+
+OutputUndo::OutputUndo(std::string path, std::string aside, bool onInterrupt)
+    : path_(std::move(path)), aside_(std::move(aside)), slot_(onInterrupt ? claimSlot(path_, aside_, kTemporarySlots, kSlots) : -1) {}
+
+OutputUndo::OutputUndo(OutputUndo&& o) noexcept
+    : path_(std::move(o.path_)), aside_(std::move(o.aside_)), slot_(std::exchange(o.slot_, -1)) {}
+
+OutputUndo::~OutputUndo() { releaseSlot(slot_); }
+
+void OutputUndo::undo() const { undoOutput(path_.c_str(), aside_.c_str()); }
 
 }  // namespace sffd

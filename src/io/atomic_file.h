@@ -43,4 +43,23 @@ class AtomicFile {
   std::unique_ptr<Impl> impl_;
 };
 
+// One output of a command that writes several, undone when the command fails (undo()) or, with
+// `onInterrupt`, is interrupted (SIGINT, SIGTERM, SIGHUP: by the handler that removes the temporary files,
+// while this is held, the latest first): the file made at `path` removed, or, where `aside` names the file it
+// replaced (kept there: a second link to it, or the file moved), that put back. At most 64 held at once are
+// undone by an interrupt.
+class OutputUndo {
+ public:
+  OutputUndo(std::string path, std::string aside, bool onInterrupt);
+  OutputUndo(OutputUndo&& o) noexcept;
+  OutputUndo& operator=(OutputUndo&&) = delete;
+  ~OutputUndo();   // undoes nothing
+  void undo() const;
+  const std::string& aside() const { return aside_; }
+
+ private:
+  std::string path_, aside_;
+  int slot_;
+};
+
 }  // namespace sffd
