@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cstdio>
 #include <map>
+#include <set>
 
 #include <nlohmann/json.hpp>
 
@@ -108,6 +109,13 @@ int run(const ParsedArgs& args) {
   S.warmup = args.getInt("--warmup", 2);
   if (S.repeat < 1 || S.repeat > 100000) throw Error(ErrorKind::Input, "--repeat must be 1..100000");
   if (S.warmup < 0 || S.warmup > 100000) throw Error(ErrorKind::Input, "--warmup must be 0..100000");
+  const std::vector<std::string> names = args.getList("--backends", "vulkan,gl");
+  if (names.empty()) throw Error(ErrorKind::Input, "--backends names no backend");
+  // Named backends only, checked before any runs (docs/CLI.md): auto would time one of them again under its
+  // name, and gl-glfw the GL driver gl-egl times, in a window.
+  static const std::set<std::string> known{"vulkan", "gl", "gl-egl", "gl-osmesa", "gles", "cpu"};
+  for (const std::string& n : names)
+    if (!known.count(n)) throw Error(ErrorKind::Input, "--backends: unknown backend '" + n + "' (vulkan, gl, gl-egl, gl-osmesa, gles, cpu)");
   Job job = loadJob(args);
   DeformOptions& o = S.options;
   o.strict = args.has("--strict");
@@ -123,9 +131,6 @@ int run(const ParsedArgs& args) {
   if (args.get("--precision", "float") == "double") o.precision = Precision::Double;
   else if (args.get("--precision", "float") != "float") throw Error(ErrorKind::Input, "--precision must be float or double");
   else o.precision = Precision::Float;
-
-  const std::vector<std::string> names = args.getList("--backends", "vulkan,gl");
-  if (names.empty()) throw Error(ErrorKind::Input, "--backends names no backend");
 
   std::vector<BackendResult> results;
   for (const std::string& name : names) {
