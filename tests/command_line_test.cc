@@ -138,6 +138,32 @@ TEST_F(CommandLine, BenchNamesExactlyTheBackendsItTakes) {
   }
 }
 
+// A number past an int's range gave "option --repeat needs an integer, not '99999999999'" (a list option: "needs one
+// integer for all axes or three"), without the range that a smaller wrong number was told.
+TEST_F(CommandLine, IntegerOptionsNameTheirRange) {
+  const std::string job = box_ + " -l " + lattice_, huge = "99999999999";
+  const std::pair<std::string, std::string> refused[] = {
+      {"bench " + job + " --repeat " + huge, "option --repeat needs an integer 1..100000, not '" + huge + "'"},
+      {"bench " + job + " --repeat 0", "option --repeat needs an integer 1..100000, not '0'"},
+      {"bench " + job + " --warmup -" + huge, "option --warmup needs an integer 0..100000, not '-" + huge + "'"},
+      {"bench " + job + " --tess " + huge, "--tess must be an integer 1..64, not '" + huge + "'"},
+      {"conform " + job + " --backends cpu,cpu --tess " + huge, "box: option --tess needs an integer 1..64, not '" + huge + "'"},
+      {"animate " + job + " -l " + lattice_ + " -o " + out("a.glb") + " --frames " + huge,
+       "option --frames needs an integer 2..10000, not '" + huge + "'"},
+      {"render " + box_ + " -o " + out("p.png") + " --width " + huge, "option --width needs an integer 16..8192, not '" + huge + "'"},
+      {"deform " + std::string(SFFD_TEST_DATA) + "/teapot.bpt -l " + lattice_ + " -o " + out("o.obj") + " --bpt-resolution " + huge,
+       "option --bpt-resolution needs an integer 1..1000, not '" + huge + "'"},
+      {"lattice " + box_ + " -o " + out("x.json") + " --counts 5," + huge + ",5",
+       "option --counts needs one integer 2..64 for all axes or three, not '5," + huge + ",5'"},
+      {"lattice " + box_ + " -o " + out("x.json") + " --counts 65", "option --counts needs one integer 2..64 for all axes or three, not '65'"},
+      {"lattice " + box_ + " -o " + out("x.json") + " --degree " + huge, "option --degree needs one integer 1..5 for all axes or three"},
+      {"lattice --from " + lattice_ + " -o " + out("x.json") + " --refine " + huge, "option --refine needs one integer 1..64 for all axes"},
+      {"lattice --from " + lattice_ + " -o " + out("x.json") + " --elevate " + huge, "option --elevate needs one integer 0..4 for all axes"},
+  };
+  for (const auto& [args, message] : refused) expectUsageError(runSffd(args), message);
+  for (const char* name : {"a.glb", "p.png", "o.obj", "x.json"}) EXPECT_FALSE(fs::exists(dir_ / name)) << name;
+}
+
 // lavapipe cannot finish a smooth job in a microsecond: the wait gives up with a device error.
 TEST_F(CommandLine, DeviceWaitTimesOutAsADeviceError) {
   RunResult r = runSffd("deform " + box_ + " -l " + lattice_ + " --backend vulkan --tess 32 --edge-length 0.05 -o " + out("o.obj"),

@@ -53,8 +53,7 @@ int run(const ParsedArgs& args) {
   const std::vector<std::string> paths = args.all("--lattice");
   if (paths.size() < 2) throw Error(ErrorKind::Input, "animate needs at least two lattices (-l L0 -l L1 ...)");
   if (!args.has("--frames")) throw Error(ErrorKind::Input, "animate needs --frames N (2..10000): how many frames to make");
-  const int frames = args.getInt("--frames", 0);
-  if (frames < 2 || frames > 10000) throw Error(ErrorKind::Input, "--frames must be 2..10000");
+  const int frames = args.getInt("--frames", 0, 2, 10000);
   const double fps = args.getDouble("--fps", 24.0);
   if (!std::isfinite(fps) || !(fps > 0) || fps > 1000) throw Error(ErrorKind::Input, "--fps must be a number in (0, 1000]");
   const bool numbered = isFramePattern(out);
