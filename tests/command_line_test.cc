@@ -164,6 +164,24 @@ TEST_F(CommandLine, IntegerOptionsNameTheirRange) {
   for (const char* name : {"a.glb", "p.png", "o.obj", "x.json"}) EXPECT_FALSE(fs::exists(dir_ / name)) << name;
 }
 
+// animate's -o is read as printf would, its one conversion the frame number: "%5d" wrote "f_    0.obj" (spaces
+// in the names), "f_%%_%d.obj" was refused as no pattern and "x%%.glb" written under that name.
+TEST_F(CommandLine, AnimateNamesAreReadAsPrintfWould) {
+  const std::string animate = "animate " + box_ + " -l " + lattice_ + " -l " + lattice_ + " --frames 2 --backend cpu --quiet -o ";
+  for (const char* bad : {"f_%5d.obj", "f_%-3d.obj", "f_%x.obj", "f_%d_%d.obj", "f_%00005d.obj", "x%.glb"})
+    expectUsageError(runSffd(animate + out(bad)), "-o " + out(bad) + ": numbered files take one frame number, %d or %0Nd (zero-padded "
+                                                  "to N digits, like frame_%04d.ply), and %% for a literal %");
+  for (const fs::directory_entry& e : fs::directory_iterator(dir_))   // nothing written
+    EXPECT_TRUE(e.path().filename() == "box.obj" || e.path().filename() == "l.json") << e.path();
+  RunResult r = runSffd(animate + out("f_%%_%03d.obj"));
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir_ / "f_%_000.obj") && fs::exists(dir_ / "f_%_001.obj"));
+  r = runSffd(animate + out("x%%.glb"));
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir_ / "x%.glb"));
+  EXPECT_FALSE(fs::exists(dir_ / "x%%.glb"));
+}
+
 // lavapipe cannot finish a smooth job in a microsecond: the wait gives up with a device error.
 TEST_F(CommandLine, DeviceWaitTimesOutAsADeviceError) {
   RunResult r = runSffd("deform " + box_ + " -l " + lattice_ + " --backend vulkan --tess 32 --edge-length 0.05 -o " + out("o.obj"),
