@@ -97,7 +97,7 @@ TEST(LatticeCommand, RefusesWithOneLineAndWritesNothing) {
   } cases[] = {
       {"--from " + base.string() + " -o " + (dir / "x.txt").string(), "expected .json, .npy, .prm or .vtk"},
       {"--from " + base.string() + " -o " + (dir / "x.json").string() + " --elevate 4", "degrees stay within 1..5"},
-      {"--from " + base.string() + " -o " + (dir / "x.json").string() + " --refine 0", "1..64 parts"},
+      {"--from " + base.string() + " -o " + (dir / "x.json").string() + " --refine 0", "option --refine needs one integer 1..64 for all axes or three, not '0'"},
       {"--from " + base.string() + " -o " + (dir / "x.json").string() + " --refine 2,2", "one integer for all axes or three"},
       {"--from " + base.string() + " -o " + (dir / "x.json").string() + " --counts 3", "with --from the lattice's own is kept"},
       // Ignored before: the lattice's own degree kept, nothing normalised.

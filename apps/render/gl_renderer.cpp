@@ -86,12 +86,6 @@ glm::vec3 toLinear(glm::vec3 c) {
   return {std::pow(std::max(c.r, 0.f), 2.2f), std::pow(std::max(c.g, 0.f), 2.2f), std::pow(std::max(c.b, 0.f), 2.2f)};
 }
 
-std::string formatNumber(float v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g", static_cast<double>(v));
-  return buf;
-}
-
 glm::dvec3 axisVector(UpAxis a) {
   switch (a) {
     case UpAxis::PosX: return {1, 0, 0};
@@ -136,6 +130,21 @@ UpAxis upAxisFor(const std::string& option, const std::string& meshPath) {
   std::string ext = std::filesystem::path(meshPath).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
   return ext == ".gltf" || ext == ".glb" ? UpAxis::PosY : UpAxis::PosZ;
+}
+
+std::array<std::string, 2> legendLabels(float lo, float hi) {
+  // One format for both ends: each label on its own ("%.3g") put 4.11E-13 under 0.00807.
+  const double big = std::max(std::fabs(double(lo)), std::fabs(double(hi)));
+  char a[32], b[32];
+  if (big == 0 || (big >= 1e-3 && big < 1e5)) {
+    const int decimals = big == 0 ? 0 : std::max(0, 2 - int(std::floor(std::log10(big))));   // 3 digits of the larger
+    std::snprintf(a, sizeof a, "%.*f", decimals, double(lo));
+    std::snprintf(b, sizeof b, "%.*f", decimals, double(hi));
+  } else {
+    std::snprintf(a, sizeof a, "%.2e", double(lo));
+    std::snprintf(b, sizeof b, "%.2e", double(hi));
+  }
+  return {a, b};
 }
 
 glm::vec3 viridis(float t) {
@@ -469,7 +478,7 @@ Renderer::Frame Renderer::frame(const RenderOptions& o, int width, int height) c
   }
   if (o.scalarRange) sMin = (*o.scalarRange)[0], sMax = (*o.scalarRange)[1];
   if (!std::isfinite(sMin) || !std::isfinite(sMax)) sMin = 0, sMax = 1;
-  const std::string maxLabel = formatNumber(sMax), minLabel = formatNumber(sMin);
+  const auto [minLabel, maxLabel] = legendLabels(sMin, sMax);
   float legendW = 0;
   if (anyScalars && o.legend) {
     legendW = std::max({Overlay::textWidth(maxLabel, scale), Overlay::textWidth(minLabel, scale), 8 * scale}) + 10 * scale;

@@ -162,6 +162,9 @@ class Renderer {
 
 // Viridis, the perceptually uniform colormap (sRGB, t clamped to [0, 1]).
 glm::vec3 viridis(float t);
+// The legend's labels of lo and hi in one format: fixed, with three significant digits of the larger end, or
+// both in scientific notation where that end is below 1e-3 or from 1e5 up.
+std::array<std::string, 2> legendLabels(float lo, float hi);
 
 
 }  // namespace sffd::gl

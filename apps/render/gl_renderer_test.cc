@@ -236,6 +236,18 @@ TEST(Viridis, Ends) {
   EXPECT_EQ(viridis(7), hi);
 }
 
+// Both ends of a legend in one format (render --color-by geometry drew 0.00807 above 4.11E-13).
+TEST(LegendLabels, BothEndsInOneFormat) {
+  using Labels = std::array<std::string, 2>;
+  EXPECT_EQ(legendLabels(4.11e-13f, 0.00807f), (Labels{"0.00000", "0.00807"}));
+  EXPECT_EQ(legendLabels(0.0f, 0.133f), (Labels{"0.000", "0.133"}));
+  EXPECT_EQ(legendLabels(0.5f, 12.5f), (Labels{"0.5", "12.5"}));
+  EXPECT_EQ(legendLabels(0.0f, 175.0f), (Labels{"0", "175"}));
+  EXPECT_EQ(legendLabels(0.0f, 0.0f), (Labels{"0", "0"}));
+  EXPECT_EQ(legendLabels(4.11e-13f, 8.07e-6f), (Labels{"4.11e-13", "8.07e-06"}));
+  EXPECT_EQ(legendLabels(2.0f, 123456.0f), (Labels{"2.00e+00", "1.23e+05"}));
+}
+
 TEST_F(RendererTest, WireframeDarkensTheEdges) {
   Mesh sphere = makeSphere(1.0, glm::dvec3(0), 24, 12);
   RenderOptions o = smallOptions();

@@ -154,6 +154,18 @@ int ParsedArgs::getInt(const std::string& name, int fallback) const {
   return v;
 }
 
+int ParsedArgs::getInt(const std::string& name, int fallback, int lo, int hi) const {
+  auto it = values.find(name);
+  if (it == values.end()) return fallback;
+  const std::string& s = it->second;
+  int v = 0;
+  auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  // A word, a number past int's range and one outside lo..hi get the one message that names the range.
+  if (ec != std::errc() || p != s.data() + s.size() || v < lo || v > hi)
+    throw usage("option " + name + " needs an integer " + std::to_string(lo) + ".." + std::to_string(hi) + ", not '" + s + "'");
+  return v;
+}
+
 std::vector<std::string> ParsedArgs::getList(const std::string& name, const std::string& fallback) const {
   const std::string text = get(name, fallback);
   std::vector<std::string> out;
@@ -167,21 +179,23 @@ std::vector<std::string> ParsedArgs::getList(const std::string& name, const std:
   }
 }
 
-std::array<int, 3> ParsedArgs::getTriple(const std::string& name, std::array<int, 3> fallback) const {
+std::array<int, 3> ParsedArgs::getTriple(const std::string& name, std::array<int, 3> fallback, int lo, int hi) const {
   auto it = values.find(name);
   if (it == values.end()) return fallback;
   std::array<int, 3> r{};
   const std::string& s = it->second;
   int n = 0;
+  bool outside = false;   // a number, but past lo..hi (or int's range)
   // Every part between commas must be an integer, an empty last one too ("5,5,5," and "5," are refused).
   for (size_t start = 0;;) {
     const size_t comma = s.find(',', start), end = comma == std::string::npos ? s.size() : comma;
     int v = 0;
     auto [p, ec] = std::from_chars(s.data() + start, s.data() + end, v);
-    if (n >= 3 || ec != std::errc() || p != s.data() + end) {
+    if (n >= 3 || p != s.data() + end || (ec != std::errc() && ec != std::errc::result_out_of_range)) {
       n = 4;
       break;
     }
+    outside |= ec != std::errc() || v < lo || v > hi;
     r[n++] = v;
     if (comma == std::string::npos) break;
     start = comma + 1;
@@ -190,6 +204,9 @@ std::array<int, 3> ParsedArgs::getTriple(const std::string& name, std::array<int
   if (n == 1) r = {r[0], r[0], r[0]};
   else if (n != 3)
     throw usage("option " + name + " needs one integer for all axes or three (U,V,W) like 5 or 5,6,7, not '" + it->second + "'");
+  if (outside)
+    throw usage("option " + name + " needs one integer " + std::to_string(lo) + ".." + std::to_string(hi) +
+                " for all axes or three, not '" + it->second + "'");
   return r;
 }
 

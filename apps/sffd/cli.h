@@ -43,7 +43,10 @@ struct ParsedArgs {
   std::string get(const std::string& name, const std::string& fallback = "") const;
   double getDouble(const std::string& name, double fallback) const;
   int getInt(const std::string& name, int fallback) const;
-  std::array<int, 3> getTriple(const std::string& name, std::array<int, 3> fallback) const;
+  // An integer lo..hi; anything else is refused with a message that names the range.
+  int getInt(const std::string& name, int fallback, int lo, int hi) const;
+  // One integer lo..hi for every axis, or three (docs/CLI.md).
+  std::array<int, 3> getTriple(const std::string& name, std::array<int, 3> fallback, int lo, int hi) const;
   // A comma-separated list of names (--backends, --require); an empty name ("cpu,", "a,,b") is refused.
   std::vector<std::string> getList(const std::string& name, const std::string& fallback) const;
   std::string requireValue(const std::string& name) const;

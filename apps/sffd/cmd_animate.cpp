@@ -25,13 +25,24 @@ std::string frameName(const std::string& pattern, int f) {
   return name;
 }
 
-// A pattern is accepted when its one '%' starts a %d conversion with an optional zero-padded width.
+// Whether -o numbers its frames, read as printf would: "%%" is a '%', and one "%d" or "%0Nd" (zero-padded
+// to N digits, N up to 99) the frame number. Any other '%' is refused rather than taken literally or passed
+// to printf: "%5d" padded with spaces into the names, and "100%%_%d.obj" was refused as no pattern.
 bool isFramePattern(const std::string& out) {
-  const size_t p = out.find('%');
-  if (p == std::string::npos || out.find('%', p + 1) != std::string::npos) return false;
-  size_t i = p + 1;
-  while (i < out.size() && std::isdigit(static_cast<unsigned char>(out[i]))) ++i;
-  return i < out.size() && out[i] == 'd' && i - p <= 4;
+  int numbers = 0;
+  for (size_t p = out.find('%'); p != std::string::npos; p = out.find('%', p)) {
+    size_t i = p + 1;
+    if (i < out.size() && out[i] == '%') {
+      p = i + 1;
+      continue;
+    }
+    while (i < out.size() && std::isdigit(static_cast<unsigned char>(out[i]))) ++i;
+    if (i >= out.size() || out[i] != 'd' || (i > p + 1 && out[p + 1] != '0') || i - p > 4 || ++numbers > 1)
+      throw Error(ErrorKind::Input, "-o " + out + ": numbered files take one frame number, %d or %0Nd (zero-padded to N digits, "
+                                    "like frame_%04d.ply), and %% for a literal %");
+    p = i + 1;
+  }
+  return numbers == 1;
 }
 
 // Frame f of `frames`: key lattices spread evenly over the frames, control points interpolated
@@ -53,11 +64,11 @@ int run(const ParsedArgs& args) {
   const std::vector<std::string> paths = args.all("--lattice");
   if (paths.size() < 2) throw Error(ErrorKind::Input, "animate needs at least two lattices (-l L0 -l L1 ...)");
   if (!args.has("--frames")) throw Error(ErrorKind::Input, "animate needs --frames N (2..10000): how many frames to make");
-  const int frames = args.getInt("--frames", 0);
-  if (frames < 2 || frames > 10000) throw Error(ErrorKind::Input, "--frames must be 2..10000");
+  const int frames = args.getInt("--frames", 0, 2, 10000);
   const double fps = args.getDouble("--fps", 24.0);
   if (!std::isfinite(fps) || !(fps > 0) || fps > 1000) throw Error(ErrorKind::Input, "--fps must be a number in (0, 1000]");
   const bool numbered = isFramePattern(out);
+  const std::string gltf = numbered ? "" : frameName(out, 0);   // "%%" is a '%' there too
   if (numbered && args.has("--fps")) throw Error(ErrorKind::Input, "--fps times a glTF animation; numbered files have no times");
   // glTF keeps the key times as floats: the last frame's, (N-1)/F seconds, must be one.
   if (!numbered && !(double(frames - 1) / fps <= std::numeric_limits<float>::max()))
@@ -68,7 +79,7 @@ int run(const ParsedArgs& args) {
   if (args.has("--binary") && ext != ".ply" && ext != ".stl") throw Error(ErrorKind::Input, "--binary writes .ply and .stl, not '" + ext + "'");
   std::vector<std::string> inputs = paths;
   inputs.push_back(args.positional[0]);
-  for (int f = 0; f < (numbered ? frames : 1); ++f) checkOutputPath(numbered ? frameName(out, f) : out, inputs);
+  for (int f = 0; f < (numbered ? frames : 1); ++f) checkOutputPath(numbered ? frameName(out, f) : gltf, inputs);
 
   Job job = loadJob(args);
   std::vector<Lattice> keys = {job.lattice};
@@ -85,7 +96,7 @@ int run(const ParsedArgs& args) {
   // before the others are made (10,000 frames of a smooth cube took 80 GB).
   if (!numbered)
     checkKeptFits(run.deformer, uint64_t(frames) * (meshHeldBytes(run.mesh) + 6 * sizeof(float) * run.mesh.positions.size()),
-                  "the " + std::to_string(frames) + " frames of " + out,
+                  "the " + std::to_string(frames) + " frames of " + gltf,
                   "use fewer --frames, or numbered files (frame_%04d.ply), written one at a time");
   std::vector<Mesh> meshes;
   // Numbered frames: as they were again when a later one fails; kept on an interrupt, as finished files (there
@@ -104,11 +115,11 @@ int run(const ParsedArgs& args) {
     }
   }
   if (!numbered) {
-    written.willWrite(out);   // a .gltf's .bin is written first
-    meshio::writeGltfAnimation(out, meshes, fps);
+    written.willWrite(gltf);   // a .gltf's .bin is written first
+    meshio::writeGltfAnimation(gltf, meshes, fps);
   }
   written.keep();
-  note(args, "wrote " + (numbered ? std::to_string(frames) + " frames " + out : out + " (" + std::to_string(frames) + " frames)") + " (" +
+  note(args, "wrote " + (numbered ? std::to_string(frames) + " frames " + out : gltf + " (" + std::to_string(frames) + " frames)") + " (" +
                  device.label() + ", " + device.info().name + ")");
   return 0;
 }

@@ -49,9 +49,11 @@ void checkCase(const Case& c) {
     throw Error(ErrorKind::Input, c.name + ": --method must be smooth, accurate or classic, not '" + m + "'");
   if (clip != "regular" && clip != "knot-box") throw Error(ErrorKind::Input, c.name + ": --clip must be regular or knot-box");
   if (p != "float" && p != "double") throw Error(ErrorKind::Input, c.name + ": --precision must be float or double");
-  const int tess = c.args.getInt("--tess", 10);
-  if (tess < 1 || tess > kMaxTessLevel)
-    throw Error(ErrorKind::Input, c.name + ": --tess must be 1.." + std::to_string(kMaxTessLevel));
+  try {
+    c.args.getInt("--tess", 10, 1, kMaxTessLevel);
+  } catch (const Error& e) {
+    throw Error(ErrorKind::Input, c.name + ": " + e.what());
+  }
   for (const std::string& f : {c.args.positional.at(0), c.args.requireValue("--lattice")})
     if (!fs::is_regular_file(f)) throw Error(ErrorKind::Input, c.name + ": " + f + ": no such file");
 }

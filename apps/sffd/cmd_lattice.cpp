@@ -25,13 +25,10 @@ void applyPreset(Lattice& lattice, std::string p) {
 }
 
 Lattice fittedLattice(const ParsedArgs& args) {
-  std::array<int, 3> counts = args.getTriple("--counts", {5, 5, 5});
-  std::array<int, 3> degree = args.getTriple("--degree", {2, 2, 2});
-  for (int a = 0; a < 3; ++a) {
-    if (degree[a] < 1 || degree[a] > 5) throw Error(ErrorKind::Input, "--degree values must be in 1..5");
+  std::array<int, 3> counts = args.getTriple("--counts", {5, 5, 5}, 2, 64);
+  std::array<int, 3> degree = args.getTriple("--degree", {2, 2, 2}, 1, 5);
+  for (int a = 0; a < 3; ++a)
     if (counts[a] <= degree[a]) throw Error(ErrorKind::Input, "--counts must exceed --degree on every axis");
-    if (counts[a] > 64) throw Error(ErrorKind::Input, "--counts above 64 per axis is not supported by `sffd lattice`");
-  }
   Mesh mesh = readMeshWarning(args.positional[0]);
   if (args.has("--normalize")) {
     double s = args.getDouble("--normalize", 1.0);
@@ -57,7 +54,7 @@ Lattice latticeFrom(const ParsedArgs& args) {
   if (args.positional.empty()) {
     LatticeReadOptions read;
     read.memoryLimit = memoryLimitFromEnvironment();
-    read.npyDegree = args.getTriple("--degree", {2, 2, 2});
+    read.npyDegree = args.getTriple("--degree", {2, 2, 2}, 1, 5);
     if (io::lowerExtension(from) == ".npy")
       throw Error(ErrorKind::Input, from + ": a .npy lattice has no box of its own: give the MESH it belongs to (sffd lattice MESH --from " + from + " ...)");
     return withToolLimitName([&] { return readLattice(from, read); });
@@ -82,9 +79,9 @@ int run(const ParsedArgs& args) {
   const std::string source = args.has("--from") ? args.get("--from") : out;
   const uint64_t limit = memoryLimitFromEnvironment();
   if (args.has("--refine"))
-    lattice = withToolLimitName([&] { return refineLattice(lattice, args.getTriple("--refine", {1, 1, 1}), source, limit); });
+    lattice = withToolLimitName([&] { return refineLattice(lattice, args.getTriple("--refine", {1, 1, 1}, 1, 64), source, limit); });
   if (args.has("--elevate"))
-    lattice = withToolLimitName([&] { return elevateLattice(lattice, args.getTriple("--elevate", {0, 0, 0}), source, limit); });
+    lattice = withToolLimitName([&] { return elevateLattice(lattice, args.getTriple("--elevate", {0, 0, 0}, 0, 4), source, limit); });
   if (args.has("--preset")) applyPreset(lattice, args.get("--preset"));
   writeLattice(out, lattice);
   note(args, "wrote " + out + " (" + std::to_string(lattice.counts[0]) + "x" + std::to_string(lattice.counts[1]) + "x" +

@@ -24,9 +24,7 @@ Error usageError(const std::string& what) { return Error(ErrorKind::Input, what)
 }  // namespace
 
 int sizeOption(const ParsedArgs& args, const char* name, int fallback) {
-  int v = args.getInt(name, fallback);
-  if (v < 16 || v > 8192) throw usageError(std::string("option ") + name + " must be 16..8192 pixels, not " + std::to_string(v));
-  return v;
+  return args.getInt(name, fallback, 16, 8192);
 }
 
 // --view AZ,EL in degrees.

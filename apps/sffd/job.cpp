@@ -94,10 +94,7 @@ Job loadJob(const ParsedArgs& args) {
   job.meshPath = args.positional.at(0);
   job.latticePath = args.requireValue("--lattice");
   MeshReadOptions read;
-  if (args.has("--bpt-resolution")) {
-    read.bptResolution = args.getInt("--bpt-resolution", 10);
-    if (read.bptResolution < 1 || read.bptResolution > 1000) throw Error(ErrorKind::Input, "--bpt-resolution must be 1..1000");
-  }
+  if (args.has("--bpt-resolution")) read.bptResolution = args.getInt("--bpt-resolution", 10, 1, 1000);
   job.mesh = readMeshWarning(job.meshPath, read);
   if (args.has("--ignore-normals") && job.mesh.normalsFromFile) {
     computeVertexNormals(job.mesh);
@@ -124,7 +121,7 @@ Lattice loadJobLattice(const ParsedArgs& args, const Job& job, const std::string
   if (args.has("--degree") && ext != ".npy")
     throw Error(ErrorKind::Input, "--degree is a .npy lattice's; " + latticePath + " keeps its own (sffd lattice --from L --elevate raises it)");
   LatticeReadOptions lo;
-  lo.npyDegree = args.getTriple("--degree", {2, 2, 2});
+  lo.npyDegree = args.getTriple("--degree", {2, 2, 2}, 1, 5);
   meshBounds(job.mesh, lo.meshBoxLo, lo.meshBoxHi);
   // .npy (reference implementation): the body box is the model's box normalised into [-1,1]^3 and
   // the model itself sits at the --normalize scale inside it (0.99: strictly inside). The shared

@@ -9,6 +9,8 @@
 #include "backends/cpu/cpu_backend.h"
 #include "core/device_timeout.h"
 #include "core/huge_pages.h"
+#include "core/kernel_registry.h"
+#include "core/shader_binary_cache.h"
 #include <sffd/sffd.h>
 
 using namespace sffd;
@@ -69,6 +71,10 @@ int main(int argc, char** argv) {
       }
       checkDeviceTimeoutVariable();
       checkCpuThreadsVariable();
+      checkCpuAvx2Variable();
+      checkHugePagesVariable();
+      checkShaderCacheDisableVariable();
+      checkStrictRoundingVariable();
       const int status = c.run(args);
       if (status == 0)
         for (const std::string& w : cli::takeWarnings()) std::fprintf(stderr, "sffd: warning: %s\n", oneLine(w.c_str()).c_str());

@@ -4,6 +4,8 @@
 #include <cstdlib>
 #include <fstream>
 
+#include <sffd/error.h>
+
 #if defined(__linux__)
 #include <sys/mman.h>
 #include <unistd.h>
@@ -44,9 +46,17 @@ std::optional<std::string> tunablesForHugePages(const char* current, std::string
 #define SFFD_MALLOC_IS_GLIBC 1
 #endif
 
+void checkHugePagesVariable() {
+  const char* v = std::getenv("SFFD_HUGE_PAGES");
+  if (v && *v && std::string_view(v) != "0" && std::string_view(v) != "1")
+    throw Error(ErrorKind::Input, std::string("SFFD_HUGE_PAGES must be 0 or 1, not '") + v + "'");
+}
+
 void restartWithHugePages(char** argv) {
 #if SFFD_MALLOC_IS_GLIBC && defined(__linux__) && defined(__GLIBC__) && (__GLIBC__ > 2 || __GLIBC_MINOR__ >= 35)
-  if (const char* off = std::getenv("SFFD_HUGE_PAGES"); off && std::string_view(off) == "0") return;
+  // Only unset, empty or 1 restarts: 0 turns it off, and anything else is refused once the tool runs
+  // (checkHugePagesVariable), which a restart first would only delay.
+  if (const char* v = std::getenv("SFFD_HUGE_PAGES"); v && *v && std::string_view(v) != "1") return;
   std::ifstream file("/sys/kernel/mm/transparent_hugepage/enabled");
   std::string line;
   std::getline(file, line);

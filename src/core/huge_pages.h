@@ -45,8 +45,11 @@ std::optional<std::string> tunablesForHugePages(const char* current, std::string
 // Starts the program again (execv of /proc/self/exe, same arguments, same process id) with
 // tunablesForHugePages() in its environment: a tunable is read only at start-up. Returns, and the
 // program goes on as it is, where that does not apply (not Linux with glibc 2.35 or later, a sanitizer's
-// malloc, nothing to change, SFFD_HUGE_PAGES=0) or the restart fails. For a program's main(), before
-// anything else.
+// malloc, nothing to change, SFFD_HUGE_PAGES set to anything but 1) or the restart fails. For a program's
+// main(), before anything else.
 void restartWithHugePages(char** argv);
+// An input Error when SFFD_HUGE_PAGES is set to anything but 0 (no restart) or 1 (the restart, as when
+// unset): the tool checks it before a command runs, where the value was taken as 1 before.
+void checkHugePagesVariable();
 
 }  // namespace sffd

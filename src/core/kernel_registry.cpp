@@ -71,6 +71,12 @@ KernelVariant forLattice(KernelVariant v, const gpu::AccurateParams& params) {
   return forInlineLattice(v, params.lattice, {params.tables.z, params.tables.w});
 }
 
+void checkStrictRoundingVariable() {
+  const char* v = std::getenv("SFFD_STRICT_ROUNDING");
+  if (v && *v && std::string_view(v) != "fixup" && std::string_view(v) != "driver")
+    throw Error(ErrorKind::Input, std::string("SFFD_STRICT_ROUNDING must be fixup or driver, not '") + v + "'");
+}
+
 KernelVariant forDevice(KernelVariant v, const DeviceInfo& device) {
   const bool llvmpipe = device.name.find("llvmpipe") != std::string::npos;
   if (v.strict) {

@@ -52,6 +52,9 @@ KernelVariant forLattice(KernelVariant v, const gpu::AccurateParams& params);
 // are correctly rounded (SFFD_STRICT_ROUNDING=fixup or =driver in the environment forces it on or off);
 // SFFD_ASSUME_ONE_SAMPLE_SITE, which a small one-shot job asks for, kept only on lavapipe below Mesa 23.
 KernelVariant forDevice(KernelVariant v, const DeviceInfo& device);
+// An input Error when SFFD_STRICT_ROUNDING is set to anything but fixup or driver (the tool checks it before a
+// command runs; forDevice() would take another value as unset).
+void checkStrictRoundingVariable();
 
 std::span<const EmbeddedKernel> embeddedKernels();
 // nullptr when no kernel has that name.

@@ -43,6 +43,12 @@ void checkCpuThreadsVariable() {
     throw Error(ErrorKind::Input, std::string("SFFD_CPU_THREADS must be an integer 1..256, not '") + std::getenv("SFFD_CPU_THREADS") + "'");
 }
 
+void checkCpuAvx2Variable() {
+  const char* env = std::getenv("SFFD_CPU_AVX2");
+  if (env && *env && std::string_view(env) != "0" && std::string_view(env) != "1")
+    throw Error(ErrorKind::Input, std::string("SFFD_CPU_AVX2 must be 0 or 1, not '") + env + "'");
+}
+
 bool cpuUsesAvx2() {
 #ifdef SFFD_CPU_AVX2_COPIES
   static const bool has = __builtin_cpu_supports("avx2");

@@ -21,6 +21,9 @@ unsigned cpuThreadCount();
 // An input Error when SFFD_CPU_THREADS is set to anything else (the tool checks it before a command runs;
 // cpuThreadCount() would take every core instead).
 void checkCpuThreadsVariable();
+// An input Error when SFFD_CPU_AVX2 is set to anything but 0 (the baseline copy) or 1 (the AVX2 copy where
+// the processor has it, as when unset); cpuUsesAvx2() would take any other value as 1.
+void checkCpuAvx2Variable();
 
 namespace cpu {
 
