@@ -178,7 +178,7 @@ int run(const ParsedArgs& args) {
   std::printf("%s: smooth FFD, %zu triangles -> %zu sub-triangles (l = %g, %s clipping) -> %zu output triangles (level %d)\n",
               meshName.c_str(), job.mesh.triangles.size(), subs, o.edgeLength, clipName.c_str(),
               subs * size_t(tessTriangleCount(o.tess)), o.tess);
-  std::printf("median of %d runs after %d warm-up, min..max in brackets; GPU timestamps (cpu: wall clock)\n", S.repeat, S.warmup);
+  std::printf("median of %d runs after %d warm-up, min..max in brackets; GPU timestamps (cpu, gl-osmesa: wall clock)\n", S.repeat, S.warmup);
   for (const BackendResult& r : results) {
     std::printf("%-10s %s, %s\n", r.label.c_str(), r.device.c_str(), r.driver.c_str());
     auto line = [&](const Series& s, const std::string& k) {

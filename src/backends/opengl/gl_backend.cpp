@@ -11,6 +11,7 @@
 #include <glad/gl.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cctype>
 #include <cstdlib>
 #include <cstring>
@@ -25,6 +26,7 @@
 #include "backends/opengl/gl_state.h"
 #include "core/device_timeout.h"
 #include "core/kernel_registry.h"
+#include "core/wall_clock.h"
 #include "kernels/common/shader_layout.h"
 
 namespace sffd::gl {
@@ -103,7 +105,10 @@ class GlBackend final : public Backend {
     GLint bits = 0;
     // ES: timestamps only through EXT_disjoint_timer_query (gl_loader_es.cpp points glQueryCounter at it).
     if (!es_ || glad_glQueryCounter) glGetQueryiv(GL_TIMESTAMP, GL_QUERY_COUNTER_BITS, &bits);
-    L.timestamps = bits > 0;
+    // OSMesa's llvmpipe runs a dispatch at the next flush, after both timestamps (70 ns apart around a 3 ms
+    // deform): its dispatches are timed on the host instead, as the CPU device's are.
+    hostTimed_ = info_.provider == "osmesa";
+    L.timestamps = bits > 0 || hostTimed_;
 
     GLint uboAlign = 0, maxBlock = 0;
     glGetIntegerv(GL_UNIFORM_BUFFER_OFFSET_ALIGNMENT, &uboAlign);
@@ -310,17 +315,25 @@ class GlBackend final : public Backend {
     }
 
     glUseProgram(prog.name);
-    Pending rec{std::string(d.label.empty() ? d.kernel : d.label), 0, 0};
+    Pending rec{std::string(d.label.empty() ? d.kernel : d.label), 0, 0, -1};
     // A pair of GL_TIMESTAMP counters, not a GL_TIME_ELAPSED query: llvmpipe's elapsed time covers only
     // rasterizer scenes and gives 0 or garbage for compute, while its timestamps bracket the dispatch,
     // which llvmpipe runs to completion before returning.
-    if (L.timestamps) {
+    std::chrono::steady_clock::time_point t0;
+    if (hostTimed_) {
+      glFinish();   // the work before it, not timed with it
+      t0 = std::chrono::steady_clock::now();
+    } else if (L.timestamps) {
       rec.begin = takeQuery();
       rec.end = takeQuery();
       glQueryCounter(rec.begin, GL_TIMESTAMP);
     }
     glDispatchCompute(d.groups[0], d.groups[1], d.groups[2]);
     if (rec.end) glQueryCounter(rec.end, GL_TIMESTAMP);
+    if (hostTimed_) {
+      glFinish();
+      rec.hostMs = msSince(t0);
+    }
     pending_.push_back(std::move(rec));
     dirty_ = true;
     checkGl("dispatch of " + what);
@@ -360,6 +373,7 @@ class GlBackend final : public Backend {
     for (Pending& p : pending_) {
       DispatchTiming t;
       t.label = std::move(p.label);
+      if (p.hostMs >= 0) t.gpuMs = p.hostMs;
       if (p.begin) {
         GLuint64 t0 = 0, t1 = 0;
         glGetQueryObjectui64v(p.begin, GL_QUERY_RESULT, &t0);   // waits for the result
@@ -383,6 +397,7 @@ class GlBackend final : public Backend {
   struct Pending {
     std::string label;
     GLuint begin = 0, end = 0;   // GL_TIMESTAMP queries around the dispatch (0: no timing)
+    double hostMs = -1;          // the dispatch timed on the host (hostTimed_), else -1
   };
   static constexpr uint64_t kRingBytes = 64 * 1024;
   // Everything later work may consume: storage and uniform reads, buffer transfers, indirect commands,
@@ -438,6 +453,7 @@ class GlBackend final : public Backend {
   bool dirty_ = false;   // dispatches since the last barrier
   bool es_ = false;                // an OpenGL ES context (the gles backend)
   bool heldToEsMinimum_ = false;   // es_, and held to the ES 3.1 minimum limits (gl_es_limits.h)
+  bool hostTimed_ = false;         // dispatches timed on the host: the driver's timestamps do not bracket them (OSMesa)
   bool hung_ = false;    // a wait timed out: the device may still use our objects
 };
 
