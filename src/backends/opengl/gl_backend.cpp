@@ -321,7 +321,7 @@ class GlBackend final : public Backend {
     // which llvmpipe runs to completion before returning.
     std::chrono::steady_clock::time_point t0;
     if (hostTimed_) {
-      glFinish();   // the work before it, not timed with it
+      waitIdle("dispatch");   // the work before it, not timed with it (bounded, as every wait)
       t0 = std::chrono::steady_clock::now();
     } else if (L.timestamps) {
       rec.begin = takeQuery();
@@ -331,7 +331,7 @@ class GlBackend final : public Backend {
     glDispatchCompute(d.groups[0], d.groups[1], d.groups[2]);
     if (rec.end) glQueryCounter(rec.end, GL_TIMESTAMP);
     if (hostTimed_) {
-      glFinish();
+      waitIdle("dispatch");
       rec.hostMs = msSince(t0);
     }
     pending_.push_back(std::move(rec));
