@@ -103,9 +103,10 @@ class WrittenFiles {
   std::vector<OutputUndo> files_;
 };
 
-// Whether `path` is the file stdout or stderr goes to (--json /dev/stdout > log): the shell's, written in
-// place, never moved or removed.
-bool isStandardStream(const std::string& path);
+// Whether an output to `file` (a link not followed: the file replacedFile() names) is written in place, not
+// through a temporary renamed onto it: a device, a FIFO, the file stdout or stderr goes to (--json /dev/stdout
+// > log). The shell's or the system's, no file of the command's: never kept aside, moved or removed.
+bool writtenInPlace(const std::string& file);
 
 // Opens the device the options ask for (--backend, --device), printing fallback notes unless --quiet.
 Device openDeviceFromArgs(const ParsedArgs& args);

@@ -177,9 +177,7 @@ std::string xml(const std::string& s) {
 // (--json /dev/stdout works), where a write that fails is an error (into /dev/full the report was lost
 // without a word, exit 0).
 void writeReport(const std::string& path, const std::function<void(std::ostream&)>& write) {
-  std::error_code ec;
-  const fs::file_status st = fs::status(path, ec);
-  if ((!fs::exists(st) || fs::is_regular_file(st)) && !isStandardStream(path)) return writeFileAtomically(path, write);
+  if (!writtenInPlace(replacedFile(path))) return writeFileAtomically(path, write);
   std::ofstream f(path);
   if (!f) throw Error(ErrorKind::Input, path + ": cannot write");
   write(f);

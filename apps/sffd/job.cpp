@@ -181,11 +181,14 @@ void checkOutputPath(const std::string& out, const std::vector<std::string>& inp
     checkOutputPath(fs::path(replacedFile(out)).replace_extension(".bin").string(), files, renamed);
 }
 
-bool isStandardStream(const std::string& path) {
-  struct stat file {}, stream {};
-  if (::stat(path.c_str(), &file) != 0) return false;
+bool writtenInPlace(const std::string& file) {
+  std::error_code ec;
+  const fs::file_status st = fs::symlink_status(file, ec);
+  if (fs::exists(st) && !fs::is_regular_file(st)) return true;
+  struct stat named {}, stream {};
+  if (::stat(file.c_str(), &named) != 0) return false;
   for (int fd : {1, 2})
-    if (::fstat(fd, &stream) == 0 && stream.st_dev == file.st_dev && stream.st_ino == file.st_ino) return true;
+    if (::fstat(fd, &stream) == 0 && stream.st_dev == named.st_dev && stream.st_ino == named.st_ino) return true;
   return false;
 }
 
@@ -198,11 +201,9 @@ void WrittenFiles::willWrite(const std::string& path) {
   std::vector<std::string> files = {replacedFile(path)};
   if (io::lowerExtension(path) == ".gltf") files.push_back(fs::path(files[0]).replace_extension(".bin").string());
   for (const std::string& file : files) {
+    if (writtenInPlace(file)) continue;
     std::error_code ec;
-    const fs::file_status st = fs::symlink_status(file, ec);
-    // Written in place, no file of the command's: a device, a FIFO, the file the shell sends stdout to.
-    if ((fs::exists(st) && !fs::is_regular_file(st)) || isStandardStream(file)) continue;
-    if (!fs::exists(st)) {
+    if (!fs::exists(fs::symlink_status(file, ec))) {
       files_.emplace_back(file, "", !keptOnInterrupt_);
       continue;
     }

@@ -4,7 +4,7 @@
 #include <cstdlib>
 #include <fstream>
 
-#include <sffd/error.h>
+#include "core/environment_check.h"
 
 #if defined(__linux__)
 #include <sys/mman.h>
@@ -46,11 +46,7 @@ std::optional<std::string> tunablesForHugePages(const char* current, std::string
 #define SFFD_MALLOC_IS_GLIBC 1
 #endif
 
-void checkHugePagesVariable() {
-  const char* v = std::getenv("SFFD_HUGE_PAGES");
-  if (v && *v && std::string_view(v) != "0" && std::string_view(v) != "1")
-    throw Error(ErrorKind::Input, std::string("SFFD_HUGE_PAGES must be 0 or 1, not '") + v + "'");
-}
+void checkHugePagesVariable() { checkVariableIsOneOf("SFFD_HUGE_PAGES", {"0", "1"}); }
 
 void restartWithHugePages(char** argv) {
 #if SFFD_MALLOC_IS_GLIBC && defined(__linux__) && defined(__GLIBC__) && (__GLIBC__ > 2 || __GLIBC_MINOR__ >= 35)

@@ -6,6 +6,7 @@
 #include <mutex>
 #include <set>
 
+#include "core/environment_check.h"
 #include "kernels/common/shader_layout.h"
 
 namespace sffd {
@@ -71,11 +72,7 @@ KernelVariant forLattice(KernelVariant v, const gpu::AccurateParams& params) {
   return forInlineLattice(v, params.lattice, {params.tables.z, params.tables.w});
 }
 
-void checkStrictRoundingVariable() {
-  const char* v = std::getenv("SFFD_STRICT_ROUNDING");
-  if (v && *v && std::string_view(v) != "fixup" && std::string_view(v) != "driver")
-    throw Error(ErrorKind::Input, std::string("SFFD_STRICT_ROUNDING must be fixup or driver, not '") + v + "'");
-}
+void checkStrictRoundingVariable() { checkVariableIsOneOf("SFFD_STRICT_ROUNDING", {"fixup", "driver"}); }
 
 KernelVariant forDevice(KernelVariant v, const DeviceInfo& device) {
   const bool llvmpipe = device.name.find("llvmpipe") != std::string::npos;

@@ -9,7 +9,7 @@
 #include <cstring>
 #include <fstream>
 
-#include <sffd/error.h>
+#include "core/environment_check.h"
 #include "core/fnv1a.h"
 
 namespace sffd {
@@ -44,11 +44,7 @@ bool take(std::string_view& in, T& value) {
 
 }  // namespace
 
-void checkShaderCacheDisableVariable() {
-  const char* v = std::getenv("SFFD_SHADER_CACHE_DISABLE");
-  if (v && *v && std::string_view(v) != "0" && std::string_view(v) != "1")
-    throw Error(ErrorKind::Input, std::string("SFFD_SHADER_CACHE_DISABLE must be 0 or 1, not '") + v + "'");
-}
+void checkShaderCacheDisableVariable() { checkVariableIsOneOf("SFFD_SHADER_CACHE_DISABLE", {"0", "1"}); }
 
 std::optional<fs::path> shaderCacheFolder(std::string_view request) {
   if (request == "none") return std::nullopt;

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include <sffd/error.h>
+#include "core/environment_check.h"
 #include "core/huge_pages.h"
 #include "core/kernel_registry.h"
 #include "core/wall_clock.h"
@@ -43,11 +44,7 @@ void checkCpuThreadsVariable() {
     throw Error(ErrorKind::Input, std::string("SFFD_CPU_THREADS must be an integer 1..256, not '") + std::getenv("SFFD_CPU_THREADS") + "'");
 }
 
-void checkCpuAvx2Variable() {
-  const char* env = std::getenv("SFFD_CPU_AVX2");
-  if (env && *env && std::string_view(env) != "0" && std::string_view(env) != "1")
-    throw Error(ErrorKind::Input, std::string("SFFD_CPU_AVX2 must be 0 or 1, not '") + env + "'");
-}
+void checkCpuAvx2Variable() { checkVariableIsOneOf("SFFD_CPU_AVX2", {"0", "1"}); }
 
 bool cpuUsesAvx2() {
 #ifdef SFFD_CPU_AVX2_COPIES
