@@ -1,6 +1,7 @@
 #include "kernels/clip/regular_clip.h"
 
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -172,28 +173,36 @@ PackedClip packClip(const ClipTriangles& clip, size_t first, size_t last) {
   return P;
 }
 
+// The kernels' words are the arrays' bytes (PackedTable): SplitPattern is 4 uint32, SplitPatternVertex 3
+// float bits and a word of edge, pad 0 and step (little-endian: edge | step << 16), two uint16 a word.
+static_assert(std::endian::native == std::endian::little, "the split-pattern table is uploaded as its bytes");
+static_assert(sizeof(SplitPattern) == 16 && sizeof(SplitPatternVertex) == 16);
+
 const PackedTable& packedTable() {
   static const PackedTable T = [] {
     const SplitPatternTable& S = splitPatternTable();
     PackedTable t;
     t.nmax = uint32_t(S.nmax());
-    reserveHuge(t.words, 4 * S.patterns().size() + 4 * S.vertices().size() + (S.triangles().size() + 1) / 2);
-    for (const SplitPattern& p : S.patterns())
-      t.words.insert(t.words.end(), {p.firstVertex, p.vertexCount, p.firstTriangle, p.triangleCount});
-    t.vertexWord = uint32_t(t.words.size());
-    for (const SplitPatternVertex& v : S.vertices()) {
-      uint32_t w[4];
-      std::memcpy(w, v.lambda, 12);
-      w[3] = uint32_t(v.edge) | (uint32_t(v.step) << 16);
-      t.words.insert(t.words.end(), w, w + 4);
-    }
-    t.triangleWord = uint32_t(t.words.size());
-    auto tri = S.triangles();
-    for (size_t i = 0; i < tri.size(); i += 2)
-      t.words.push_back(uint32_t(tri[i]) | (i + 1 < tri.size() ? uint32_t(tri[i + 1]) << 16 : 0u));
+    t.vertexWord = uint32_t(4 * S.patterns().size());
+    t.triangleWord = t.vertexWord + uint32_t(4 * S.vertices().size());
+    t.wordCount = t.triangleWord + uint32_t((S.triangles().size() + 1) / 2);
     return t;
   }();
   return T;
+}
+
+void uploadPackedTable(Backend& backend, BufferId words) {
+  const SplitPatternTable& S = splitPatternTable();
+  const PackedTable& T = packedTable();
+  backend.upload(words, 0, S.patterns().data(), S.patterns().size_bytes());
+  backend.upload(words, uint64_t(T.vertexWord) * 4, S.vertices().data(), S.vertices().size_bytes());
+  const std::span<const uint16_t> tri = S.triangles();
+  const uint64_t pairs = tri.size() / 2;
+  backend.upload(words, uint64_t(T.triangleWord) * 4, tri.data(), pairs * 4);
+  if (tri.size() % 2) {
+    const uint32_t last = tri.back();   // an odd count's last word: its upper half 0
+    backend.upload(words, (uint64_t(T.triangleWord) + pairs) * 4, &last, 4);
+  }
 }
 
 ClipRanges clipRanges(const PreparedMesh& mesh, size_t clipTriangles, size_t realSize) {
@@ -212,7 +221,7 @@ ClipRanges clipRanges(uint64_t vertices, uint64_t firstParent, uint64_t parents,
   r.pn = up(r.slotNormals + SFFD_SLOT_NORMAL_STRIDE * parents, realAlign);
   r.clipReals = up(r.pn + SFFD_PN_STRIDE * parents, realAlign);
   r.realElements = r.clipReals + SFFD_CLIP_REAL_STRIDE * clips;
-  r.triangles = up(packedTable().words.size(), wordAlign);
+  r.triangles = up(packedTable().wordCount, wordAlign);
   r.clipHeaders = up(r.triangles + 4 * SFFD_MESH_TRIANGLE_STRIDE * parents, wordAlign);
   r.counts = up(r.clipHeaders + 4 * SFFD_CLIP_HEADER_STRIDE * clips, wordAlign);
   r.words = r.counts + clips;
@@ -258,15 +267,15 @@ template void writeClipVertexSection<double>(const PreparedMesh&, double*);
 template void writeClipParentSections<float>(const ClipRanges&, const PreparedMesh&, const std::vector<double>*, const PackedClip&, float*);
 template void writeClipParentSections<double>(const ClipRanges&, const PreparedMesh&, const std::vector<double>*, const PackedClip&, double*);
 
-std::vector<uint32_t> clipWordRange(const ClipRanges& r, const PreparedMesh& mesh, const PackedClip& clip) {
-  std::vector<uint32_t> w;
-  resizeHuge(w, r.words, 0u);
-  const PackedTable& T = packedTable();
-  std::copy(T.words.begin(), T.words.end(), w.begin());
+void uploadClipWords(Backend& backend, BufferId words, const ClipRanges& r, const PreparedMesh& mesh,
+                     const PackedClip& clip, bool withTable) {
+  if (withTable) uploadPackedTable(backend, words);
+  std::vector<uint32_t> own;
+  resizeHuge(own, r.words - r.triangles, 0u);
   const uint64_t perParent = 4 * SFFD_MESH_TRIANGLE_STRIDE;
-  std::copy_n(mesh.triangles.begin() + perParent * r.firstParent, perParent * r.parents, w.begin() + r.triangles);
-  std::copy(clip.headers.begin(), clip.headers.end(), w.begin() + r.clipHeaders);
-  return w;
+  std::copy_n(mesh.triangles.begin() + perParent * r.firstParent, perParent * r.parents, own.begin());
+  std::copy(clip.headers.begin(), clip.headers.end(), own.begin() + (r.clipHeaders - r.triangles));
+  backend.upload(words, r.triangles * 4, own.data(), own.size() * 4);
 }
 
 namespace {
@@ -280,7 +289,6 @@ SubTriangleRecords clipRun(Backend& backend, const PreparedMesh& M, const PnOutp
   const size_t n = clip.triangles.size();
   const ClipRanges ranges = clipRanges(M, n, sizeof(Real));
   const std::vector<Real> reals = clipRealRange<Real>(ranges, M, &pn.records, pc);
-  const std::vector<uint32_t> words = clipWordRange(ranges, M, pc);
   auto fits = [&](size_t bytes, const char* what) {
     if (bytes > lim.maxStorageBufferRange)
       throw Error(ErrorKind::Input, std::string("the job's ") + what + " (" + std::to_string(bytes >> 20) +
@@ -288,13 +296,14 @@ SubTriangleRecords clipRun(Backend& backend, const PreparedMesh& M, const PnOutp
                                         std::to_string(lim.maxStorageBufferRange >> 20) + " MiB); use a coarser mesh");
   };
   fits(reals.size() * sizeof(Real), "vertices, PN records and clip triangles");
-  fits(words.size() * 4, "triangles and clip triangles");
+  fits(ranges.words * 4, "triangles and clip triangles");
   auto make = [&](const void* data, size_t bytes) {
     BufferId b = backend.createBuffer(std::max<size_t>(bytes, 16));
-    if (bytes) backend.upload(b, 0, data, bytes);
+    if (bytes && data) backend.upload(b, 0, data, bytes);
     return b;
   };
-  BufferId bReals = make(reals.data(), reals.size() * sizeof(Real)), bWords = make(words.data(), words.size() * 4);
+  BufferId bReals = make(reals.data(), reals.size() * sizeof(Real)), bWords = make(nullptr, ranges.words * 4);
+  uploadClipWords(backend, bWords, ranges, M, pc, true);
 
   gpu::ClipParams params;
   params.table = {T.nmax, T.vertexWord, T.triangleWord, 0};

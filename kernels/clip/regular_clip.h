@@ -86,24 +86,30 @@ SubTriangleRecords recordsFromSubTriangles(const PreparedMesh& mesh, std::span<c
                                            size_t parents, const std::vector<SubTriangle>& subs, KernelVariant variant);
 
 // Device inputs of the clip kernels (layout.h): the clip triangles packed as headers (8 uint each) and
-// reals (SFFD_CLIP_REAL_STRIDE real4 each), and the split-pattern table packed into uint words.
+// reals (SFFD_CLIP_REAL_STRIDE real4 each), and the split-pattern table as uint words (packedTable).
 struct PackedClip {
   std::vector<uint32_t> headers;
   std::vector<double> reals;
 };
 PackedClip packClip(const ClipTriangles& clip);
 PackedClip packClip(const ClipTriangles& clip, size_t first, size_t last);   // clip triangles [first, last)
+// The split-pattern table as the clip kernels read it, the first section of their words: the patterns
+// (4 words each), from vertexWord the vertices (a uvec4: lambda's bits, edge | step << 16), from
+// triangleWord the triangles' 16-bit local indices two to a word; wordCount words in all. Those are the
+// bytes of the compiled-in arrays (split_pattern_table.h) on a little-endian host, so uploadPackedTable
+// copies them from there: nothing is packed at run time (4 MB at Nmax 24, once a process) nor copied
+// through a vector first.
 struct PackedTable {
-  std::vector<uint32_t> words;
-  uint32_t nmax = 0, vertexWord = 0, triangleWord = 0;
+  uint32_t nmax = 0, vertexWord = 0, triangleWord = 0, wordCount = 0;
 };
 const PackedTable& packedTable();
+void uploadPackedTable(Backend& backend, BufferId words);   // into words [0, wordCount) of `words`
 
 // The clip kernels' two input ranges (layout.h, SFFD_BINDING_CLIP_REALS and SFFD_BINDING_CLIP_WORDS) of
 // one pre-compute chunk: all the vertices, the chunk's parents [firstParent, + parents) and their clip
 // triangles [firstClip, + clips); where each section begins, in real4 elements and in words, each at a
 // multiple of SFFD_SECTION_ALIGN bytes. The one place that lays them out; clipRealRange and
-// clipWordRange fill them.
+// uploadClipWords fill them.
 struct ClipRanges {
   uint64_t firstParent = 0, parents = 0, firstClip = 0, clips = 0;
   uint64_t normals = 0, slotNormals = 0, pn = 0, clipReals = 0, realElements = 0;
@@ -117,7 +123,7 @@ ClipRanges clipRanges(uint64_t vertices, uint64_t firstParent, uint64_t parents,
                       size_t realSize);
 // The reals' range (the PN records' section zero without `pnRecords`, the whole mesh's: the caller's
 // pn_triangles writes it), in the kernel's reals (float or double: no wider copy of a large range),
-// and the words' range; `clip` holds the chunk's clip triangles (packClip).
+// and uploadClipWords the words'; `clip` holds the chunk's clip triangles (packClip).
 template <class Real>
 std::vector<Real> clipRealRange(const ClipRanges& r, const PreparedMesh& mesh, const std::vector<double>* pnRecords,
                                   const PackedClip& clip);
@@ -130,7 +136,11 @@ void writeClipVertexSection(const PreparedMesh& mesh, Real* out);
 template <class Real>
 void writeClipParentSections(const ClipRanges& r, const PreparedMesh& mesh, const std::vector<double>* pnRecords,
                              const PackedClip& clip, Real* out);
-std::vector<uint32_t> clipWordRange(const ClipRanges& r, const PreparedMesh& mesh, const PackedClip& clip);
+// The words' range into `words` (r.words words): the table (uploadPackedTable) where `withTable` (a buffer
+// that already holds it, kept from the chunk before, skips it), then the chunk's own sections from
+// r.triangles on: its parents' triangles, its clip triangles' headers and their counts (zero).
+void uploadClipWords(Backend& backend, BufferId words, const ClipRanges& r, const PreparedMesh& mesh,
+                     const PackedClip& clip, bool withTable);
 
 struct CpuKernelArgs;
 namespace cpu {

@@ -82,7 +82,8 @@ struct DeformSession::Impl {
     PreChunkInputs c{r};
     if (realSize == 8) c.reals = uploadVector(b, clipRealRange<double>(r, mesh, nullptr, pc));
     else c.reals = uploadVector(b, clipRealRange<float>(r, mesh, nullptr, pc));
-    c.words = uploadVector(b, clipWordRange(r, mesh, pc));
+    c.words = make(b, r.words * 4);
+    uploadClipWords(b, c.words, r, mesh, pc, true);
     return c;
   }
   // The same for a streamed chunk: the vertices' section, which every chunk repeats, is built once
@@ -117,9 +118,9 @@ struct DeformSession::Impl {
     void drop(Impl& I, Backend& B) { I.drop(B, id), room = 0; }
   };
   // Into the stream's buffers (StreamBuffer), which a chunk before may have filled: the vertices' section is
-  // uploaded only into a fresh reals buffer.
+  // uploaded only into a fresh reals buffer, the split-pattern table only into a fresh words buffer.
   PreChunkInputs uploadStreamedInputs(Backend& b, const ClipRanges& r, const PackedClip& pc, BufferId reals,
-                                      bool freshReals, BufferId words) {
+                                      bool freshReals, BufferId words, bool freshWords) {
     PreChunkInputs c{r, reals, words};
     if (freshReals) b.upload(c.reals, 0, vertexSection.data(), vertexSection.size());
     auto upload = [&](auto zero) {
@@ -130,8 +131,7 @@ struct DeformSession::Impl {
       b.upload(c.reals, r.byteOf(r.slotNormals), own.data(), own.size() * sizeof(Real));
     };
     realSize == 8 ? upload(0.0) : upload(0.0f);
-    const std::vector<uint32_t> w = clipWordRange(r, mesh, pc);
-    b.upload(c.words, 0, w.data(), w.size() * 4);
+    uploadClipWords(b, c.words, r, mesh, pc, freshWords);
     return c;
   }
 };

@@ -87,9 +87,10 @@ const SessionTimings& DeformSession::streamChunks(const ChunkReader& read, const
       nextMade = false;
     }
     if (!r.parents) throw tooLargeForOneBinding(nv, p0, I.realSize, lim.maxStorageBufferRange);
-    bool freshReals = false;
+    bool freshReals = false, freshWords = false;
     const BufferId reals = realsBuffer.atLeast(I, B, r.byteOf(r.realElements), &freshReals);
-    const PreChunkInputs in = I.uploadStreamedInputs(B, r, packClip(clips), reals, freshReals, wordsBuffer.atLeast(I, B, r.words * 4));
+    const BufferId words = wordsBuffer.atLeast(I, B, r.words * 4, &freshWords);
+    const PreChunkInputs in = I.uploadStreamedInputs(B, r, packClip(clips), reals, freshReals, words, freshWords);
     K.pn(in);
     if (knotBox) {
       knotBoxSubs.clear();

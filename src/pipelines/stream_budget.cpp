@@ -201,7 +201,7 @@ JobEstimate estimateStreamedSmoothJob(const Mesh& mesh, const DeformSessionOptio
   const double perParent = (SFFD_SLOT_NORMAL_STRIDE + SFFD_PN_STRIDE) * r4, perClip = SFFD_CLIP_REAL_STRIDE * r4;
   const double sections = std::min(double(kStreamedChunkBytes) + perParent + s.parentClips * perClip, perParent * parents + perClip * clips) +
                           3 * SFFD_SECTION_ALIGN;
-  const double words = 4.0 * (double(packedTable().words.size()) + 8 * parents + 9 * clips) + 3 * SFFD_SECTION_ALIGN;
+  const double words = 4.0 * (double(packedTable().wordCount) + 8 * parents + 9 * clips) + 3 * SFFD_SECTION_ALIGN;
   const double inputs = 2 * V * r4 + sections + words;   // on the device: the vertex section again
   const double clipHost = clips * (3.0 * sizeof(ClipTriangle) + 32 + 288 + 20) + sections + words;
   // One deform chunk: at most the chunk's sub-triangles and what one binding holds (or one clip triangle's);
