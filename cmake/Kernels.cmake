@@ -17,12 +17,14 @@ set(SFFD_KERNELS
 # disk cache keeps only machine code), and deform_smooth's inlined SSA form with its assumptions folded
 # is translated in 30-50 ms, not 100-260 (docs/performance/kernels.md, "SPIR-V made for the usual dispatch").
 # clip_write's in 26 ms, not 35, for 6 % more instructions when it runs on lavapipe 22.3 (0.1 ms of a
-# clip that runs once a mesh, against the translation every process pays: "The whole run, again").
-# The other kernels gain nothing there, so they stay as glslang writes them. `--simplify-instructions` is left out
+# clip that runs once a mesh, against the translation every process pays: "The whole run, again");
+# pn_triangles' in 5.8 ms, not 7.1, clip_count's in 2.6, not 3.8, their warm times within the noise
+# ("The whole run, again", 2026-11-30). The others (split steps, accurate and classic FFD's), not
+# measured so, stay as glslang writes them. `--simplify-instructions` is left out
 # because it reassociates float constants where no NoContraction forbids it: the fast kernels would no
 # longer give the CPU twin's bits on lavapipe. The rest changes no arithmetic (constant folding is IEEE;
 # strict kernels stay bit-identical).
-set(SFFD_SPIRV_OPTIMIZED deform_smooth clip_write)
+set(SFFD_SPIRV_OPTIMIZED deform_smooth clip_write pn_triangles clip_count)
 find_program(SFFD_SPIRV_OPT spirv-opt REQUIRED)
 set(SFFD_SPIRV_OPT_PASSES
     --wrap-opkill --eliminate-dead-branches --merge-return --inline-entry-points-exhaustive
