@@ -84,6 +84,10 @@ struct RunnerOptions {
   std::string deviceSubstring;
 };
 
+// An input Error when the test hook SFFD_CONFORM_FAULT (docs/CONFORMANCE.md) is set to a value that names no
+// fault (one it injected none for before).
+void checkConformFaultVariable();
+
 // Runs the cases on backend `name` in child processes (a crash or a hang ends one case, and a new
 // child goes on with the next), each writing its buffers under `dir`.
 BackendRun runBackend(const std::string& name, const std::vector<Case>& cases, const fs::path& dir,
