@@ -124,11 +124,10 @@ Fault faultOf(const std::string& s) {
 void checkConformFaultVariable() {
   const char* v = std::getenv("SFFD_CONFORM_FAULT");
   if (!v || !*v) return;
-  static const std::set<std::string> kinds{"crash", "hang", "slow-compile", "stuck-compile", "compile-then-hang", "slow-open"},
-      backends{"vulkan", "gl", "gl-egl", "gl-osmesa", "gl-glfw", "gles", "cpu"};
+  static const std::set<std::string> kinds{"crash", "hang", "slow-compile", "stuck-compile", "compile-then-hang", "slow-open"};
   const Fault f = faultOf(v);
   // A value that named no fault, or one that could never happen (slow-open of a case), injected none.
-  if (kinds.count(f.kind) && backends.count(f.backend) && (!f.hasCase || (!f.caseName.empty() && f.kind != "slow-open"))) return;
+  if (kinds.count(f.kind) && backendNames().count(f.backend) && (!f.hasCase || (!f.caseName.empty() && f.kind != "slow-open"))) return;
   throw Error(ErrorKind::Input, std::string("SFFD_CONFORM_FAULT must be KIND:BACKEND[:CASE] (KIND crash, hang, slow-compile, "
                                             "stuck-compile or compile-then-hang) or slow-open:BACKEND, not '") + v + "'");
 }
