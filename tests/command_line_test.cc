@@ -104,14 +104,27 @@ TEST_F(CommandLine, ValuesThatWereTakenOrIgnoredAreRefused) {
 // Variables whose other values were taken silently (known leftovers of the sixth session's audits):
 // SFFD_CPU_AVX2=banana ran the AVX2 copy, SFFD_HUGE_PAGES=xyz restarted with huge pages,
 // SFFD_SHADER_CACHE_DISABLE=maybe turned the cache off, SFFD_STRICT_ROUNDING=fix left the choice to the driver.
+// Then (2026-11-30, every other getenv("SFFD_...")) the Vulkan switches and SFFD_TRACE_COMPILE took any value but 0 as 1,
+// SFFD_MAX_CHUNK_* took abc as 1 and -5 as 2^64-5, SFFD_CONFORM_FAULT a typo as no fault, and SFFD_GL_PROVIDER and
+// SFFD_GLES_LIMITS were refused only where a GL device opened (GLES_LIMITS in other words).
 TEST_F(CommandLine, VariablesTakeTheirDocumentedValuesOnly) {
   struct Case {
     const char *variable, *value, *takes;
   };
+  const char* const chunk = "an integer 1..4294967295";
+  const char* const fault =
+      "KIND:BACKEND[:CASE] (KIND crash, hang, slow-compile, stuck-compile or compile-then-hang) or slow-open:BACKEND";
   for (const Case& c : {Case{"SFFD_CPU_AVX2", "banana", "0 or 1"}, Case{"SFFD_CPU_AVX2", "yes", "0 or 1"},
                         Case{"SFFD_HUGE_PAGES", "xyz", "0 or 1"}, Case{"SFFD_HUGE_PAGES", "00", "0 or 1"},
                         Case{"SFFD_SHADER_CACHE_DISABLE", "maybe", "0 or 1"}, Case{"SFFD_SHADER_CACHE_DISABLE", "true", "0 or 1"},
-                        Case{"SFFD_STRICT_ROUNDING", "fix", "fixup or driver"}}) {
+                        Case{"SFFD_STRICT_ROUNDING", "fix", "fixup or driver"},
+                        Case{"SFFD_VK_STAGING", "yes", "0 or 1"}, Case{"SFFD_VK_VERBOSE", "true", "0 or 1"},
+                        Case{"SFFD_VK_DISABLE_F64", "on", "0 or 1"}, Case{"SFFD_VK_VALIDATION", "2", "0 or 1"},
+                        Case{"SFFD_TRACE_COMPILE", "yes", "0 or 1"}, Case{"SFFD_GLES_LIMITS", "phone", "minimum or device"},
+                        Case{"SFFD_GL_PROVIDER", "vulkan", "egl, osmesa or glfw"}, Case{"SFFD_GL_PROVIDER", "egl-es", "egl, osmesa or glfw"},
+                        Case{"SFFD_MAX_CHUNK_VERTICES", "-5", chunk}, Case{"SFFD_MAX_CHUNK_PATCHES", "abc", chunk},
+                        Case{"SFFD_MAX_CHUNK_TRIANGLES", "0", chunk}, Case{"SFFD_MAX_CHUNK_SUBTRIANGLES", "4294967296", chunk},
+                        Case{"SFFD_CONFORM_FAULT", "crash:vulkn", fault}, Case{"SFFD_CONFORM_FAULT", "slow-open:cpu:box", fault}}) {
     const std::string env = std::string(c.variable) + "=" + c.value;
     const std::string message = std::string(c.variable) + " must be " + c.takes + ", not '" + c.value + "'";
     expectUsageError(runSffd("devices", env), message);
@@ -120,11 +133,20 @@ TEST_F(CommandLine, VariablesTakeTheirDocumentedValuesOnly) {
   EXPECT_FALSE(fs::exists(dir_ / "o.obj"));
   for (const char* env : {"SFFD_CPU_AVX2=0", "SFFD_CPU_AVX2=1", "SFFD_CPU_AVX2=", "SFFD_HUGE_PAGES=0", "SFFD_HUGE_PAGES=1",
                           "SFFD_SHADER_CACHE_DISABLE=0", "SFFD_SHADER_CACHE_DISABLE=1", "SFFD_STRICT_ROUNDING=fixup",
-                          "SFFD_STRICT_ROUNDING=driver"}) {
+                          "SFFD_STRICT_ROUNDING=driver", "SFFD_VK_STAGING=1 SFFD_VK_VERBOSE=0 SFFD_VK_DISABLE_F64=1 SFFD_VK_VALIDATION=0",
+                          "SFFD_TRACE_COMPILE=0", "SFFD_GLES_LIMITS=device SFFD_GL_PROVIDER=osmesa", "SFFD_GLES_LIMITS=minimum",
+                          "SFFD_MAX_CHUNK_PATCHES=1 SFFD_MAX_CHUNK_SUBTRIANGLES=4294967295", "SFFD_CONFORM_FAULT=slow-open:cpu"}) {
     const RunResult r = runSffd("deform " + box_ + " -l " + lattice_ + " --backend cpu --strict --quiet -o " + out("o.obj"), env);
     EXPECT_EQ(r.status, 0) << env << ": " << r.err;
   }
   EXPECT_EQ(runSffd("devices", "SFFD_CPU_AVX2=0").out.find(", AVX2)"), std::string::npos);
+  // 1 still turns a switch on: tracing (scripts and docs/performance use it), on Vulkan through staging memory.
+  if (usable("vulkan")) {
+    const RunResult r = runSffd("deform " + box_ + " -l " + lattice_ + " --backend vulkan --quiet -o " + out("o.obj"),
+                                "SFFD_TRACE_COMPILE=1 SFFD_VK_STAGING=1 SFFD_SHADER_CACHE_DISABLE=1");
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.err.find("compile vulkan"), std::string::npos) << r.err;
+  }
 }
 
 // bench's message listed auto and gl-glfw, which CLI.md does not give it, and took them: auto timed one of the

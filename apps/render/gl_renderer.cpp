@@ -184,9 +184,7 @@ struct Renderer::Programs {
 };
 
 std::unique_ptr<Renderer> Renderer::createHeadless(Provider provider) {
-  if (provider == Provider::Auto) {
-    if (const char* env = std::getenv("SFFD_GL_PROVIDER"); env && *env) provider = parseProvider(env);
-  }
+  if (provider == Provider::Auto) provider = providerFromEnvironment();
   if (provider != Provider::Auto) return std::make_unique<Renderer>(std::shared_ptr<Context>(createContext(provider)));
   std::string reasons;
   for (Provider p : {Provider::EGL, Provider::OSMesa}) {

@@ -141,9 +141,13 @@ auto withToolLimitName(F&& f) -> decltype(f());
 // names of options (DeformOptions fields) by the flags that set them.
 std::string toolLimitMessage(std::string what);
 
-// SFFD_MAX_CHUNK_* (elements per chunk, to test chunking): the value of the variable `name`, at
-// least 1; 0 when it is not set (no limit).
+// SFFD_MAX_CHUNK_* (elements per chunk, to test chunking): the value of the variable `name`, an integer
+// 1..4294967295; 0 when it is not set (no limit).
 size_t chunkFromEnvironment(const char* name);
+// An input Error naming the first variable only the tool reads (SFFD_HUGE_PAGES, SFFD_MEMORY_LIMIT,
+// SFFD_MAX_CHUNK_*, SFFD_CONFORM_FAULT) set to a value docs/CLI.md does not give it; main() makes it,
+// after checkLibraryVariables, before a command runs.
+void checkToolVariables();
 
 // --crease-angle DEG|auto: the threshold for meshes without normals, kCreaseAngleAuto when the option
 // is absent or auto; a number must be 0..180 degrees (an input Error otherwise).

@@ -8,7 +8,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
-#include <set>
 
 #include <nlohmann/json.hpp>
 #include <sffd/error.h>
@@ -102,10 +101,9 @@ std::vector<BackendRun> readDump(const fs::path& dir, const std::vector<Case>& c
 }
 
 int run(const ParsedArgs& args) {
-  static const std::set<std::string> known{"vulkan", "gl", "gl-egl", "gl-osmesa", "gl-glfw", "gles", "cpu"};
   const std::vector<std::string> names = args.getList("--backends", "vulkan,gl-egl,gl-osmesa,cpu");
   for (const std::string& n : names)
-    if (!known.count(n)) throw Error(ErrorKind::Input, "--backends: unknown backend '" + n + "' (vulkan, gl, gl-egl, gl-osmesa, gl-glfw, gles, cpu)");
+    if (!backendNames().count(n)) throw Error(ErrorKind::Input, "--backends: unknown backend '" + n + "' (vulkan, gl, gl-egl, gl-osmesa, gl-glfw, gles, cpu)");
   const std::vector<std::string> required = args.getList("--require", "");
   for (const std::string& n : required)
     if (std::find(names.begin(), names.end(), n) == names.end())

@@ -20,6 +20,7 @@
 #include <cstring>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <fstream>
 #include <thread>
 
@@ -104,16 +105,46 @@ void say(int fd, const std::string& line) {
   }
 }
 
+// The test hook's value, KIND:BACKEND[:CASE], in its parts (CASE empty when absent).
+struct Fault {
+  std::string kind, backend, caseName;
+  bool hasCase = false;
+};
+Fault faultOf(const std::string& s) {
+  Fault f;
+  const size_t a = s.find(':'), b = a == std::string::npos ? a : s.find(':', a + 1);
+  f.kind = s.substr(0, a);
+  if (a != std::string::npos) f.backend = s.substr(a + 1, b == std::string::npos ? b : b - a - 1);
+  if (b != std::string::npos) f.caseName = s.substr(b + 1), f.hasCase = true;
+  return f;
+}
+
+}  // namespace
+
+void checkConformFaultVariable() {
+  const char* v = std::getenv("SFFD_CONFORM_FAULT");
+  if (!v || !*v) return;
+  static const std::set<std::string> kinds{"crash", "hang", "slow-compile", "stuck-compile", "compile-then-hang", "slow-open"};
+  const Fault f = faultOf(v);
+  // A value that named no fault, or one that could never happen (slow-open of a case), injected none.
+  if (kinds.count(f.kind) && backendNames().count(f.backend) && (!f.hasCase || (!f.caseName.empty() && f.kind != "slow-open"))) return;
+  throw Error(ErrorKind::Input, std::string("SFFD_CONFORM_FAULT must be KIND:BACKEND[:CASE] (KIND crash, hang, slow-compile, "
+                                            "stuck-compile or compile-then-hang) or slow-open:BACKEND, not '") + v + "'");
+}
+
+namespace {
+
 // The test hook: "crash:vulkan", "hang:gl-egl:CASE", "slow-compile:cpu:CASE" (a compile of 3 case
 // timeouts, which is progress), "stuck-compile:cpu" (one that never ends) or "compile-then-hang:cpu" (a
 // slow compile, then a hang: no progress once the compile has ended), at the start of a case; "slow-open:cpu"
-// (an opening of 3 case timeouts, progress too) while the device opens (caseName empty).
+// (an opening of 3 case timeouts, progress too) while the device opens (caseName empty). checkConformFaultVariable
+// has refused any other value.
 void injectFault(const std::string& backend, const std::string& caseName, double timeoutSeconds) {
   const char* v = std::getenv("SFFD_CONFORM_FAULT");
   if (!v) return;
-  std::string s = v, kind = s.substr(0, s.find(':')), rest = s.find(':') == std::string::npos ? "" : s.substr(s.find(':') + 1);
-  std::string b = rest.substr(0, rest.find(':')), c = rest.find(':') == std::string::npos ? "" : rest.substr(rest.find(':') + 1);
-  if (b != backend || (!c.empty() && c != caseName) || (kind == "slow-open") != caseName.empty()) return;
+  const Fault f = faultOf(v);
+  const std::string& kind = f.kind;
+  if (f.backend != backend || (f.hasCase && f.caseName != caseName) || (kind == "slow-open") != caseName.empty()) return;
   if (kind == "slow-open") std::this_thread::sleep_for(std::chrono::duration<double>(3 * timeoutSeconds));
   if (kind == "crash") ::raise(SIGSEGV);
   if (kind == "hang")

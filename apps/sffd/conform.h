@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -83,6 +84,16 @@ struct RunnerOptions {
   double timeoutSeconds = 60;   // per case: no progress for that long is a Timeout
   std::string deviceSubstring;
 };
+
+// The names --backends takes (and SFFD_CONFORM_FAULT's BACKEND).
+inline const std::set<std::string>& backendNames() {
+  static const std::set<std::string> names{"vulkan", "gl", "gl-egl", "gl-osmesa", "gl-glfw", "gles", "cpu"};
+  return names;
+}
+
+// An input Error when the test hook SFFD_CONFORM_FAULT (docs/CONFORMANCE.md) is set to a value that names no
+// fault (one it injected none for before).
+void checkConformFaultVariable();
 
 // Runs the cases on backend `name` in child processes (a crash or a hang ends one case, and a new
 // child goes on with the next), each writing its buffers under `dir`.

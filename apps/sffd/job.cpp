@@ -13,8 +13,11 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/sffd/cli.h"
+#include "apps/sffd/conform.h"
 #include "core/backend.h"
 #include <sffd/error.h>
+#include "core/environment_check.h"
+#include "core/huge_pages.h"
 #include "core/job_budget.h"
 #include "io/atomic_file.h"
 #include "io/io_util.h"
@@ -316,9 +319,19 @@ std::string toolLimitMessage(std::string what) {
   return what;
 }
 
-size_t chunkFromEnvironment(const char* name) {
-  const char* v = std::getenv(name);
-  return v ? std::max<size_t>(1, std::strtoull(v, nullptr, 10)) : 0;
+namespace {
+// A chunk of more elements than 32-bit indices count is bounded by the device's limits anyway.
+constexpr uint64_t kMaxChunkVariable = UINT32_MAX;
+}  // namespace
+
+size_t chunkFromEnvironment(const char* name) { return size_t(integerVariable(name, 1, kMaxChunkVariable)); }
+
+void checkToolVariables() {
+  checkHugePagesVariable();
+  memoryLimitFromEnvironment();
+  for (const char* name : {"SFFD_MAX_CHUNK_VERTICES", "SFFD_MAX_CHUNK_PATCHES", "SFFD_MAX_CHUNK_TRIANGLES", "SFFD_MAX_CHUNK_SUBTRIANGLES"})
+    checkVariableIsInteger(name, 1, kMaxChunkVariable);
+  conform::checkConformFaultVariable();
 }
 
 bool wantDouble(const ParsedArgs& args, const DeviceInfo& info, bool autoDouble) {

@@ -6,11 +6,8 @@
 #include <string>
 
 #include "apps/sffd/cli.h"
-#include "backends/cpu/cpu_backend.h"
-#include "core/device_timeout.h"
+#include "backends/backend_select.h"
 #include "core/huge_pages.h"
-#include "core/kernel_registry.h"
-#include "core/shader_binary_cache.h"
 #include <sffd/sffd.h>
 
 using namespace sffd;
@@ -69,12 +66,8 @@ int main(int argc, char** argv) {
         std::fputs(cli::helpText(c).c_str(), stdout);
         return 0;
       }
-      checkDeviceTimeoutVariable();
-      checkCpuThreadsVariable();
-      checkCpuAvx2Variable();
-      checkHugePagesVariable();
-      checkShaderCacheDisableVariable();
-      checkStrictRoundingVariable();
+      checkLibraryVariables();   // what the library reads, then what the tool alone does: before any work
+      cli::checkToolVariables();
       const int status = c.run(args);
       if (status == 0)
         for (const std::string& w : cli::takeWarnings()) std::fprintf(stderr, "sffd: warning: %s\n", oneLine(w.c_str()).c_str());

@@ -70,7 +70,9 @@ struct DeviceEntry {
 class Device {
  public:
   // Opens the device asked for; throws a device Error (ErrorKind::Device) when it is unusable. For
-  // "auto", devices that fail are skipped and `notes` receives one line for each.
+  // "auto", devices that fail are skipped and `notes` receives one line for each. An SFFD_* variable set to
+  // a value docs/CLI.md ("Environment variables") does not give it is an input Error first, here, in
+  // listDevices() and in the adopting calls.
   static Device open(const DeviceRequest& request = {}, std::vector<std::string>* notes = nullptr);
 
   // A Device may be moved while Deformers use it: they follow it to where it was moved. A moved-from

@@ -4,12 +4,14 @@
 #include <sffd/error.h>
 
 #include "api/output_chunk_check.h"
+#include "backends/backend_select.h"
 #include "backends/opengl/gl_backend.h"
 #include "backends/opengl/gl_context.h"
 
 namespace sffd::opengl {
 
 Device adoptCurrentContext(GetProcAddress getProc) {
+  checkLibraryVariables();
   std::shared_ptr<gl::Context> context = gl::adoptCurrentContext(getProc);
   std::unique_ptr<Backend> backend = gl::createBackendOn(std::move(context));
   std::string label = backend->info().api == "gles" ? "gles-adopted" : "gl-adopted";

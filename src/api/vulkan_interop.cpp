@@ -4,10 +4,14 @@
 #include <sffd/error.h>
 
 #include "api/output_chunk_check.h"
+#include "backends/backend_select.h"
 
 namespace sffd::vulkan {
 
-Device adoptDevice(const DeviceConfig& config) { return Device("vulkan-adopted", vk::adoptBackend(config)); }
+Device adoptDevice(const DeviceConfig& config) {
+  checkLibraryVariables();
+  return Device("vulkan-adopted", vk::adoptBackend(config));
+}
 
 BufferRange bufferOf(const Deformer& deformer, const OutputChunk& chunk) {
   Device& device = deformer.device();

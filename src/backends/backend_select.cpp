@@ -4,6 +4,10 @@
 #include "backends/cpu/cpu_backend.h"
 #include "backends/opengl/gl_backend.h"
 #include "backends/vulkan/vk_backend.h"
+#include "backends/vulkan/vk_loader.h"
+#include "core/device_timeout.h"
+#include "core/kernel_registry.h"
+#include "core/shader_binary_cache.h"
 
 namespace sffd {
 
@@ -50,7 +54,20 @@ OpenedBackend openNamed(const std::string& name, const BackendRequest& r) {
 
 }  // namespace
 
+void checkLibraryVariables() {
+  checkDeviceTimeoutVariable();
+  checkCpuThreadsVariable();
+  checkCpuAvx2Variable();
+  checkShaderCacheDisableVariable();
+  checkStrictRoundingVariable();
+  checkTraceCompileVariable();
+  vk::checkVulkanVariables();
+  gl::checkGlProviderVariable();
+  gl::checkGlesLimitsVariable();
+}
+
 OpenedBackend openBackend(const BackendRequest& r, std::vector<std::string>* notes) {
+  checkLibraryVariables();
   if (r.name != "auto") return openNamed(r.name, r);
   for (const char* name : {"vulkan", "gl"}) {
     try {
@@ -65,6 +82,7 @@ OpenedBackend openBackend(const BackendRequest& r, std::vector<std::string>* not
 }
 
 std::vector<std::pair<std::string, DeviceInfo>> listBackends(std::vector<std::string>& problems) {
+  checkLibraryVariables();
   std::vector<std::pair<std::string, DeviceInfo>> out;
   try {
     for (DeviceInfo& d : vk::listDevices()) out.emplace_back("vulkan", d);

@@ -24,6 +24,11 @@ struct BackendRequest {
   std::string shaderCache = {}; // Vulkan: "" default folder, "none", or a folder (DeviceRequest::shaderCache)
 };
 
+// An input Error naming the first SFFD_* variable the library reads that is set to a value docs/CLI.md
+// ("Environment variables") does not give it, where it would be taken silently as a default or as "on".
+// openBackend, listBackends and the adopting calls make it first; the tool before a command runs.
+void checkLibraryVariables();
+
 // Opens the backend; throws a device Error (exit 3) when the one asked for is unusable. For "auto",
 // failures are skipped and `notes` receives one line per skipped backend.
 OpenedBackend openBackend(const BackendRequest& request, std::vector<std::string>* notes = nullptr);

@@ -8,8 +8,8 @@ namespace sffd {
 
 // SFFD_DEVICE_TIMEOUT seconds (a number > 0; tests set tiny ones), else 60.
 double deviceTimeoutSeconds();
-// An input Error when SFFD_DEVICE_TIMEOUT is set to anything but such a number (the tool checks it before
-// a command runs; deviceTimeoutSeconds() would wait 60 s instead).
+// An input Error when SFFD_DEVICE_TIMEOUT is set to anything but such a number (checked before any work:
+// checkLibraryVariables, backend_select.h; deviceTimeoutSeconds() would wait 60 s instead).
 void checkDeviceTimeoutVariable();
 uint64_t deviceTimeoutNs();
 

@@ -115,10 +115,12 @@ void gridFor(uint64_t threads, const DeviceLimits& limits, uint32_t groups[3]) {
 bool compileTraceOn() {
   static const bool on = [] {
     const char* v = std::getenv("SFFD_TRACE_COMPILE");
-    return v && *v && std::string_view(v) != "0";
+    return v && std::string_view(v) == "1";
   }();
   return on;
 }
+
+void checkTraceCompileVariable() { checkVariableIsOneOf("SFFD_TRACE_COMPILE", {"0", "1"}); }
 
 void traceFirstDispatch(std::string_view label, double deviceMs) {
   if (!compileTraceOn()) return;

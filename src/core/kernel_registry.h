@@ -52,8 +52,8 @@ KernelVariant forLattice(KernelVariant v, const gpu::AccurateParams& params);
 // are correctly rounded (SFFD_STRICT_ROUNDING=fixup or =driver in the environment forces it on or off);
 // SFFD_ASSUME_ONE_SAMPLE_SITE, which a small one-shot job asks for, kept only on lavapipe below Mesa 23.
 KernelVariant forDevice(KernelVariant v, const DeviceInfo& device);
-// An input Error when SFFD_STRICT_ROUNDING is set to anything but fixup or driver (the tool checks it before a
-// command runs; forDevice() would take another value as unset).
+// An input Error when SFFD_STRICT_ROUNDING is set to anything but fixup or driver (checked before any work:
+// checkLibraryVariables, backend_select.h; forDevice() would take another value as unset).
 void checkStrictRoundingVariable();
 
 std::span<const EmbeddedKernel> embeddedKernels();
@@ -62,8 +62,10 @@ const EmbeddedKernel* findKernel(std::string_view name);
 // GLSL source of a variant for an OpenGL (es: OpenGL ES) driver: the variant defines follow the #version line.
 std::string glslForVariant(const EmbeddedKernel& kernel, KernelVariant variant, bool es = false);
 
-// Whether SFFD_TRACE_COMPILE is set (and not 0).
+// Whether SFFD_TRACE_COMPILE is 1 (read once).
 bool compileTraceOn();
+// An input Error when SFFD_TRACE_COMPILE is set to anything but 0 or 1.
+void checkTraceCompileVariable();
 // With tracing on, the device time of the first dispatch of each label in the process, one line
 // `sffd: first dispatch LABEL: MS ms`: on llvmpipe and lavapipe it includes the code generation.
 void traceFirstDispatch(std::string_view label, double deviceMs);

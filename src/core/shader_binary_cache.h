@@ -19,8 +19,8 @@ namespace sffd {
 // else $XDG_CACHE_HOME/sffd, else $HOME/.cache/sffd; none when SFFD_SHADER_CACHE_DISABLE is set to
 // anything but "" or "0", or without a home), "none" no cache, anything else that folder.
 std::optional<std::filesystem::path> shaderCacheFolder(std::string_view request);
-// An input Error when SFFD_SHADER_CACHE_DISABLE is set to anything but 0 or 1 (the tool checks it before a
-// command runs; shaderCacheFolder() would take "maybe" as 1).
+// An input Error when SFFD_SHADER_CACHE_DISABLE is set to anything but 0 or 1 (checked before any work:
+// checkLibraryVariables, backend_select.h; shaderCacheFolder() would take "maybe" as 1).
 void checkShaderCacheDisableVariable();
 
 class ShaderBinaryCache {

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <charconv>
 #include <chrono>
 #include <condition_variable>
 #include <cstdlib>
@@ -22,27 +21,12 @@
 
 namespace sffd {
 
-namespace {
-// SFFD_CPU_THREADS: 0 when unset or empty, -1 when it is not an integer 1..256.
-int threadsVariable() {
-  const char* env = std::getenv("SFFD_CPU_THREADS");
-  if (!env || !*env) return 0;
-  int t = 0;
-  const char* end = env + std::strlen(env);
-  const auto [p, ec] = std::from_chars(env, end, t);
-  return ec == std::errc() && p == end && t >= 1 && t <= 256 ? t : -1;
-}
-}  // namespace
-
 unsigned cpuThreadCount() {
-  if (const int t = threadsVariable(); t > 0) return unsigned(t);
+  if (const uint64_t t = integerVariable("SFFD_CPU_THREADS", 1, 256)) return unsigned(t);
   return std::min(std::max(1u, std::thread::hardware_concurrency()), 256u);
 }
 
-void checkCpuThreadsVariable() {
-  if (threadsVariable() < 0)
-    throw Error(ErrorKind::Input, std::string("SFFD_CPU_THREADS must be an integer 1..256, not '") + std::getenv("SFFD_CPU_THREADS") + "'");
-}
+void checkCpuThreadsVariable() { checkVariableIsInteger("SFFD_CPU_THREADS", 1, 256); }
 
 void checkCpuAvx2Variable() { checkVariableIsOneOf("SFFD_CPU_AVX2", {"0", "1"}); }
 

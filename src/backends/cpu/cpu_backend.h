@@ -18,8 +18,8 @@ namespace sffd {
 // Threads a dispatch runs on: every core (at most 256), or SFFD_CPU_THREADS where it is an integer 1..256
 // (more than the cores is allowed: the tests split work as a larger machine would).
 unsigned cpuThreadCount();
-// An input Error when SFFD_CPU_THREADS is set to anything else (the tool checks it before a command runs;
-// cpuThreadCount() would take every core instead).
+// An input Error when SFFD_CPU_THREADS is set to anything else (checked before any work: checkLibraryVariables,
+// backend_select.h; cpuThreadCount() would take every core instead).
 void checkCpuThreadsVariable();
 // An input Error when SFFD_CPU_AVX2 is set to anything but 0 (the baseline copy) or 1 (the AVX2 copy where
 // the processor has it, as when unset); cpuUsesAvx2() would take any other value as 1.

@@ -25,6 +25,7 @@
 #include "backends/opengl/gl_programs.h"
 #include "backends/opengl/gl_state.h"
 #include "core/device_timeout.h"
+#include "core/environment_check.h"
 #include "core/kernel_registry.h"
 #include "core/wall_clock.h"
 #include "kernels/common/shader_layout.h"
@@ -457,14 +458,11 @@ class GlBackend final : public Backend {
   bool hung_ = false;    // a wait timed out: the device may still use our objects
 };
 
-// Whether the gles backend uses the device's own limits: asked for, or SFFD_GLES_LIMITS=device.
+// Whether the gles backend uses the device's own limits: asked for, or SFFD_GLES_LIMITS=device (=minimum: not).
 bool useDeviceLimits(bool asked) {
+  checkGlesLimitsVariable();
   const char* env = std::getenv("SFFD_GLES_LIMITS");
-  if (!env || !*env) return asked;
-  std::string v = env;
-  if (v == "device") return true;
-  if (v == "minimum") return false;
-  throw Error(ErrorKind::Input, "SFFD_GLES_LIMITS='" + v + "': expected minimum or device");
+  return env && *env ? std::string_view(env) == "device" : asked;
 }
 
 // A backend of one explicit provider, refused when its renderer does not match the device substring.
@@ -478,14 +476,13 @@ std::unique_ptr<Backend> backendOf(Provider provider, const std::string& deviceS
 
 }  // namespace
 
+void checkGlesLimitsVariable() { checkVariableIsOneOf("SFFD_GLES_LIMITS", {"minimum", "device"}); }
+
 bool doublesLoseBits(std::string_view vendor) { return vendor.find("NVIDIA") != std::string_view::npos; }
 
 std::unique_ptr<Backend> createBackend(const Options& options) {
   Provider provider = options.provider;
-  if (provider == Provider::Auto) {
-    const char* env = std::getenv("SFFD_GL_PROVIDER");
-    if (env && *env) provider = parseProvider(env);
-  }
+  if (provider == Provider::Auto) provider = providerFromEnvironment();
   if (provider != Provider::Auto) return backendOf(provider, options.deviceSubstring, options.deviceLimits);
   std::string reasons;
   for (Provider p : {Provider::EGL, Provider::OSMesa}) {

@@ -32,6 +32,8 @@ bool doublesLoseBits(std::string_view vendor);
 // One entry per headless provider that gives a GL 4.3+ core context. Throws a device Error when none does.
 std::vector<DeviceInfo> listDevices();
 std::unique_ptr<Backend> createBackend(const Options& options);
+// An input Error when SFFD_GLES_LIMITS is set to anything but minimum (the default) or device.
+void checkGlesLimitsVariable();
 // A backend on a context the caller made (the viewer's visible GLFW window); the backend activates it
 // before its GL calls and keeps it alive. Throws a device Error when it is not GL 4.3+ core.
 std::unique_ptr<Backend> createBackendOn(std::shared_ptr<Context> context);

@@ -4,11 +4,13 @@
 #include <dlfcn.h>
 
 #include <atomic>
+#include <cstdlib>
 #include <string_view>
 
 #include <glad/gl.h>
 
 #include <sffd/error.h>
+#include "core/environment_check.h"
 
 namespace sffd::gl {
 
@@ -51,6 +53,14 @@ Provider parseProvider(const std::string& name) {
   if (name == "glfw") return Provider::GLFW;
   if (name == "egl-es") return Provider::EGLES;
   throw Error(ErrorKind::Input, "unknown GL provider '" + name + "' (egl, osmesa, glfw, egl-es)");
+}
+
+void checkGlProviderVariable() { checkVariableIsOneOf("SFFD_GL_PROVIDER", {"egl", "osmesa", "glfw"}); }
+
+Provider providerFromEnvironment() {
+  checkGlProviderVariable();
+  const char* env = std::getenv("SFFD_GL_PROVIDER");
+  return env && *env ? parseProvider(env) : Provider::Auto;
 }
 
 bool providerLibraryPresent(Provider provider) {

@@ -24,6 +24,10 @@ Provider parseProvider(const std::string& name);
 // Whether the provider's library can be opened (EGL, OSMesa) or linked in (GLFW) on this machine.
 // A present library may still give no context (no X display, no 4.3 core support).
 bool providerLibraryPresent(Provider provider);
+// What Auto becomes under SFFD_GL_PROVIDER=egl|osmesa|glfw (Auto when unset or empty); an input Error
+// (checkGlProviderVariable's) for any other value.
+Provider providerFromEnvironment();
+void checkGlProviderVariable();
 
 using GLProc = void (*)();
 

@@ -4,8 +4,10 @@
 
 #include <cstdlib>
 #include <string>
+#include <string_view>
 
 #include <sffd/error.h>
+#include "core/environment_check.h"
 
 namespace sffd::vk {
 
@@ -76,7 +78,12 @@ void Api::loadDevice(VkDevice device) {
 
 bool envFlag(const char* name) {
   const char* value = std::getenv(name);
-  return value && *value && std::string(value) != "0";
+  return value && std::string_view(value) == "1";
+}
+
+void checkVulkanVariables() {
+  for (const char* name : {"SFFD_VK_STAGING", "SFFD_VK_VERBOSE", "SFFD_VK_DISABLE_F64", "SFFD_VK_VALIDATION"})
+    checkVariableIsOneOf(name, {"0", "1"});
 }
 
 const char* resultName(VkResult result) {

@@ -107,8 +107,11 @@ struct Api {
   void loadDevice(VkDevice device);
 };
 
-// Whether env `name` is set to anything but "" or "0" (SFFD_VK_VALIDATION and the test switches).
+// Whether env `name`, one of the Vulkan backend's switches (SFFD_VK_STAGING, SFFD_VK_VERBOSE, SFFD_VK_DISABLE_F64,
+// SFFD_VK_VALIDATION), is 1. Never throws (the debug callback reads one): checkVulkanVariables refuses a value
+// but 0 or 1 before any work.
 bool envFlag(const char* name);
+void checkVulkanVariables();
 
 // A zero-initialised Vulkan struct with its sType set.
 template <typename T>
