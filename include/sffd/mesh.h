@@ -36,13 +36,19 @@ struct Material {
 // Every per-vertex field is one per vertex or, where it may be left out, empty; every per-triangle field
 // one per triangle or empty; indices in range. A Deformer and the writers refuse a Mesh that breaks this
 // (an input Error naming the field), and a Deformer a non-finite position, normal, texture coordinate or
-// colour too.
+// colour, or a weld id at two positions (weldId below), too.
 struct Mesh {
   std::vector<glm::dvec3> positions;             // per vertex, finite
   std::vector<glm::dvec3> normals;               // per vertex, unit length; empty: none (a Deformer computes them
                                                  // as readMesh computes missing ones, the writers write none)
-  std::vector<uint32_t> weldId;                  // per vertex: index of its distinct position, or location (below),
-                                                 // below the vertex count; empty: a Deformer welds by position
+  // Per vertex, the location on the surface it is at: a label below the vertex count (any labels; the
+  // readers number the distinct positions 0, 1, ... by first appearance). Smooth and accurate FFD join
+  // two triangles along an edge whose ends have the same two weld ids, so the vertices of one weld id must
+  // be at one position (equal coordinates, 0 and -0 alike). A Deformer refuses a mesh where they are not
+  // (positions edited after welding, say) with an input Error naming the first vertex away from its id's
+  // first vertex. Vertices at one position with different ids are two locations (two sheets touching):
+  // not joined, in the input as in the output. Empty: a Deformer welds by position.
+  std::vector<uint32_t> weldId;
   // false: weldId is by exact position (the readers, meshFromView), and the OBJ and OFF writers find
   // the distinct positions themselves. true: weldId names each vertex's location on the input surface
   // (the smooth and accurate output, weldPatchVertices), one position a location, and those writers

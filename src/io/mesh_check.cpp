@@ -2,6 +2,7 @@
 // written, checked in one place for the readers (finishMesh), meshFromView, the Deformer and writeMesh.
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include <sffd/error.h>
 
@@ -51,6 +52,24 @@ void checkIndices(const std::vector<uint32_t>& index, size_t tableSize, const ch
                                       count(tableSize, table) + (none ? " (nor Mesh::kNoIndex)" : ""));
 }
 
+// One weld id, one position: smooth and accurate FFD join two triangles along the edge whose corners have
+// the same two weld ids and weld their output by them, so two positions under one id would tear the result
+// or drop its triangles without a word. Vertices at one position with different ids are two locations (two
+// sheets touching) and stay apart, as the caller says. O(n): the first vertex of each id, no hash.
+void checkWeldPositions(const Mesh& mesh, const std::string& source) {
+  constexpr uint32_t kNone = ~0u;
+  std::vector<uint32_t> first(mesh.weldId.size(), kNone);   // ids are below the vertex count (checked)
+  for (size_t v = 0; v < mesh.weldId.size(); ++v) {
+    uint32_t& f = first[mesh.weldId[v]];
+    if (f == kNone) f = uint32_t(v);
+    else if (mesh.positions[v] != mesh.positions[f])   // == per coordinate: 0 and -0 are one position
+      throw inputError(source, 0, "weldId[" + std::to_string(v) + "] is " + std::to_string(mesh.weldId[v]) + ", as vertex " +
+                                      std::to_string(f) + "'s, but vertex " + std::to_string(v) + " is at " + text(mesh.positions[v]) +
+                                      " and vertex " + std::to_string(f) + " at " + text(mesh.positions[f]) +
+                                      ": vertices with one weld id must be at one position (leave weldId empty to weld by position)");
+  }
+}
+
 }  // namespace
 
 void checkMeshStructure(const Mesh& mesh, const std::string& source) {
@@ -79,6 +98,7 @@ void validateMesh(const Mesh& mesh, const std::string& source, bool normals) {
   // A weld id is a distinct position or location, of which there are no more than vertices.
   checkIndices(mesh.weldId, mesh.positions.size(), "weldId", "vertices", false, source);
   checkFinite(mesh.positions, "positions", source);
+  checkWeldPositions(mesh, source);   // after the finite check: NaN equals nothing
   if (normals) checkFinite(mesh.normals, "normals", source);
   checkFinite(mesh.texcoords, "texcoords", source);
   checkFinite(mesh.colors, "colors", source);

@@ -20,8 +20,8 @@ void weldPositions(Mesh& mesh);
 void checkMeshStructure(const Mesh& mesh, const std::string& source);
 
 // What a mesh to deform must hold besides (the readers, meshFromView and the Deformer check it): weldId
-// empty or one per vertex, each below the vertex count; finite positions, texture coordinates, colours
-// and, with `normals`, normals.
+// empty or one per vertex, each below the vertex count, the vertices of one id at one position; finite
+// positions, texture coordinates, colours and, with `normals`, normals.
 void validateMesh(const Mesh& mesh, const std::string& source, bool normals = true);
 
 }  // namespace sffd
