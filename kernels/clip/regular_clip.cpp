@@ -173,8 +173,7 @@ PackedClip packClip(const ClipTriangles& clip, size_t first, size_t last) {
   return P;
 }
 
-// The kernels' words are the arrays' bytes (PackedTable): SplitPattern is 4 uint32, SplitPatternVertex 3
-// float bits and a word of edge, pad 0 and step (little-endian: edge | step << 16), two uint16 a word.
+// The kernels' words are the arrays' bytes (PackedTable, split_pattern_table.h) on a little-endian host.
 static_assert(std::endian::native == std::endian::little, "the split-pattern table is uploaded as its bytes");
 static_assert(sizeof(SplitPattern) == 16 && sizeof(SplitPatternVertex) == 16);
 
