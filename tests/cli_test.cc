@@ -127,6 +127,22 @@ TEST(Cli, LatticeThenDeformWritesStats) {
     phases += j["host_ms"][k].get<double>();
   }
   EXPECT_LE(phases, j["timings_ms"]["total"].get<double>() + 1e-6);
+  EXPECT_EQ(j["host_ms"]["weld"].get<double>(), 0.0);   // classic welds nothing
+}
+
+// Smooth and accurate weld their output on the host: host_ms.weld is that part of result, and not 0.
+TEST(Cli, StatsGiveTheWeldsShareOfTheResult) {
+  fs::path dir = tempDir("weld_stats");
+  for (const char* method : {"smooth", "accurate"}) {
+    const std::string stats = (dir / (std::string(method) + ".json")).string();
+    RunResult r = runSffd("deform " + kData + "/sphere.obj -l " + kData + "/lattices/sphere_twist.npy --tess 3 --method " + method +
+                          " --backend cpu -o " + (dir / "t.ply").string() + " --stats " + stats + " --quiet");
+    ASSERT_EQ(r.status, 0) << r.err;
+    std::ifstream sf(stats);
+    nlohmann::json j = nlohmann::json::parse(sf);
+    EXPECT_GT(j["host_ms"]["weld"].get<double>(), 0.0) << method;
+    EXPECT_LE(j["host_ms"]["weld"].get<double>(), j["host_ms"]["result"].get<double>()) << method;
+  }
 }
 
 // The shader cache's counts in --stats: where the Vulkan driver has VK_EXT_shader_object (lavapipe 25),

@@ -108,7 +108,7 @@ int run(const ParsedArgs& args) {
         {"timings_ms", {{"pn", t.pnMs}, {"clip", t.clipMs}, {"deform", t.deformMs}, {"total", totalMs}}},
         // Where the whole run's wall time goes (docs/performance/whole_run.md): the inputs read,
         // the device opened, the lattice checked, the Deformer made (pre-compute), deformed, its result taken (download,
-        // weld), the output written.
+        // weld), the output written; then the weld's share of the result.
         {"host_ms",
          {{"read", readMs},
           {"open_device", openMs},
@@ -116,7 +116,8 @@ int run(const ParsedArgs& args) {
           {"prepare", run.prepareMs},
           {"deform", run.deformMs},
           {"result", run.resultMs},
-          {"write", writeMs}}},
+          {"write", writeMs},
+          {"weld", t.weldMs}}},   // part of result
     };
     // Smooth: the target edge length used (given, or a tenth of the mesh's largest extent); others: null.
     j["edge_length"] = run.method == "smooth" ? nlohmann::ordered_json(edgeLengthOf(args, job.mesh)) : nlohmann::ordered_json();

@@ -75,6 +75,8 @@ struct DeformOptions {
 struct Timings {
   double pnMs = 0, clipMs = 0, deformMs = 0;
   double wallMs = 0;                                    // the whole call, waiting included
+  double weldMs = 0;   // the last result() or streamResult() (smooth, accurate): host time making the patch
+                       // vertices from the device's output and welding them (a sink's pieces handed on included)
   std::vector<std::pair<std::string, double>> steps;   // the last deform()'s dispatches by label (split: deform.sample, ...)
 };
 

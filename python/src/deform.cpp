@@ -137,7 +137,7 @@ void bindDeform(py::module_& m, DeviceFor deviceFor) {
           steps[key] = (steps.contains(key) ? steps[key].cast<double>() : 0.0) + ms;
         }
         return py::dict("pn_ms"_a = t.pnMs, "clip_ms"_a = t.clipMs, "deform_ms"_a = t.deformMs, "wall_ms"_a = t.wallMs,
-                        "steps_ms"_a = steps);
+                        "weld_ms"_a = t.weldMs, "steps_ms"_a = steps);
       });
 
   m.def(

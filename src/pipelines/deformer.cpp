@@ -276,6 +276,7 @@ Mesh Deformer::result() const {
   CallScope call(impl().backend());
   ProgressReporter progress(impl().options.progress, &impl().backend());
   progress("download", 0);
+  impl().timings.weldMs = 0;
   return takeResult(impl(), [&] {
     Mesh mesh = impl().run->result(progress);
     progress("download", 1);
@@ -288,6 +289,7 @@ void Deformer::streamResult(MeshSink& sink) const {
   CallScope call(impl().backend());
   ProgressReporter progress(impl().options.progress, &impl().backend());
   progress("download", 0);
+  impl().timings.weldMs = 0;
   takeResult(impl(), [&] {
     impl().run->streamResult(sink, progress);
     progress("download", 1);

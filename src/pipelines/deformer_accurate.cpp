@@ -123,6 +123,7 @@ class AccurateRun final : public MethodRun {
     slice.level = job_.level;
     slice.reserve(kWeldSlice);
     auto add = [&](size_t first, size_t count, const auto* pos, const auto* nrm) {
+      const auto t0 = std::chrono::steady_clock::now();
       const size_t reals = size_t(tessVertexCount(job_.level)) * 4;
       for (size_t s = 0; s < count; s += kWeldSlice) {
         slice.clear();
@@ -130,6 +131,7 @@ class AccurateRun final : public MethodRun {
         carryPatchAttributes(slice, input_);
         weld.add(slice);
       }
+      timings_.weldMs += msSince(t0);
     };
     variant_.f64 ? forEachChunk<double>(add) : forEachChunk<float>(add);
   }

@@ -2,12 +2,14 @@
 // tessellation on the device; the results are downloaded when asked for. A one-shot Deformer's session
 // (DeformSession::streamed) runs only when its result is taken, a chunk at a time, each welded as it comes.
 #include <algorithm>
+#include <chrono>
 #include <memory>
 #include <stdexcept>
 
 #include <sffd/error.h>
 
 #include "core/huge_pages.h"
+#include "core/wall_clock.h"
 #include "kernels/smooth/smooth_deform.h"
 #include "pipelines/deform_session.h"
 #include "pipelines/deformer_internal.h"
@@ -80,6 +82,7 @@ class SmoothRun final : public MethodRun {
   // pre-image of c's first sub-triangle is pre's `preFirst`.
   void weldChunk(PatchWelder& weld, const DeformSession::Chunk& c, const SubTrianglePreImages& pre, size_t preFirst) const {
     auto add = [&](size_t first, size_t count, const auto* tess) {
+      const auto t0 = std::chrono::steady_clock::now();
       const size_t tessReals = 2 * size_t(tessVertexCount(session_->level())) * 4;
       for (size_t s = 0; s < count; s += kWeldSlice) {
         slice_.clear();
@@ -87,6 +90,7 @@ class SmoothRun final : public MethodRun {
         carryPatchAttributes(slice_, input_);
         weld.add(slice_);
       }
+      timings_.weldMs += msSince(t0);
     };
     session_->options().variant.f64 ? forEachBlock(c, downloadD_, add) : forEachBlock(c, downloadF_, add);
   }
