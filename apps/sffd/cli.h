@@ -3,7 +3,9 @@
 #pragma once
 #include <map>
 #include <optional>
+#include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <sffd/device.h>
@@ -122,6 +124,10 @@ JobAndDevice loadJobAndOpenDevice(const ParsedArgs& args);
 
 // --precision auto|float|double resolved for a backend (auto: double where the device has it).
 bool wantDouble(const ParsedArgs& args, const DeviceInfo& info, bool autoDouble);
+
+// An input Error "--backends: unknown backend 'x' (a, b, c)" for the first of `names` not among `known`, the
+// names a command's --backends takes (bench's, conform's), listed in the message in their order.
+void checkBackendNames(const std::vector<std::string>& names, std::span<const std::string_view> known);
 
 void note(const ParsedArgs& args, const std::string& line);   // stderr unless --quiet
 // A warning about the result or the input ("sffd: warning: LINE" on stderr, even with --quiet), printed

@@ -114,13 +114,8 @@ int run(const ParsedArgs& args) {
   if (names.empty()) throw Error(ErrorKind::Input, "--backends names no backend");
   // Named backends only, checked before any runs (docs/CLI.md): auto would time one of them again under its
   // name, and gl-glfw the GL driver gl-egl times, in a window.
-  static const char* const known[] = {"vulkan", "gl", "gl-egl", "gl-osmesa", "gles", "cpu"};
-  for (const std::string& n : names)
-    if (std::find(std::begin(known), std::end(known), n) == std::end(known)) {
-      std::string list;
-      for (const char* k : known) list += (list.empty() ? "" : ", ") + std::string(k);
-      throw Error(ErrorKind::Input, "--backends: unknown backend '" + n + "' (" + list + ")");
-    }
+  static constexpr std::string_view known[] = {"vulkan", "gl", "gl-egl", "gl-osmesa", "gles", "cpu"};
+  checkBackendNames(names, known);
   Job job = loadJob(args);
   DeformOptions& o = S.options;
   o.strict = args.has("--strict");

@@ -102,8 +102,7 @@ std::vector<BackendRun> readDump(const fs::path& dir, const std::vector<Case>& c
 
 int run(const ParsedArgs& args) {
   const std::vector<std::string> names = args.getList("--backends", "vulkan,gl-egl,gl-osmesa,cpu");
-  for (const std::string& n : names)
-    if (!backendNames().count(n)) throw Error(ErrorKind::Input, "--backends: unknown backend '" + n + "' (vulkan, gl, gl-egl, gl-osmesa, gl-glfw, gles, cpu)");
+  checkBackendNames(names, kBackendNames);
   const std::vector<std::string> required = args.getList("--require", "");
   for (const std::string& n : required)
     if (std::find(names.begin(), names.end(), n) == names.end())

@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <map>
 #include <optional>
-#include <set>
+#include <string_view>
 #include <string>
 #include <vector>
 
@@ -85,11 +85,8 @@ struct RunnerOptions {
   std::string deviceSubstring;
 };
 
-// The names --backends takes (and SFFD_CONFORM_FAULT's BACKEND).
-inline const std::set<std::string>& backendNames() {
-  static const std::set<std::string> names{"vulkan", "gl", "gl-egl", "gl-osmesa", "gl-glfw", "gles", "cpu"};
-  return names;
-}
+// The names --backends takes (and SFFD_CONFORM_FAULT's BACKEND), in the order its message lists them.
+inline constexpr std::string_view kBackendNames[] = {"vulkan", "gl", "gl-egl", "gl-osmesa", "gl-glfw", "gles", "cpu"};
 
 // An input Error when the test hook SFFD_CONFORM_FAULT (docs/CONFORMANCE.md) is set to a value that names no
 // fault (one it injected none for before).

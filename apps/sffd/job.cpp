@@ -334,6 +334,15 @@ void checkToolVariables() {
   conform::checkConformFaultVariable();
 }
 
+void checkBackendNames(const std::vector<std::string>& names, std::span<const std::string_view> known) {
+  for (const std::string& n : names)
+    if (std::find(known.begin(), known.end(), n) == known.end()) {
+      std::string list;
+      for (std::string_view k : known) list += (list.empty() ? "" : ", ") + std::string(k);
+      throw Error(ErrorKind::Input, "--backends: unknown backend '" + n + "' (" + list + ")");
+    }
+}
+
 bool wantDouble(const ParsedArgs& args, const DeviceInfo& info, bool autoDouble) {
   std::string p = args.get("--precision", "auto");
   if (p == "float") return false;
