@@ -146,7 +146,11 @@ struct Parent {
 // The reads in two forms (prelude.glsl sffdRollsLoops): for Mesa 22.3 and GPUs, few iterations of
 // several reads; where the host asks for rolled loops, one read an iteration. The values go through a
 // shift register (an array indexed by constants only: registers). Same values, same bits.
-Parent loadParent(uint id) {
+// Without `withPn` the PN record is not read and its points are 0: for a clip triangle whose sites are
+// all parent corners (cornerSitesOnly). The reads are in a branch, which lavapipe 25.0 skips where no lane
+// takes it and in which 22.3 reads for the lanes that take it only (docs/performance/kernels.md, "Reads
+// that a clip triangle needs").
+Parent loadParent(uint id, bool withPn) {
   Parent p;
   p.id = id;
   p.local = id - params.range.w;
@@ -156,14 +160,13 @@ Parent loadParent(uint id) {
   real3 q[22];
   uint base = SFFD_PN_STRIDE * p.local;
   if (!sffdRollsLoops()) {
-    for (uint h = 0u; h < 2u; ++h) {   // two iterations of eleven reads
-      for (uint j = 0u; j < 11u; ++j) q[j] = q[j + 11u];
-      for (uint j = 0u; j < 11u; ++j) {
-        uint i = 11u * h + j;
-        uint a = i < 3u ? positionIndex(p.verts[i]) : (i < 6u ? normalIndex(p.verts[i - 3u]) : pnIndex(base + (i - 6u)));
-        q[11u + j] = clipInReals[a].xyz;
+    for (uint i = 0u; i < 6u; ++i) q[i] = clipInReals[i < 3u ? positionIndex(p.verts[i]) : normalIndex(p.verts[i - 3u])].xyz;
+    for (uint j = 6u; j < 22u; ++j) q[j] = real3(0);
+    if (withPn)
+      for (uint h = 0u; h < 2u; ++h) {   // two iterations of eight reads
+        for (uint j = 0u; j < 8u; ++j) q[6u + j] = q[14u + j];
+        for (uint j = 0u; j < 8u; ++j) q[14u + j] = clipInReals[pnIndex(base + 8u * h + j)].xyz;
       }
-    }
   } else {
     // Three loops, each with a shift register of its own (6, 10, 6): every iteration moves each element of
     // its register under the lane mask, so one register of 22 cost 21 moves a read, these 5 to 9
@@ -173,13 +176,16 @@ Parent loadParent(uint id) {
       for (uint j = 0u; j < 5u; ++j) q[j] = q[j + 1u];
       q[5] = clipInReals[a].xyz;
     }
-    for (uint i = 0u; i < sffdRolled(10u); ++i) {
-      for (uint j = 6u; j < 15u; ++j) q[j] = q[j + 1u];
-      q[15] = clipInReals[pnIndex(base + i)].xyz;
-    }
-    for (uint i = 0u; i < sffdRolled(6u); ++i) {
-      for (uint j = 16u; j < 21u; ++j) q[j] = q[j + 1u];
-      q[21] = clipInReals[pnIndex(base + 10u + i)].xyz;
+    for (uint j = 6u; j < 22u; ++j) q[j] = real3(0);
+    if (withPn) {
+      for (uint i = 0u; i < sffdRolled(10u); ++i) {
+        for (uint j = 6u; j < 15u; ++j) q[j] = q[j + 1u];
+        q[15] = clipInReals[pnIndex(base + i)].xyz;
+      }
+      for (uint i = 0u; i < sffdRolled(6u); ++i) {
+        for (uint j = 16u; j < 21u; ++j) q[j] = q[j + 1u];
+        q[21] = clipInReals[pnIndex(base + 10u + i)].xyz;
+      }
     }
   }
   p.V[0] = q[0]; p.V[1] = q[1]; p.V[2] = q[2];
@@ -285,6 +291,11 @@ EdgeNeighbour edgeNeighbour(Parent p, real pe) {
   edgeEnds(p, e, lo, hi);
   uint sLo = SFFD_SLOT_NORMAL_STRIDE * p.local + 2u * slotOf(lo, e);
   uint sHi = SFFD_SLOT_NORMAL_STRIDE * p.local + 2u * slotOf(hi, e);
+  r.e = e;
+  // The flags first, one word each: most edges are no crease, and their four normals are then not read
+  // (as the PN record in loadParent).
+  r.crease = !(slotNormals(sLo).w < real(0.5) && slotNormals(sHi).w < real(0.5));
+  if (!r.crease) return r;
   real4 fLo, gLo, fHi, gHi;   // rolled where the host asks for it (see loadParent)
   if (!sffdRollsLoops()) {
     fLo = slotNormals(sLo), gLo = slotNormals(sLo + 1u);
@@ -297,8 +308,6 @@ EdgeNeighbour edgeNeighbour(Parent p, real pe) {
     }
     fLo = q[0], gLo = q[1], fHi = q[2], gHi = q[3];
   }
-  r.e = e;
-  r.crease = !(fLo.w < real(0.5) && fHi.w < real(0.5));
   r.nLo = gLo.w > real(0.5) ? gLo.xyz : fLo.xyz;   // the one that is not this triangle's own
   r.nHi = gHi.w > real(0.5) ? gHi.xyz : fHi.xyz;
   r.nMid = pnEdgeNormal(parentV(p, lo), parentV(p, hi), r.nLo, r.nHi);
@@ -355,6 +364,13 @@ ClipTriangle loadClipTriangle(uint ct) {
 
 real4 cornerLam(ClipTriangle T, uint c) { return c == 0u ? T.lam[0] : (c == 1u ? T.lam[1] : T.lam[2]); }
 real4 clipEdgeParams(ClipTriangle T, uint e) { return e == 0u ? T.edgeParams[0] : (e == 1u ? T.edgeParams[1] : T.edgeParams[2]); }
+
+// Whether every site of the clip triangle's split is a corner of its parent: one sub-triangle (each
+// edge one segment) whose corners are parent corners, as every clip triangle is where the mesh is finer
+// than the edge length. Its sites' values are then the parent's corner positions and normals alone.
+bool cornerSitesOnly(ClipTriangle T, ClipSetup S) {
+  return S.count == uvec3(1u) && (T.kinds & 255u) < 3u && ((T.kinds >> 8u) & 255u) < 3u && ((T.kinds >> 16u) & 255u) < 3u;
+}
 
 // Site of a corner of the clip triangle.
 Site clipCornerSite(ClipTriangle T, uint c) {

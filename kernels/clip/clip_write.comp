@@ -16,7 +16,7 @@ void main() {
   ClipSetup S;
   if (sffdRollsLoops()) S = clipSetupOf(T.welds, T.flatCorner);   // its records read once (loadClipTriangle)
   else S = clipSetup(ct);
-  Parent par = loadParent(T.parent);
+  Parent par = loadParent(T.parent, !cornerSitesOnly(T, S));
   // Per local clip edge: the parent edge it lies on and the neighbour's normal there (crease edges).
   // A rolled loop (one copy of the reads, see loadParent), the results through a shift register.
   EdgeNeighbour nbr0, nbr1, nbr2;
