@@ -43,7 +43,10 @@ void main() {
     uint c = s / 2u;
     uint other = (s % 2u == 1u) ? (c + 1u) % 3u : (c + 2u) % 3u;
     real4 nFirst = slotNormals[SFFD_SLOT_NORMAL_STRIDE * tri + 2u * s];
-    real3 nSecond = slotNormals[SFFD_SLOT_NORMAL_STRIDE * tri + 2u * s + 1u].xyz;
+    // Read for a crease slot only, the one pnEdgePoint uses it in: most slots are none, and lavapipe reads
+    // in a branch only for the lanes in it (clip_sites.glsl loadParent).
+    real3 nSecond = real3(0);
+    if (nFirst.w > real(0.5)) nSecond = slotNormals[SFFD_SLOT_NORMAL_STRIDE * tri + 2u * s + 1u].xyz;
     real3 Vc = c == 0u ? V0 : (c == 1u ? V1 : V2), Vo = other == 0u ? V0 : (other == 1u ? V1 : V2);
     real3 e = pnEdgePoint(Vc, Vo, nFirst, nSecond);
     for (uint j = 0u; j < 5u; ++j) b[j] = b[j + 1u];
