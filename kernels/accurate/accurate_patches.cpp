@@ -306,42 +306,43 @@ AccurateOutput accurateFfd(Backend& backend, const AccurateJob& job, const Packe
 
 namespace {
 template <class Real>
-void appendAccurate(const AccurateJob& job, size_t first, size_t count, const Real* positions, const Real* normals,
-                    PatchVertices& pv) {
-  const int L = pv.level, nv = tessVertexCount(L);
-  for (size_t s = first; s < first + count; ++s) {
-    const SubTriangle& T = job.subs[s];
-    pv.parent.push_back(T.parent);
-    for (int r = 0; r <= L; ++r)
-      for (int q = 0; q <= r; ++q) {
-        const int v = r * (r + 1) / 2 + q;
-        const double l0 = double(L - r) / L, l1 = double(r - q) / L, l2 = double(q) / L;
-        glm::dvec3 lam = (l0 * T.corners[0].lam + l1 * T.corners[1].lam) + l2 * T.corners[2].lam;
-        const size_t g = (s - first) * nv + v;
-        for (int a = 0; a < 3; ++a) {
-          pv.lamParent.push_back(lam[a]);
-          pv.position.push_back(double(positions[4 * g + a]) + 0.0);   // -0 -> +0: welding compares bits
-          pv.normal.push_back(double(normals[4 * g + a]) + 0.0);
-        }
+void writeAccurate(const AccurateJob& job, size_t first, size_t count, const Real* positions, const Real* normals, size_t at,
+                   PatchVertices& pv) {
+  const size_t nv = size_t(tessVertexCount(pv.level));
+  const std::vector<double> w = tessWeights(pv.level);
+  pv.resize(at + count);
+  double* lamParent = &pv.lamParent[3 * nv * at];
+  double* position = &pv.position[3 * nv * at];
+  double* normal = &pv.normal[3 * nv * at];
+  for (size_t s = 0; s < count; ++s) {
+    const SubTriangle& T = job.subs[first + s];
+    pv.parent[at + s] = T.parent;
+    for (size_t v = 0; v < nv; ++v, lamParent += 3, position += 3, normal += 3) {
+      const size_t g = s * nv + v;
+      for (int a = 0; a < 3; ++a) {
+        lamParent[a] = (w[3 * v] * T.corners[0].lam[a] + w[3 * v + 1] * T.corners[1].lam[a]) + w[3 * v + 2] * T.corners[2].lam[a];
+        position[a] = double(positions[4 * g + a]) + 0.0;   // -0 -> +0: welding compares bits
+        normal[a] = double(normals[4 * g + a]) + 0.0;
       }
+    }
   }
 }
 }  // namespace
 
-void appendAccuratePatchVertices(const AccurateJob& job, size_t first, size_t count, const float* positions,
-                                 const float* normals, PatchVertices& pv) {
-  appendAccurate(job, first, count, positions, normals, pv);
+void writeAccuratePatchVertices(const AccurateJob& job, size_t first, size_t count, const float* positions,
+                                const float* normals, size_t at, PatchVertices& pv) {
+  writeAccurate(job, first, count, positions, normals, at, pv);
 }
-void appendAccuratePatchVertices(const AccurateJob& job, size_t first, size_t count, const double* positions,
-                                 const double* normals, PatchVertices& pv) {
-  appendAccurate(job, first, count, positions, normals, pv);
+void writeAccuratePatchVertices(const AccurateJob& job, size_t first, size_t count, const double* positions,
+                                const double* normals, size_t at, PatchVertices& pv) {
+  writeAccurate(job, first, count, positions, normals, at, pv);
 }
 
 PatchVertices accuratePatchVertices(const AccurateJob& job, const AccurateOutput& out) {
   PatchVertices pv;
   pv.level = job.level;
   pv.reserve(job.count());
-  appendAccurate(job, 0, job.count(), out.positions.data(), out.normals.data(), pv);
+  writeAccurate(job, 0, job.count(), out.positions.data(), out.normals.data(), 0, pv);
   return pv;
 }
 

@@ -113,13 +113,14 @@ void dispatchAccurateChunk(Backend& backend, const gpu::AccurateParams& params, 
 // Per patch its parent, per tessellation vertex its pre-image barycentrics in the parent
 // (sum_i lambda_i lam_i), its position and normal.
 PatchVertices accuratePatchVertices(const AccurateJob& job, const AccurateOutput& out);
-// The same, a chunk at a time: appends sub-triangles [first, first + count) to `patches` (level set, room
-// reserved by the caller: PatchVertices::reserve), their positions and normals (x, y, z, w) a tessellation
-// vertex as the device holds them, widened to double here.
-void appendAccuratePatchVertices(const AccurateJob& job, size_t first, size_t count, const float* positions,
-                                 const float* normals, PatchVertices& patches);
-void appendAccuratePatchVertices(const AccurateJob& job, size_t first, size_t count, const double* positions,
-                                 const double* normals, PatchVertices& patches);
+// The same, a chunk at a time: sub-triangles [first, first + count) become the patches from `at` on of
+// `patches` (level set; resized to at + count patches: PatchVertices::resize), their positions and normals
+// (x, y, z, w) a tessellation vertex as the device holds them, widened to double here. `at`: patchCount()
+// appends (room reserved by the caller: PatchVertices::reserve), 0 refills a slice.
+void writeAccuratePatchVertices(const AccurateJob& job, size_t first, size_t count, const float* positions,
+                                const float* normals, size_t at, PatchVertices& patches);
+void writeAccuratePatchVertices(const AccurateJob& job, size_t first, size_t count, const double* positions,
+                                const double* normals, size_t at, PatchVertices& patches);
 
 struct CpuKernelArgs;
 namespace cpu {

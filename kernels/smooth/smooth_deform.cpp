@@ -147,36 +147,35 @@ void dispatchDeform(Backend& backend, const gpu::DeformParams& params, const Def
 
 namespace {
 template <class Real>
-void appendPatchVerticesOf(const SubTrianglePreImages& subs, size_t first, size_t count, const Real* tess, PatchVertices& P) {
-  const int L = P.level, nv = tessVertexCount(L);
-  for (size_t s = first; s < first + count; ++s) {
-    P.parent.push_back(subs.parent[s]);
-    glm::dvec3 lam[3];
-    for (int c = 0; c < 3; ++c) {
-      const double* l = &subs.lam[9 * s + 3 * c];
-      lam[c] = {l[0], l[1], l[2]};
-    }
-    const Real* t = &tess[(s - first) * 2 * nv * 4];
-    for (int r = 0; r <= L; ++r)
-      for (int c = 0; c <= r; ++c) {
-        int v = r * (r + 1) / 2 + c;
-        glm::dvec3 w(double(L - r) / L, double(r - c) / L, double(c) / L);
-        glm::dvec3 lp = w.x * lam[0] + w.y * lam[1] + w.z * lam[2];
-        for (int a = 0; a < 3; ++a) {
-          P.lamParent.push_back(lp[a]);
-          P.position.push_back(double(t[4 * v + a]));
-          P.normal.push_back(double(t[4 * (nv + v) + a]));
-        }
+void writePatchVerticesOf(const SubTrianglePreImages& subs, size_t first, size_t count, const Real* tess, size_t at,
+                          PatchVertices& P) {
+  const size_t nv = size_t(tessVertexCount(P.level));
+  const std::vector<double> w = tessWeights(P.level);
+  P.resize(at + count);
+  double* lamParent = &P.lamParent[3 * nv * at];
+  double* position = &P.position[3 * nv * at];
+  double* normal = &P.normal[3 * nv * at];
+  for (size_t s = 0; s < count; ++s) {
+    P.parent[at + s] = subs.parent[first + s];
+    const double* lam = &subs.lam[9 * (first + s)];   // corner c's barycentrics from 3c
+    const Real* t = &tess[s * 2 * nv * 4];
+    for (size_t v = 0; v < nv; ++v, lamParent += 3, position += 3, normal += 3)
+      for (int a = 0; a < 3; ++a) {
+        lamParent[a] = w[3 * v] * lam[a] + w[3 * v + 1] * lam[3 + a] + w[3 * v + 2] * lam[6 + a];
+        position[a] = double(t[4 * v + a]);
+        normal[a] = double(t[4 * (nv + v) + a]);
       }
   }
 }
 }  // namespace
 
-void appendPatchVertices(const SubTrianglePreImages& subs, size_t first, size_t count, const float* tess, PatchVertices& P) {
-  appendPatchVerticesOf(subs, first, count, tess, P);
+void writePatchVertices(const SubTrianglePreImages& subs, size_t first, size_t count, const float* tess, size_t at,
+                        PatchVertices& P) {
+  writePatchVerticesOf(subs, first, count, tess, at, P);
 }
-void appendPatchVertices(const SubTrianglePreImages& subs, size_t first, size_t count, const double* tess, PatchVertices& P) {
-  appendPatchVerticesOf(subs, first, count, tess, P);
+void writePatchVertices(const SubTrianglePreImages& subs, size_t first, size_t count, const double* tess, size_t at,
+                        PatchVertices& P) {
+  writePatchVerticesOf(subs, first, count, tess, at, P);
 }
 
 PatchVertices patchVerticesOf(const SubTriangleRecords& subs, const SmoothOutput& out) {
@@ -185,7 +184,7 @@ PatchVertices patchVerticesOf(const SubTriangleRecords& subs, const SmoothOutput
   SubTrianglePreImages pre;
   pre.append(subs.headers.data(), subs.records.data(), subs.size());
   P.reserve(pre.size());
-  appendPatchVerticesOf(pre, 0, pre.size(), out.tess.data(), P);
+  writePatchVerticesOf(pre, 0, pre.size(), out.tess.data(), 0, P);
   return P;
 }
 

@@ -73,11 +73,14 @@ struct SubTrianglePreImages {
 // The tessellation with each vertex's pre-image in its parent triangle (for the writers and the
 // error analysis).
 PatchVertices patchVerticesOf(const SubTriangleRecords& subs, const SmoothOutput& out);
-// The same, a chunk at a time: appends sub-triangles [first, first + count) to `patches` (level set, room
-// reserved by the caller: PatchVertices::reserve), their tessellation at `tess` as the device holds it (2 nv
-// (x, y, z, w) a sub-triangle: positions, then normals), widened to double here.
-void appendPatchVertices(const SubTrianglePreImages& subs, size_t first, size_t count, const float* tess, PatchVertices& patches);
-void appendPatchVertices(const SubTrianglePreImages& subs, size_t first, size_t count, const double* tess, PatchVertices& patches);
+// The same, a chunk at a time: sub-triangles [first, first + count) become the patches from `at` on of
+// `patches` (level set; resized to at + count patches: PatchVertices::resize), their tessellation at `tess`
+// as the device holds it (2 nv (x, y, z, w) a sub-triangle: positions, then normals), widened to double
+// here. `at`: patchCount() appends (room reserved by the caller: PatchVertices::reserve), 0 refills a slice.
+void writePatchVertices(const SubTrianglePreImages& subs, size_t first, size_t count, const float* tess, size_t at,
+                        PatchVertices& patches);
+void writePatchVertices(const SubTrianglePreImages& subs, size_t first, size_t count, const double* tess, size_t at,
+                        PatchVertices& patches);
 
 struct CpuKernelArgs;
 namespace cpu {

@@ -4,6 +4,7 @@
 // OBJ), and a rehash reuses the storage the last table left: a streamed weld rehashes every compaction,
 // and fresh storage each time cost more in page faults and the kernel's zeroing than the weld itself.
 #pragma once
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -20,29 +21,20 @@ class Key3Map {
   explicit Key3Map(size_t expected) : expected_(expected) {}
 
   // The value of `key`; a new key gets `fresh`. The reference stays valid until the next of() or remap().
+  // Inline, the rare cases apart: the weld asks it for most of a patch's boundary vertices.
   uint32_t& of(const Key3& key, uint32_t fresh) {
-    if (same(key, kEmpty)) {   // the all-zero key (+0.0, +0.0, +0.0) marks empty slots: kept beside them
-      if (!hasZero_) hasZero_ = true, zeroValue_ = fresh;
-      return zeroValue_;
-    }
-    if (slots_.empty()) {   // allocated at the first key (a weld that forgets locations expects fewer)
-      size_t n = 16;
-      while (n < 2 * expected_) n *= 2;
-      resizeHuge(slots_, n);
-    }
-    if (2 * (used_ + 1) > slots_.size()) grow();
-    Slot* s = find(key);
-    if (same(s->key, kEmpty)) s->key = key, s->value = fresh, ++used_;
-    return s->value;
+    if (same(key, kEmpty) || 2 * (used_ + 1) > slots_.size()) return ofRare(key, fresh);
+    return insert(key, fresh);
   }
 
-  // Keeps the keys whose value v has a new value to[v] (`none`: the key goes), in a table sized for them.
-  void remap(const std::vector<uint32_t>& to, uint32_t none) {
+  // Keeps the keys whose value v has a new value to[v] (`none`: the key goes), in a table sized for them,
+  // or for `room` keys if more (those expected before the next remap: a growth rehashes them all).
+  void remap(const std::vector<uint32_t>& to, uint32_t none, size_t room = 0) {
     if (hasZero_) hasZero_ = to[zeroValue_] != none, zeroValue_ = to[zeroValue_];
     size_t kept = 0;
     for (const Slot& s : slots_) kept += !same(s.key, kEmpty) && to[s.value] != none;
     size_t n = 16;
-    while (n < 4 * kept) n *= 2;
+    while (n < 2 * std::max(2 * kept, room)) n *= 2;
     emptyTable(n);
     used_ = kept;
     for (const Slot& s : spare_)
@@ -60,6 +52,25 @@ class Key3Map {
     h = (h ^ (h >> 29) ^ k[1]) * 0xBF58476D1CE4E5B9ull;
     h = (h ^ (h >> 31) ^ k[2]) * 0x94D049BB133111EBull;
     return size_t(h ^ (h >> 32));
+  }
+  uint32_t& insert(const Key3& key, uint32_t fresh) {
+    Slot* s = find(key);
+    if (same(s->key, kEmpty)) s->key = key, s->value = fresh, ++used_;
+    return s->value;
+  }
+  // of() for the all-zero key, the first key and a key that needs a larger table.
+  [[gnu::noinline]] uint32_t& ofRare(const Key3& key, uint32_t fresh) {
+    if (same(key, kEmpty)) {   // the all-zero key (+0.0, +0.0, +0.0) marks empty slots: kept beside them
+      if (!hasZero_) hasZero_ = true, zeroValue_ = fresh;
+      return zeroValue_;
+    }
+    if (slots_.empty()) {   // allocated at the first key (a weld that forgets locations expects fewer)
+      size_t n = 16;
+      while (n < 2 * expected_) n *= 2;
+      resizeHuge(slots_, n);
+    }
+    if (2 * (used_ + 1) > slots_.size()) grow();
+    return insert(key, fresh);
   }
   Slot* find(const Key3& key) {
     const size_t mask = slots_.size() - 1;

@@ -69,14 +69,11 @@ constexpr size_t kBlock = 4096;   // records writePly and writeStl append betwee
 
 namespace meshio {
 
-void checkFiniteVertex(const std::string& path, size_t v, const glm::dvec3& position, const glm::dvec3* normal, bool floats) {
+void throwBadVertex(const std::string& path, size_t v, const glm::dvec3& position, const glm::dvec3* normal, bool floats) {
   auto finite = [](const glm::dvec3& x) { return std::isfinite(x.x) && std::isfinite(x.y) && std::isfinite(x.z); };
-  if (finite(position) && (!normal || finite(*normal))) {
-    // A file of floats would hold a double past their range as an infinity (normals are unit).
-    if (!floats || (io::withinFloatRange(position.x) && io::withinFloatRange(position.y) && io::withinFloatRange(position.z))) return;
+  if (finite(position) && (!normal || finite(*normal)) && floats)
     throw Error(ErrorKind::Input, path + ": not written: vertex " + std::to_string(v) +
                                       " of the result lies beyond the range of the file's floats (a text file holds it)");
-  }
   throw Error(ErrorKind::Input, path + ": not written: vertex " + std::to_string(v) + " of the result has a " +
                                     (finite(position) ? "non-finite normal" : "non-finite position") +
                                     " (the lattice moves it beyond the floating-point range of the computation)");

@@ -2,10 +2,13 @@
 // its pieces come has writeMesh's bytes.
 #pragma once
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <string>
 
 #include <sffd/mesh.h>
+
+#include "io/io_util.h"
 
 namespace sffd::meshio {
 
@@ -18,10 +21,22 @@ struct Carried {
 // naming what is wrong; an internal one for digits outside 1..17).
 std::string checkWriteTarget(const std::string& path, const MeshWriteOptions& options);
 
+// checkFiniteVertex's Error for a vertex that fails it.
+[[noreturn]] void throwBadVertex(const std::string& path, size_t v, const glm::dvec3& position, const glm::dvec3* normal,
+                                 bool floats);
+
 // An input Error naming vertex `v` when its position or its normal (null: none) is not finite, or, for a
-// file of floats (binary STL), its position is past their range.
-void checkFiniteVertex(const std::string& path, size_t v, const glm::dvec3& position, const glm::dvec3* normal,
-                       bool floats = false);
+// file of floats (binary STL), its position is past their range (a double there would be an infinity; normals
+// are unit). Inline: the writers ask it for every vertex.
+inline void checkFiniteVertex(const std::string& path, size_t v, const glm::dvec3& position, const glm::dvec3* normal,
+                              bool floats = false) {
+  auto finite = [](const glm::dvec3& x) { return std::isfinite(x.x) && std::isfinite(x.y) && std::isfinite(x.z); };
+  auto inFloats = [](const glm::dvec3& x) {
+    return io::withinFloatRange(x.x) && io::withinFloatRange(x.y) && io::withinFloatRange(x.z);
+  };
+  if (!finite(position) || (normal && !finite(*normal)) || (floats && !inFloats(position)))
+    throwBadVertex(path, v, position, normal, floats);
+}
 
 // PLY: float properties for `digits` <= 9, double above (the text header's rule too).
 std::string plyHeader(size_t vertices, size_t faces, int digits, const Carried& has, bool binary);

@@ -126,8 +126,7 @@ class AccurateRun final : public MethodRun {
       const auto t0 = std::chrono::steady_clock::now();
       const size_t reals = size_t(tessVertexCount(job_.level)) * 4;
       for (size_t s = 0; s < count; s += kWeldSlice) {
-        slice.clear();
-        appendAccuratePatchVertices(job_, first + s, std::min(kWeldSlice, count - s), pos + s * reals, nrm + s * reals, slice);
+        writeAccuratePatchVertices(job_, first + s, std::min(kWeldSlice, count - s), pos + s * reals, nrm + s * reals, 0, slice);
         carryPatchAttributes(slice, input_);
         weld.add(slice);
       }
@@ -142,7 +141,7 @@ class AccurateRun final : public MethodRun {
     p.reserve(job_.count());
     auto add = [&](size_t first, size_t count, const auto* pos, const auto* nrm) {
       if (first != p.patchCount()) throw std::logic_error("AccurateRun: chunks out of order");
-      appendAccuratePatchVertices(job_, first, count, pos, nrm, p);
+      writeAccuratePatchVertices(job_, first, count, pos, nrm, p.patchCount(), p);
     };
     variant_.f64 ? forEachChunk<double>(add) : forEachChunk<float>(add);
     carryAttributes(p, input_);

@@ -85,8 +85,7 @@ class SmoothRun final : public MethodRun {
       const auto t0 = std::chrono::steady_clock::now();
       const size_t tessReals = 2 * size_t(tessVertexCount(session_->level())) * 4;
       for (size_t s = 0; s < count; s += kWeldSlice) {
-        slice_.clear();
-        appendPatchVertices(pre, preFirst + first + s, std::min(kWeldSlice, count - s), tess + s * tessReals, slice_);
+        writePatchVertices(pre, preFirst + first + s, std::min(kWeldSlice, count - s), tess + s * tessReals, 0, slice_);
         carryPatchAttributes(slice_, input_);
         weld.add(slice_);
       }
@@ -108,7 +107,7 @@ class SmoothRun final : public MethodRun {
     p.level = session_->level();
     auto append = [&](const DeformSession::Chunk& c, const SubTrianglePreImages& pre, size_t preFirst) {
       if (c.first != p.patchCount()) throw std::logic_error("SmoothRun: chunks out of order");
-      auto add = [&](size_t first, size_t count, const auto* tess) { appendPatchVertices(pre, preFirst + first, count, tess, p); };
+      auto add = [&](size_t first, size_t count, const auto* tess) { writePatchVertices(pre, preFirst + first, count, tess, p.patchCount(), p); };
       session_->options().variant.f64 ? forEachBlock(c, downloadD_, add) : forEachBlock(c, downloadF_, add);
     };
     if (session_->streamed()) {

@@ -31,6 +31,13 @@ int tessVertexCount(int level) {
 }
 int tessTriangleCount(int level) { return checkedLevel(level, "tessTriangleCount") * level; }
 
+std::vector<double> tessWeights(int L) {
+  std::vector<double> w;
+  for (int r = 0; r <= L; ++r)
+    for (int c = 0; c <= r; ++c) w.insert(w.end(), {double(L - r) / L, double(r - c) / L, double(c) / L});
+  return w;
+}
+
 std::vector<uint32_t> tessTriangles(int L) {
   std::vector<uint32_t> t;
   auto idx = [](int r, int c) { return uint32_t(r * (r + 1) / 2 + c); };
@@ -127,10 +134,9 @@ bool sameNormal(const double* a, const double* b) {
 // both sides, so the bits agree), a point inside the parent by the parent and its barycentrics.
 class Locations {
  public:
-  // Keys expected: a patch's 3 (level - 1) edge points, each shared by two patches, and about one corner a
-  // patch off the input's corners (where a parent is split). The table holds twice as many slots (32 B each,
-  // all touched: at 1 M patches of level 3, 8 M slots), and grows if a mesh has more.
-  explicit Locations(size_t patches, int level) : other_(patches * (3 * size_t(level) - 1) / 2) {}
+  // `keys`: about how many the table will hold (it holds twice as many slots, 32 B each, all touched, and
+  // grows if a mesh has more).
+  explicit Locations(size_t keys) : other_(keys) {}
   static constexpr uint32_t kNone = ~0u;
 
   // The slot that holds the location of the vertex at pre-image `lam` of a patch of `parent`, whose
@@ -154,11 +160,11 @@ class Locations {
   }
   // Per weldId of the input, the last triangle with a corner there.
   void setLastUse(std::vector<uint32_t> lastUse) { lastUse_ = std::move(lastUse); }
-  // Gives each location v the slot to[v], or forgets it (kNone).
-  void remap(const std::vector<uint32_t>& to) {
+  // Gives each location v the slot to[v], or forgets it (kNone); `room`: the keys expected before the next remap.
+  void remap(const std::vector<uint32_t>& to, size_t room) {
     for (uint32_t& c : corner_)
       if (c != kNone) c = to[c];
-    other_.remap(to, kNone);
+    other_.remap(to, kNone, room);
   }
 
  private:
@@ -179,56 +185,71 @@ bool onPatchBoundary(int v, int L) {
 }  // namespace
 
 struct PatchWelder::Impl {
+  static constexpr uint32_t kNone = Locations::kNone;
   int level;
   size_t patches;   // all that will come: the outputs are reserved for them
   std::vector<uint32_t> local;   // tessTriangles
   std::vector<char> boundary;    // per patch vertex
-  Mesh m;   // per vertex slot its normal and carried values, weldId: its location's slot
-  // Per location: its position (from the patch of the lowest parent that reaches it, so that every
-  // triangle there uses the same bits where the sides disagree: a fin, a sliver) and first vertex;
-  // per vertex: the next vertex of its location (one per distinct normal and carried value).
+  // The output, each vertex's weldId its location's number: streamed, the piece of the last add() (its storage
+  // reused), else the whole Mesh. A patch's inner vertices go only here: no other patch reaches them.
+  Mesh out;
+  // Per location on a patch's boundary: its position (from the patch of the lowest parent that reaches it, so
+  // that every triangle there uses the same bits where the sides disagree: a fin, a sliver), first slot, until
+  // (the last parent that can reach it, forgetPassedLocations) and number.
   struct Location {
     uint32_t parent, first;
     glm::dvec3 position;
   };
   std::vector<Location> locs;
-  std::vector<uint32_t> next;
+  std::vector<uint32_t> locUntil, locId;
+  // Per slot (a vertex of a boundary location: one per distinct normal and carried value) those values, for
+  // the next patches' vertices there to match, its location's slot, the location's next slot and its vertex
+  // number. Compaction renumbers the slots, never the numbers.
+  std::vector<glm::dvec3> normals;
+  std::vector<glm::dvec2> texcoords;
+  std::vector<glm::dvec4> colors;
+  std::vector<uint32_t> slotLoc, next, vertexId;
   Locations where;
+  std::vector<uint32_t> vertexOf, locationOf;   // per vertex of the current patch: its vertex and location numbers
+  size_t made = 0;   // the output's vertices: in add(), its arrays are longer (the room for a patch's)
+  bool uv = false, rgba = false;   // the slice has texture coordinates, colours
   bool started = false;
-  MeshSink* sink;       // streamed: the pieces go here
-  Mesh piece;           // streamed: the vertices and triangles of the last add()
-  size_t emitted = 0;   // streamed: the vertex slots handed over
+  MeshSink* sink;   // streamed: the pieces go here
   uint32_t lastParent = 0;
-  // Forgetting (forgetPassedLocations): the slots are compacted, so a slot's location and vertex numbers (the
-  // output's) are kept per slot; until: the last parent that can reach the location.
-  bool forgetting = false;
-  std::vector<uint32_t> locUntil, locId, vertexId;
+  bool forgetting = false;   // forgetPassedLocations
   size_t locTotal = 0, vertexTotal = 0;   // made so far: the next location's and vertex's numbers
   size_t minCompact = 0, compactAt = 0;   // locations held when the next add() compacts: at least minCompact
 
+  // The keys of all the patches: a patch's 3 (level - 1) edge points, each shared by two patches, and about
+  // one corner a patch off the input's corners (where a parent is split): at 1 M patches of level 3, 8 M slots.
+  static size_t keysOf(size_t patches, int level) { return patches * (3 * size_t(level) - 1) / 2; }
+
   Impl(int level, size_t patches, MeshSink* sink)
-      : level(level), patches(patches), local(tessTriangles(level)), where(patches, level), sink(sink) {
+      : level(level), patches(patches), local(tessTriangles(level)), where(keysOf(patches, level)), sink(sink) {
     const int nv = tessVertexCount(level);
     boundary.resize(nv);
     for (int v = 0; v < nv; ++v) boundary[v] = onPatchBoundary(v, level);
-    m.normalsFromFile = true;
-    m.weldIdIsLocation = true;
+    vertexOf.resize(nv), locationOf.resize(nv);
   }
 
   // Reserved for at most every patch vertex and triangle (address space only: no growth copies, and the
   // pages not reached are never touched), in huge pages (core/huge_pages.h).
   void reserve(const PatchVertices& P) {
     const size_t vertices = patches * size_t(tessVertexCount(level)), triangles = patches * local.size() / 3;
-    reserveHuge(m.normals, vertices);
-    if (!P.texcoord.empty()) reserveHuge(m.texcoords, vertices);
-    if (!P.color.empty()) reserveHuge(m.colors, vertices);
-    reserveHuge(m.weldId, vertices);
-    reserveHuge(next, vertices);
+    reserveHuge(normals, vertices);
+    if (!P.texcoord.empty()) reserveHuge(texcoords, vertices);
+    if (!P.color.empty()) reserveHuge(colors, vertices);
+    for (auto* v : {&slotLoc, &next, &vertexId, &locUntil, &locId}) reserveHuge(*v, vertices);
     reserveHuge(locs, vertices);
-    if (sink) return;   // the triangles go with each piece
-    reserveHuge(m.triangles, triangles);
-    if (!P.material.empty()) reserveHuge(m.triangleMaterial, triangles);
-    if (!P.group.empty()) reserveHuge(m.triangleGroup, triangles);
+    if (sink) return;   // the output goes a piece at a time
+    reserveHuge(out.positions, vertices);
+    reserveHuge(out.normals, vertices);
+    if (!P.texcoord.empty()) reserveHuge(out.texcoords, vertices);
+    if (!P.color.empty()) reserveHuge(out.colors, vertices);
+    reserveHuge(out.weldId, vertices);
+    reserveHuge(out.triangles, triangles);
+    if (!P.material.empty()) reserveHuge(out.triangleMaterial, triangles);
+    if (!P.group.empty()) reserveHuge(out.triangleGroup, triangles);
   }
 
   void add(const PatchVertices& P) {
@@ -237,25 +258,9 @@ struct PatchWelder::Impl {
     if (P.level != level) throw std::logic_error("PatchWelder: patches of another level");
     if (!started) reserve(P), started = true;
     if (forgetting && locs.size() >= compactAt && P.patchCount()) compact(P.parent[0]);
-    const int nv = tessVertexCount(level);
-    const bool uv = !P.texcoord.empty(), rgba = !P.color.empty();
-    auto sameVertex = [&](uint32_t i, size_t g) {
-      return sameNormal(&m.normals[i][0], &P.normal[3 * g]) && (!uv || sameBits<2>(&m.texcoords[i][0], &P.texcoord[2 * g])) &&
-             (!rgba || sameBits<4>(&m.colors[i][0], &P.color[4 * g]));
-    };
-    auto newVertex = [&](size_t g, uint32_t loc) {
-      const uint32_t i = uint32_t(m.normals.size());
-      m.normals.push_back({P.normal[3 * g], P.normal[3 * g + 1], P.normal[3 * g + 2]});
-      if (uv) m.texcoords.push_back({P.texcoord[2 * g], P.texcoord[2 * g + 1]});
-      if (rgba) m.colors.push_back({P.color[4 * g], P.color[4 * g + 1], P.color[4 * g + 2], P.color[4 * g + 3]});
-      m.weldId.push_back(loc);
-      next.push_back(Locations::kNone);
-      if (forgetting) vertexId.push_back(uint32_t(vertexTotal));
-      ++vertexTotal;
-      return i;
-    };
-    auto positionOf = [&](size_t g) { return glm::dvec3(P.position[3 * g], P.position[3 * g + 1], P.position[3 * g + 2]); };
-    std::vector<uint32_t> map(nv);
+    const size_t nv = vertexOf.size(), nt = local.size() / 3;
+    uv = !P.texcoord.empty(), rgba = !P.color.empty();
+    const bool material = !P.material.empty(), group = !P.group.empty();
     for (size_t p = 0; p < P.patchCount(); ++p) {
       const uint32_t parent = P.parent[p];
       if (sink && parent < lastParent) throw std::logic_error("PatchWelder: streamed patches out of parent order");
@@ -264,101 +269,139 @@ struct PatchWelder::Impl {
       // patch, made from normals that need not agree at that location (a duplicate vertex of an unwelded file),
       // stuck out of the surface, and its edge points could give the real triangles' edge their positions.
       if (weldsCollapsed(P.parentWeld[3 * p], P.parentWeld[3 * p + 1], P.parentWeld[3 * p + 2])) continue;
-      for (int v = 0; v < nv; ++v) {
+      // Room for a new vertex per patch vertex and every triangle, written in place and cut to what was made:
+      // no push_back's checks per element.
+      made = out.positions.size();
+      for (auto* v : {&out.positions, &out.normals}) v->resize(made + nv);
+      if (uv) out.texcoords.resize(made + nv);
+      if (rgba) out.colors.resize(made + nv);
+      out.weldId.resize(made + nv);
+      for (size_t v = 0; v < nv; ++v) {
         const size_t g = p * nv + v;
-        uint32_t fresh = Locations::kNone, until = parent;
-        // A patch's inner vertices are its own.
-        uint32_t& loc = boundary[v] ? where.of(parent, &P.parentWeld[3 * p], &P.lamParent[3 * g], until) : fresh;
-        if (loc == Locations::kNone) {
-          loc = uint32_t(locs.size());
-          locs.push_back({parent, uint32_t(m.normals.size()), positionOf(g)});
-          if (forgetting) locUntil.push_back(until), locId.push_back(uint32_t(locTotal));
-          ++locTotal;
-          map[v] = newVertex(g, loc);
-          continue;
-        }
-        Location& L = locs[loc];
-        if (parent < L.parent) L.parent = parent, L.position = positionOf(g);
-        uint32_t i = L.first;
-        while (!sameVertex(i, g) && next[i] != Locations::kNone) i = next[i];
-        if (!sameVertex(i, g)) i = next[i] = newVertex(g, loc);
-        map[v] = i;
+        if (boundary[v]) boundaryVertex(P, p, v);
+        else locationOf[v] = uint32_t(locTotal++), vertexOf[v] = newVertex(P, g, &P.position[3 * g], locationOf[v]);
       }
+      for (auto* v : {&out.positions, &out.normals}) v->resize(made);
+      if (uv) out.texcoords.resize(made);
+      if (rgba) out.colors.resize(made);
+      out.weldId.resize(made);
+      size_t t = out.triangles.size();
+      out.triangles.resize(t + nt);
       for (size_t i = 0; i < local.size(); i += 3) {
-        std::array<uint32_t, 3> t{map[local[i]], map[local[i + 1]], map[local[i + 2]]};
-        const uint32_t* w = m.weldId.data();
-        if (weldsCollapsed(w[t[0]], w[t[1]], w[t[2]])) continue;   // a collapsed corner of a degenerate patch
-        if (forgetting) t = {vertexId[t[0]], vertexId[t[1]], vertexId[t[2]]};
-        m.triangles.push_back(t);
-        if (!P.material.empty()) m.triangleMaterial.push_back(P.material[p]);
-        if (!P.group.empty()) m.triangleGroup.push_back(P.group[p]);
+        const uint32_t a = local[i], b = local[i + 1], c = local[i + 2];
+        if (weldsCollapsed(locationOf[a], locationOf[b], locationOf[c])) continue;   // a collapsed corner of a degenerate patch
+        out.triangles[t++] = {vertexOf[a], vertexOf[b], vertexOf[c]};
       }
+      out.triangles.resize(t);
+      if (material) out.triangleMaterial.resize(t, P.material[p]);
+      if (group) out.triangleGroup.resize(t, P.group[p]);
     }
     if (sink) emit();
   }
 
-  // The vertices made since the last piece (each location's position final: parents do not decrease) and
-  // the triangles, to the sink; the triangles are not kept.
-  void emit() {
-    const size_t n = m.normals.size();
-    piece.positions.clear();
-    for (size_t i = emitted; i < n; ++i) piece.positions.push_back(locs[m.weldId[i]].position);
-    auto tail = [&](const auto& from, auto& to) { to.assign(from.begin() + std::ptrdiff_t(std::min(emitted, from.size())), from.end()); };
-    tail(m.normals, piece.normals);
-    tail(m.texcoords, piece.texcoords);
-    tail(m.colors, piece.colors);
-    tail(m.weldId, piece.weldId);
-    if (forgetting)
-      for (uint32_t& w : piece.weldId) w = locId[w];
-    piece.triangles.swap(m.triangles);
-    piece.triangleMaterial.swap(m.triangleMaterial);
-    piece.triangleGroup.swap(m.triangleGroup);
-    m.triangles.clear(), m.triangleMaterial.clear(), m.triangleGroup.clear();
-    sink->add(piece, vertexTotal - (n - emitted));
-    emitted = n;
+  // Vertex v of patch p, on the patch's boundary: its location (found or made) and the vertex there with its
+  // normal and carried values (found or made).
+  void boundaryVertex(const PatchVertices& P, size_t p, size_t v) {
+    const uint32_t parent = P.parent[p];
+    const size_t g = p * vertexOf.size() + v;
+    uint32_t until = parent;
+    uint32_t& loc = where.of(parent, &P.parentWeld[3 * p], &P.lamParent[3 * g], until);
+    uint32_t i;
+    if (loc == kNone) {
+      loc = uint32_t(locs.size());
+      locs.push_back({parent, uint32_t(slotLoc.size()), {P.position[3 * g], P.position[3 * g + 1], P.position[3 * g + 2]}});
+      locUntil.push_back(until), locId.push_back(uint32_t(locTotal++));
+      i = newSlot(P, g, loc);
+    } else {
+      Location& L = locs[loc];
+      if (parent < L.parent) {   // not streamed: the vertices made there so far move with it
+        L.parent = parent, L.position = {P.position[3 * g], P.position[3 * g + 1], P.position[3 * g + 2]};
+        for (uint32_t j = L.first; j != kNone; j = next[j]) out.positions[vertexId[j]] = L.position;
+      }
+      i = L.first;
+      while (!sameVertex(P, i, g) && next[i] != kNone) i = next[i];
+      if (!sameVertex(P, i, g)) i = next[i] = newSlot(P, g, loc);
+    }
+    vertexOf[v] = vertexId[i], locationOf[v] = locId[loc];
   }
 
-  // Drops the locations no patch of parent `now` or later can reach, with their vertices (all handed
-  // over: compact() runs between pieces), and renumbers the slots of the rest in order.
+  bool sameVertex(const PatchVertices& P, uint32_t i, size_t g) const {
+    return sameNormal(&normals[i][0], &P.normal[3 * g]) && (!uv || sameBits<2>(&texcoords[i][0], &P.texcoord[2 * g])) &&
+           (!rgba || sameBits<4>(&colors[i][0], &P.color[4 * g]));
+  }
+
+  // A slot for patch vertex g at location slot `loc`, and its vertex.
+  uint32_t newSlot(const PatchVertices& P, size_t g, uint32_t loc) {
+    normals.push_back({P.normal[3 * g], P.normal[3 * g + 1], P.normal[3 * g + 2]});
+    if (uv) texcoords.push_back({P.texcoord[2 * g], P.texcoord[2 * g + 1]});
+    if (rgba) colors.push_back({P.color[4 * g], P.color[4 * g + 1], P.color[4 * g + 2], P.color[4 * g + 3]});
+    slotLoc.push_back(loc);
+    next.push_back(kNone);
+    vertexId.push_back(newVertex(P, g, &locs[loc].position[0], locId[loc]));
+    return uint32_t(slotLoc.size() - 1);
+  }
+
+  // An output vertex at `position` with patch vertex g's normal and carried values, at location number
+  // `location`, into the room add() made: its number.
+  uint32_t newVertex(const PatchVertices& P, size_t g, const double* position, uint32_t location) {
+    out.positions[made] = {position[0], position[1], position[2]};
+    out.normals[made] = {P.normal[3 * g], P.normal[3 * g + 1], P.normal[3 * g + 2]};
+    if (uv) out.texcoords[made] = {P.texcoord[2 * g], P.texcoord[2 * g + 1]};
+    if (rgba) out.colors[made] = {P.color[4 * g], P.color[4 * g + 1], P.color[4 * g + 2], P.color[4 * g + 3]};
+    out.weldId[made++] = location;
+    return uint32_t(vertexTotal++);
+  }
+
+  // The vertices and triangles made since the last piece to the sink (each position final: parents do not
+  // decrease), and none of them kept.
+  void emit() {
+    sink->add(out, vertexTotal - out.positions.size());
+    for (auto* v : {&out.positions, &out.normals}) v->clear();
+    out.texcoords.clear(), out.colors.clear(), out.weldId.clear();
+    out.triangles.clear(), out.triangleMaterial.clear(), out.triangleGroup.clear();
+  }
+
+  // Drops the locations no patch of parent `now` or later can reach, with their slots (their vertices all
+  // handed over), and renumbers the slots of the rest in order.
   void compact(uint32_t now) {
-    constexpr uint32_t kNone = Locations::kNone;
-    std::vector<uint32_t> toLoc(locs.size(), kNone), toVertex(m.normals.size(), kNone);
+    std::vector<uint32_t> toLoc(locs.size(), kNone), toSlot(slotLoc.size(), kNone);
     size_t kept = 0;
     for (size_t l = 0; l < locs.size(); ++l)
       if (locUntil[l] >= now) toLoc[l] = uint32_t(kept), locs[kept] = locs[l], locUntil[kept] = locUntil[l], locId[kept] = locId[l], ++kept;
     locs.resize(kept), locUntil.resize(kept), locId.resize(kept);
-    const bool uv = !m.texcoords.empty(), rgba = !m.colors.empty();
-    size_t keptV = 0;
-    for (size_t i = 0; i < m.normals.size(); ++i) {
-      if (toLoc[m.weldId[i]] == kNone) continue;
-      toVertex[i] = uint32_t(keptV);
-      m.normals[keptV] = m.normals[i];
-      if (uv) m.texcoords[keptV] = m.texcoords[i];
-      if (rgba) m.colors[keptV] = m.colors[i];
-      m.weldId[keptV] = toLoc[m.weldId[i]];
-      next[keptV] = next[i];
-      vertexId[keptV] = vertexId[i];
-      ++keptV;
+    const bool uv = !texcoords.empty(), rgba = !colors.empty();
+    size_t keptS = 0;
+    for (size_t i = 0; i < slotLoc.size(); ++i) {
+      if (toLoc[slotLoc[i]] == kNone) continue;
+      toSlot[i] = uint32_t(keptS);
+      normals[keptS] = normals[i];
+      if (uv) texcoords[keptS] = texcoords[i];
+      if (rgba) colors[keptS] = colors[i];
+      slotLoc[keptS] = toLoc[slotLoc[i]];
+      next[keptS] = next[i];
+      vertexId[keptS] = vertexId[i];
+      ++keptS;
     }
-    for (auto* v : {&m.weldId, &next, &vertexId}) v->resize(keptV);
-    m.normals.resize(keptV);
-    if (uv) m.texcoords.resize(keptV);
-    if (rgba) m.colors.resize(keptV);
-    for (size_t i = 0; i < keptV; ++i)
-      if (next[i] != kNone) next[i] = toVertex[next[i]];
-    for (Location& L : locs) L.first = toVertex[L.first];
-    where.remap(toLoc);
-    emitted = keptV;
+    for (auto* v : {&slotLoc, &next, &vertexId}) v->resize(keptS);
+    normals.resize(keptS);
+    if (uv) texcoords.resize(keptS);
+    if (rgba) colors.resize(keptS);
+    for (uint32_t& n : next)
+      if (n != kNone) n = toSlot[n];
+    for (Location& L : locs) L.first = toSlot[L.first];
     compactAt = std::max(minCompact, 2 * kept);
+    where.remap(toLoc, compactAt);   // a key a location at most, and the next compaction comes at compactAt
   }
 
   Mesh finish() {
     if (forgetting) throw std::logic_error("PatchWelder: finish() after forgetPassedLocations");
-    reserveHuge(m.positions, m.normals.size());
-    for (size_t i = 0; i < m.normals.size(); ++i) m.positions.push_back(locs[m.weldId[i]].position);
+    if (sink) throw std::logic_error("PatchWelder: finish() of a streamed weld (its pieces went to the sink)");
+    out.normalsFromFile = true;
+    out.weldIdIsLocation = true;
     freeStorage(locs);
     freeStorage(next);
-    return std::move(m);
+    freeStorage(normals);
+    return std::move(out);
   }
 
   void forgetPassed(const Mesh& input, size_t compactFrom) {
@@ -370,7 +413,7 @@ struct PatchWelder::Impl {
         if (w >= lastUse.size()) lastUse.resize(size_t(w) + 1, 0);
         lastUse[w] = t;
       }
-    where = Locations(0, level);   // no table for every patch's keys: it holds the front's
+    where = Locations(compactFrom);   // no table for every patch's keys: it holds the front's (a key a location)
     where.setLastUse(std::move(lastUse));
     forgetting = true;
     minCompact = compactAt = compactFrom;

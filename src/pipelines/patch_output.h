@@ -17,6 +17,9 @@ namespace sffd {
 // (r,t),(r+1,t+1),(r,t+1) for t < r (METHOD.md 3.4 step 6).
 int tessVertexCount(int level);
 int tessTriangleCount(int level);
+// The barycentrics (i, j, k) / L of the level's vertices in their sub-triangle, 3 a vertex in index order:
+// the weights of the sub-triangle's corners in a vertex's pre-image (the producers compute them once a call).
+std::vector<double> tessWeights(int level);
 // The L^2 triangles of one patch as local vertex indices, 3 each.
 std::vector<uint32_t> tessTriangles(int level);
 
@@ -34,8 +37,8 @@ struct PatchVertices {
   std::vector<Material> materials;   // the input's tables, as Mesh has them
   std::vector<std::string> groups, materialLibraries;
   size_t patchCount() const { return parent.size(); }
-  // Room for `patches` patches of `level` in parent, lamParent, position and normal, reserved, not
-  // resized: producers push every element once, in order (no zero fill of what is overwritten).
+  // Room for `patches` patches of `level` in parent, lamParent, position and normal, reserved (address
+  // space: a producer's resize() touches the pages as it fills them).
   void reserve(size_t patches) {
     const size_t reals = 3 * patches * size_t(tessVertexCount(level));
     parent.reserve(patches);
@@ -44,10 +47,12 @@ struct PatchVertices {
     reserveHuge(normal, reals);
   }
   size_t vertexCount() const { return position.size() / 3; }
-  // Empties the per-patch and per-vertex arrays, keeping their room (a slice reused for the next patches).
-  void clear() {
-    for (auto* v : {&parent, &material, &group, &parentWeld}) v->clear();
-    for (auto* v : {&lamParent, &position, &normal, &texcoord, &color}) v->clear();
+  // parent, lamParent, position and normal sized for `patches` patches, for a producer that writes every
+  // element in place: a slice reused at the same size is not zero-filled again (the weld's slices are).
+  void resize(size_t patches) {
+    const size_t reals = 3 * patches * size_t(tessVertexCount(level));
+    parent.resize(patches);
+    for (auto* v : {&lamParent, &position, &normal}) v->resize(reals);
   }
 };
 
