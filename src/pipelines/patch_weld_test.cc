@@ -314,6 +314,39 @@ TEST_P(PatchWeldOf, SlicesWeldAsOne) {
   }
 }
 
+// A location shared by two patches whose positions there disagree (a fin, a sliver) takes the position of
+// the lower parent's patch, whichever comes first: the vertices made there before it move with it.
+TEST(PatchWeld, ALocationTakesTheLowerParentsPositionInEitherOrder) {
+  const Mesh input = meshOf({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}}, {{0, 1, 2}, {2, 1, 3}});
+  // Level 1: a patch's vertices are its corners, barycentrics (1,0,0), (0,1,0), (0,0,1).
+  auto patches = [&](std::vector<uint32_t> parents) {
+    PatchVertices P;
+    P.level = 1;
+    for (uint32_t parent : parents) {
+      P.parent.push_back(parent);
+      for (int c = 0; c < 3; ++c) {
+        const uint32_t v = input.triangles[parent][c];
+        // Parent 1 puts the shared corners (1 and 2) half a unit higher than parent 0 does.
+        const glm::dvec3 x = input.positions[v] + glm::dvec3(0, 0, parent == 1 && v != 3 ? 0.5 : 0.0);
+        for (int a = 0; a < 3; ++a) {
+          P.lamParent.push_back(a == c ? 1.0 : 0.0);
+          P.position.push_back(x[a]);
+          P.normal.push_back(a == 2 ? 1.0 : 0.0);
+        }
+      }
+    }
+    carryAttributes(P, input);
+    return P;
+  };
+  for (const std::vector<uint32_t>& order : {std::vector<uint32_t>{0, 1}, std::vector<uint32_t>{1, 0}}) {
+    SCOPED_TRACE("parents " + std::to_string(order[0]) + ", " + std::to_string(order[1]));
+    const Mesh m = weldPatchVertices(patches(order));
+    ASSERT_EQ(m.positions.size(), 4u);
+    ASSERT_EQ(m.triangles.size(), 2u);
+    for (const glm::dvec3& x : m.positions) EXPECT_EQ(x.z, 0.0);   // parent 0's, at corners 1 and 2 too
+  }
+}
+
 // What a streamed weld hands over, appended.
 struct GatheringSink final : MeshSink {
   Mesh m;
