@@ -177,22 +177,22 @@ PackedClip packClip(const ClipTriangles& clip, size_t first, size_t last) {
 static_assert(std::endian::native == std::endian::little, "the split-pattern table is uploaded as its bytes");
 static_assert(sizeof(SplitPattern) == 16 && sizeof(SplitPatternVertex) == 16);
 
+PackedTable packedTableOf(const SplitPatternTable& S) {
+  PackedTable t;
+  t.nmax = uint32_t(S.nmax());
+  t.vertexWord = uint32_t(4 * S.patterns().size());
+  t.triangleWord = t.vertexWord + uint32_t(4 * S.vertices().size());
+  t.wordCount = t.triangleWord + uint32_t((S.triangles().size() + 1) / 2);
+  return t;
+}
+
 const PackedTable& packedTable() {
-  static const PackedTable T = [] {
-    const SplitPatternTable& S = splitPatternTable();
-    PackedTable t;
-    t.nmax = uint32_t(S.nmax());
-    t.vertexWord = uint32_t(4 * S.patterns().size());
-    t.triangleWord = t.vertexWord + uint32_t(4 * S.vertices().size());
-    t.wordCount = t.triangleWord + uint32_t((S.triangles().size() + 1) / 2);
-    return t;
-  }();
+  static const PackedTable T = packedTableOf(splitPatternTable());
   return T;
 }
 
-void uploadPackedTable(Backend& backend, BufferId words) {
-  const SplitPatternTable& S = splitPatternTable();
-  const PackedTable& T = packedTable();
+void uploadPackedTable(Backend& backend, BufferId words, const SplitPatternTable& S) {
+  const PackedTable T = packedTableOf(S);
   backend.upload(words, 0, S.patterns().data(), S.patterns().size_bytes());
   backend.upload(words, uint64_t(T.vertexWord) * 4, S.vertices().data(), S.vertices().size_bytes());
   const std::span<const uint16_t> tri = S.triangles();

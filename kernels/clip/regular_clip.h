@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/backend.h"
+#include "kernels/clip/split_pattern_table.h"
 #include "kernels/common/shader_layout.h"
 #include "kernels/pn/pn_triangles.h"
 #include "model/prepared_mesh.h"
@@ -102,8 +103,10 @@ PackedClip packClip(const ClipTriangles& clip, size_t first, size_t last);   // 
 struct PackedTable {
   uint32_t nmax = 0, vertexWord = 0, triangleWord = 0, wordCount = 0;
 };
-const PackedTable& packedTable();
-void uploadPackedTable(Backend& backend, BufferId words);   // into words [0, wordCount) of `words`
+PackedTable packedTableOf(const SplitPatternTable& table);
+const PackedTable& packedTable();   // the compiled-in table's (splitPatternTable())
+// Into words [0, wordCount) of `words`: the compiled-in table, or another (a test's).
+void uploadPackedTable(Backend& backend, BufferId words, const SplitPatternTable& table = splitPatternTable());
 
 // The clip kernels' two input ranges (layout.h, SFFD_BINDING_CLIP_REALS and SFFD_BINDING_CLIP_WORDS) of
 // one pre-compute chunk: all the vertices, the chunk's parents [firstParent, + parents) and their clip

@@ -165,3 +165,45 @@ TEST(RegularClip, FewerSliversThanKnotBoxAtComparableCounts) {
   EXPECT_GT(b.minAngleDeg, a.minAngleDeg);
   EXPECT_LT(b.shareBelow03, a.shareBelow03);
 }
+
+namespace {
+
+// The words uploadPackedTable writes for `table` into a buffer filled with ones before.
+std::vector<uint32_t> uploadedWords(const SplitPatternTable& table) {
+  Backend& B = sffd::testing::cpuBackend();
+  const PackedTable T = packedTableOf(table);
+  std::vector<uint32_t> words(T.wordCount, ~0u);
+  const BufferId buffer = B.createBuffer(words.size() * 4);
+  B.upload(buffer, 0, words.data(), words.size() * 4);
+  uploadPackedTable(B, buffer, table);
+  B.download(buffer, 0, words.data(), words.size() * 4);
+  B.destroyBuffer(buffer);
+  return words;
+}
+
+}  // namespace
+
+// The clip kernels read the table as words: the patterns and vertices as they are, the 16-bit triangle
+// indices two to a word (low half first), and an odd count's last word with its upper half 0. The compiled-in
+// table's count is even (Nmax 24), so an odd one is made here.
+TEST(RegularClip, TheTableUploadsAsTheKernelsReadItAtAnyLength) {
+  const SplitPattern patterns[] = {{0, 3, 0, 1}};
+  const SplitPatternVertex vertices[] = {{{1, 0, 0}, 0, 0, 0}, {{0, 1, 0}, 1, 0, 0}, {{0, 0, 1}, 2, 0, 0}};
+  const uint16_t indices[] = {0, 1, 2, 2, 1, 0};
+  for (size_t count : {size_t(3), size_t(6)}) {
+    SCOPED_TRACE(std::to_string(count) + " indices");
+    const SplitPatternTable table(1, patterns, vertices, std::span<const uint16_t>(indices, count));
+    const PackedTable T = packedTableOf(table);
+    EXPECT_EQ(T.vertexWord, 4u);
+    EXPECT_EQ(T.triangleWord, 16u);
+    EXPECT_EQ(T.wordCount, 16u + (count + 1) / 2);
+    const std::vector<uint32_t> words = uploadedWords(table);
+    EXPECT_EQ(std::memcmp(words.data(), patterns, sizeof patterns), 0);
+    EXPECT_EQ(std::memcmp(&words[T.vertexWord], vertices, sizeof vertices), 0);
+    for (size_t i = 0; i < count; ++i) {
+      const uint32_t w = words[T.triangleWord + i / 2];
+      EXPECT_EQ(i % 2 ? w >> 16 : w & 0xffffu, indices[i]) << "index " << i;
+    }
+    if (count % 2) EXPECT_EQ(words.back() >> 16, 0u);
+  }
+}
