@@ -12,6 +12,7 @@
 
 #include "backends/backend_select.h"
 #include "backends/backend_test_support.h"
+#include "model/mesh.h"
 #include "pipelines/deform_session.h"
 #include "pipelines/deform_session_internal.h"
 #include "pipelines/device_reals.h"
@@ -164,12 +165,27 @@ TEST_P(DeformSessionTest, PrecomputeChunksGiveTheSameRecordsAndOutput) {
 // A one-shot session (DeformSessionOptions::once) makes its clip triangles and runs every stage a few
 // parents at a time (streamChunks): in many small chunks, with pre-split parents (cube2 at l = 0.05) and
 // with knot-box clipping, the same pre-images, tessellation and patches as a session that keeps everything.
+// A strip of 40 triangles that widen along it (0.01 to 1.9): at l = 0.05 the last are split into several clip
+// triangles each, so a streamed job's later chunks need larger buffers than its first, which StreamBuffer::atLeast
+// makes again (the split-pattern table and the vertex section uploaded into the new ones).
+Mesh wideningStrip() {
+  Mesh m;
+  double x = 0, w = 0.01;
+  for (int i = 0; i <= 20; ++i, x += w, w *= 1.3) m.positions.insert(m.positions.end(), {{x, 0, 0}, {x, 0.3, 0.05 * x}});
+  for (uint32_t i = 0; i < 20; ++i)
+    m.triangles.insert(m.triangles.end(), {{2 * i, 2 * i + 2, 2 * i + 1}, {2 * i + 1, 2 * i + 2, 2 * i + 3}});
+  for (uint32_t v = 0; v < m.positions.size(); ++v) m.weldId.push_back(v);
+  computeVertexNormals(m);
+  return m;
+}
+
 TEST_P(DeformSessionTest, StreamedChunksGiveTheSameOutput) {
   SFFD_OPEN_OR_SKIP(b, GetParam());
   for (auto [file, l, knotBox] : {std::tuple{"/cube2.obj", 0.05, false}, std::tuple{"/sphere.obj", 0.3, false},
-                                  std::tuple{"/sphere.obj", 0.3, true}, std::tuple{"/torus.obj", 0.3, true}}) {
+                                  std::tuple{"/sphere.obj", 0.3, true}, std::tuple{"/torus.obj", 0.3, true},
+                                  std::tuple{"widening strip", 0.05, false}}) {
     SCOPED_TRACE(std::string(file) + (knotBox ? " knot-box" : ""));
-    const Mesh m = readMesh(std::string(SFFD_TEST_DATA) + file);
+    const Mesh m = file[0] == '/' ? readMesh(std::string(SFFD_TEST_DATA) + file) : wideningStrip();
     const Lattice A = latticeFor(m, 5, 0.1);
     DeformSessionOptions o;
     o.variant = {true, false};
