@@ -314,13 +314,13 @@ void writeAccurate(const AccurateJob& job, size_t first, size_t count, const Rea
   double* lamParent = &pv.lamParent[3 * nv * at];
   double* position = &pv.position[3 * nv * at];
   double* normal = &pv.normal[3 * nv * at];
-  for (size_t s = 0; s < count; ++s) {
+  for (size_t s = 0; s < count; ++s, lamParent += 3 * nv) {
     const SubTriangle& T = job.subs[first + s];
     pv.parent[at + s] = T.parent;
-    for (size_t v = 0; v < nv; ++v, lamParent += 3, position += 3, normal += 3) {
+    writeTessPreImages(w, &T.corners[0].lam[0], &T.corners[1].lam[0], &T.corners[2].lam[0], lamParent);
+    for (size_t v = 0; v < nv; ++v, position += 3, normal += 3) {
       const size_t g = s * nv + v;
       for (int a = 0; a < 3; ++a) {
-        lamParent[a] = (w[3 * v] * T.corners[0].lam[a] + w[3 * v + 1] * T.corners[1].lam[a]) + w[3 * v + 2] * T.corners[2].lam[a];
         position[a] = double(positions[4 * g + a]) + 0.0;   // -0 -> +0: welding compares bits
         normal[a] = double(normals[4 * g + a]) + 0.0;
       }

@@ -159,9 +159,9 @@ Parent loadParent(uint id, bool withPn) {
   // two iterations of eleven reads.
   real3 q[22];
   uint base = SFFD_PN_STRIDE * p.local;
+  for (uint j = 6u; j < 22u; ++j) q[j] = real3(0);   // the PN record's, where it is not read
   if (!sffdRollsLoops()) {
     for (uint i = 0u; i < 6u; ++i) q[i] = clipInReals[i < 3u ? positionIndex(p.verts[i]) : normalIndex(p.verts[i - 3u])].xyz;
-    for (uint j = 6u; j < 22u; ++j) q[j] = real3(0);
     if (withPn)
       for (uint h = 0u; h < 2u; ++h) {   // two iterations of eight reads
         for (uint j = 0u; j < 8u; ++j) q[6u + j] = q[14u + j];
@@ -176,7 +176,6 @@ Parent loadParent(uint id, bool withPn) {
       for (uint j = 0u; j < 5u; ++j) q[j] = q[j + 1u];
       q[5] = clipInReals[a].xyz;
     }
-    for (uint j = 6u; j < 22u; ++j) q[j] = real3(0);
     if (withPn) {
       for (uint i = 0u; i < sffdRolled(10u); ++i) {
         for (uint j = 6u; j < 15u; ++j) q[j] = q[j + 1u];

@@ -155,13 +155,13 @@ void writePatchVerticesOf(const SubTrianglePreImages& subs, size_t first, size_t
   double* lamParent = &P.lamParent[3 * nv * at];
   double* position = &P.position[3 * nv * at];
   double* normal = &P.normal[3 * nv * at];
-  for (size_t s = 0; s < count; ++s) {
+  for (size_t s = 0; s < count; ++s, lamParent += 3 * nv) {
     P.parent[at + s] = subs.parent[first + s];
     const double* lam = &subs.lam[9 * (first + s)];   // corner c's barycentrics from 3c
+    writeTessPreImages(w, lam, lam + 3, lam + 6, lamParent);
     const Real* t = &tess[s * 2 * nv * 4];
-    for (size_t v = 0; v < nv; ++v, lamParent += 3, position += 3, normal += 3)
+    for (size_t v = 0; v < nv; ++v, position += 3, normal += 3)
       for (int a = 0; a < 3; ++a) {
-        lamParent[a] = w[3 * v] * lam[a] + w[3 * v + 1] * lam[3 + a] + w[3 * v + 2] * lam[6 + a];
         position[a] = double(t[4 * v + a]);
         normal[a] = double(t[4 * (nv + v) + a]);
       }

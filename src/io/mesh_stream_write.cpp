@@ -95,7 +95,7 @@ struct MeshFileWriter::Impl {
     // The largest index first (a loop that vectorizes), each triangle's only for the message.
     uint32_t most = 0;
     for (const auto& t : piece.triangles) most = std::max(most, std::max(t[0], std::max(t[1], t[2])));
-    for (size_t t = 0; !piece.triangles.empty() && most >= vertices + n && t < piece.triangles.size(); ++t)
+    for (size_t t = 0; most >= vertices + n && t < piece.triangles.size(); ++t)
       for (uint32_t i : piece.triangles[t])
         if (i >= vertices + n)
           throw inputError(path, 0, "mesh piece's triangles[" + std::to_string(t) + "]: vertex index " + std::to_string(i) +

@@ -38,6 +38,11 @@ std::vector<double> tessWeights(int L) {
   return w;
 }
 
+void writeTessPreImages(const std::vector<double>& w, const double* c0, const double* c1, const double* c2, double* out) {
+  for (size_t v = 0; v < w.size(); v += 3, out += 3)
+    for (int a = 0; a < 3; ++a) out[a] = (w[v] * c0[a] + w[v + 1] * c1[a]) + w[v + 2] * c2[a];
+}
+
 std::vector<uint32_t> tessTriangles(int L) {
   std::vector<uint32_t> t;
   auto idx = [](int r, int c) { return uint32_t(r * (r + 1) / 2 + c); };

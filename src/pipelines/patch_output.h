@@ -20,6 +20,9 @@ int tessTriangleCount(int level);
 // The barycentrics (i, j, k) / L of the level's vertices in their sub-triangle, 3 a vertex in index order:
 // the weights of the sub-triangle's corners in a vertex's pre-image (the producers compute them once a call).
 std::vector<double> tessWeights(int level);
+// The pre-images of one patch's vertices, 3 reals a vertex into `out`: vertex v at weights tessWeights()[3v..] of
+// its sub-triangle's corners, which lie at barycentrics c0, c1, c2 of the parent (the weld keys on these bits).
+void writeTessPreImages(const std::vector<double>& weights, const double* c0, const double* c1, const double* c2, double* out);
 // The L^2 triangles of one patch as local vertex indices, 3 each.
 std::vector<uint32_t> tessTriangles(int level);
 
